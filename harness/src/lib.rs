@@ -1,0 +1,7 @@
+//! mfh-harness: the verification harness for microfacet BSDF mathematics — evaluation of
+//! closed forms (`mfh eval`), and, as the project grows, oracles, checks, audits and reports.
+//!
+//! The binary `mfh` is a thin layer over [`cli::run`].
+
+pub mod cli;
+pub mod eval;

@@ -1,0 +1,18 @@
+//! mfh-reference: the reference closed forms of microfacet BSDF mathematics.
+//!
+//! Normal distribution functions, Smith Λ / G1 / G2, importance-sampling inversions and slope
+//! moments, each citing the source document and equation it implements (the documents live in
+//! `../shared/seeds/`). This crate holds closed forms only: no oracles, no I/O, no randomness.
+//! Every closed form is checked by the harness (`mfh-harness`) against independent oracles.
+
+pub mod error;
+pub mod geometry;
+pub mod model;
+pub mod ndf;
+pub mod spec;
+pub mod special;
+
+pub use error::{ParamError, QueryError};
+pub use geometry::Vec3;
+pub use model::{Masking, Model, Ndf, NormalSampler, SlopeDistribution, Smith};
+pub use spec::ModelSpec;

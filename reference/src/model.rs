@@ -1,0 +1,187 @@
+//! The model boundary: capability traits every NDF implements as far as it has a meaning for
+//! them (DESIGN.md, "The model boundary").
+
+use crate::error::QueryError;
+use crate::geometry::{dot, Vec3};
+use crate::spec::ModelSpec;
+
+/// A normal distribution function, normalized so that ∫ D(m) (m·n) dm = 1.
+pub trait Ndf: Send + Sync {
+    /// D(m) for a unit microfacet normal `m`; 0 below the horizon (m_z ≤ 0).
+    fn d(&self, m: Vec3) -> f64;
+}
+
+/// Which two-direction masking-shadowing form to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Masking {
+    /// G2 = G1(wo, m) G1(wi, m) (seed 001, eq 22).
+    Uncorrelated,
+    /// G2 = χ⁺(wo·m) χ⁺(wi·m) / (1 + Λ(wo) + Λ(wi)) (seed 001, eq 23).
+    HeightCorrelated,
+}
+
+/// Smith masking: Λ, G1 and G2.
+pub trait Smith: Ndf {
+    /// Smith Λ(w) by the model's default (most accurate) route. For w below the horizon,
+    /// Λ(−w) = −1 − Λ(w) (Heitz 2014, §5.2): the value follows from the upper hemisphere.
+    fn lambda(&self, w: Vec3) -> f64;
+
+    /// The names of the routes `lambda_route` accepts (the first is the default).
+    fn lambda_routes(&self) -> Vec<&'static str> {
+        vec!["default"]
+    }
+
+    /// Λ(w) by a named route; routes other than the default may be restricted in γ.
+    fn lambda_route(&self, w: Vec3, route: &str) -> Result<f64, QueryError> {
+        match route {
+            "default" => Ok(self.lambda(w)),
+            _ => Err(QueryError::Route {
+                route: route.to_string(),
+                reason: format!("known routes: {}", self.lambda_routes().join(", ")),
+            }),
+        }
+    }
+
+    /// G1(w, m) = χ⁺(w·m / w·n) / (1 + Λ(w)) (seed 001, eq 16). Zero at grazing incidence and
+    /// for back-facing microfacets.
+    fn g1(&self, w: Vec3, m: Vec3) -> f64 {
+        if w[2] <= 0.0 || dot(w, m) <= 0.0 {
+            return 0.0;
+        }
+        1.0 / (1.0 + self.lambda(w))
+    }
+
+    /// G2(wo, wi, m) in the uncorrelated (eq 22) or height-correlated (eq 23) form of seed 001.
+    fn g2(&self, wo: Vec3, wi: Vec3, m: Vec3, masking: Masking) -> f64 {
+        match masking {
+            Masking::Uncorrelated => self.g1(wo, m) * self.g1(wi, m),
+            Masking::HeightCorrelated => {
+                if wo[2] <= 0.0 || wi[2] <= 0.0 || dot(wo, m) <= 0.0 || dot(wi, m) <= 0.0 {
+                    0.0
+                } else {
+                    1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
+                }
+            }
+        }
+    }
+}
+
+/// Importance sampling of microfacet normals with pdf D(m)(m·n).
+pub trait NormalSampler: Ndf {
+    /// Maps `u ∈ [0, 1)²` to a microfacet normal distributed as D(m)(m·n).
+    fn sample_wm(&self, u: [f64; 2]) -> Vec3;
+
+    /// The density of `sample_wm` with respect to solid angle: D(m)(m·n).
+    fn pdf_wm(&self, m: Vec3) -> f64 {
+        if m[2] <= 0.0 {
+            0.0
+        } else {
+            self.d(m) * m[2]
+        }
+    }
+}
+
+/// A model defined in slope space (P22, P2) with slope moments.
+pub trait SlopeDistribution {
+    /// P22(p, q): the density of microfacet slopes (D(m) cos⁴θ_m).
+    fn p22(&self, p: f64, q: f64) -> f64;
+
+    /// P2(q): the 1-D density of the slope component along azimuth `phi` (the incidence plane).
+    fn p2(&self, q: f64, phi: f64) -> f64;
+
+    /// ν₂ₖ = ∫ q^{2k} P2(q) dq along azimuth `phi`; `None` where the moment diverges.
+    fn slope_moment(&self, k: u32, phi: f64) -> Option<f64>;
+
+    /// The slope variance ν₂ along `phi`; `None` where undefined.
+    fn variance(&self, phi: f64) -> Option<f64> {
+        self.slope_moment(1, phi)
+    }
+
+    /// The excess kurtosis ν₄/ν₂² − 3 (independent of `phi` for elliptic models); `None` where
+    /// undefined.
+    fn excess_kurtosis(&self) -> Option<f64> {
+        let v2 = self.slope_moment(1, 0.0)?;
+        let v4 = self.slope_moment(2, 0.0)?;
+        Some(v4 / (v2 * v2) - 3.0)
+    }
+}
+
+/// A model as the harness sees it: its spec and the capabilities it has.
+pub trait Model: Ndf {
+    /// The model described as data.
+    fn spec(&self) -> ModelSpec;
+    /// The family name as in model specs (`ggx`, `std`, …).
+    fn family(&self) -> &'static str;
+    /// The Smith capability, if the model has one.
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        None
+    }
+    /// The normal-sampling capability, if the model has one.
+    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+        None
+    }
+    /// The slope-space capability, if the model has one.
+    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
+        None
+    }
+}
+
+/// The roughness along an azimuth for an elliptic slope distribution with scales `(sx, sy)`,
+/// expressed for a direction `w`: √((sx w_x)² + (sy w_y)²) = s(φ) sin θ.
+#[inline]
+pub(crate) fn projected_scale(sx: f64, sy: f64, w: Vec3) -> f64 {
+    ((sx * w[0]).powi(2) + (sy * w[1]).powi(2)).sqrt()
+}
+
+/// The standardized cotangent a = cot θ / s(φ) of direction `w` for scales `(sx, sy)`:
+/// +∞ at normal incidence, 0 at grazing, negative below the horizon.
+#[inline]
+pub(crate) fn standardized_cotangent(sx: f64, sy: f64, w: Vec3) -> f64 {
+    let s = projected_scale(sx, sy, w);
+    if s == 0.0 {
+        if w[2] >= 0.0 {
+            f64::INFINITY
+        } else {
+            f64::NEG_INFINITY
+        }
+    } else {
+        w[2] / s
+    }
+}
+
+/// Applies Λ(−w) = −1 − Λ(w) to an upper-hemisphere Λ given as a function of the
+/// standardized cotangent.
+#[inline]
+pub(crate) fn lambda_both_hemispheres(a: f64, upper: impl Fn(f64) -> f64) -> f64 {
+    if a >= 0.0 {
+        upper(a)
+    } else {
+        -1.0 - upper(-a)
+    }
+}
+
+/// The scale along azimuth `phi`: s(φ) = √(sx² cos²φ + sy² sin²φ).
+#[inline]
+pub(crate) fn scale_along(sx: f64, sy: f64, phi: f64) -> f64 {
+    let (s, c) = phi.sin_cos();
+    ((sx * c).powi(2) + (sy * s).powi(2)).sqrt()
+}
+
+/// Validates a roughness parameter: finite and > 0.
+pub(crate) fn check_alpha(name: &'static str, value: f64) -> Result<f64, crate::ParamError> {
+    if value > 0.0 && value.is_finite() {
+        Ok(value)
+    } else {
+        Err(crate::ParamError::AlphaNotPositive { name, value })
+    }
+}
+
+/// The azimuthal part shared by every elliptic sampler: (cos 2πu, sin 2πu) scaled by the
+/// per-axis slope scales. Multiplying by the sampled slope radius gives the slope (p, q).
+/// This is the quadrant-correct form of seed 001 eq 11 / 40.
+#[inline]
+pub(crate) fn elliptic_direction(sx: f64, sy: f64, u1: f64) -> (f64, f64) {
+    let (s, c) = (std::f64::consts::TAU * u1).sin_cos();
+    (sx * c, sy * s)
+}

@@ -1,0 +1,169 @@
+//! The Beckmann NDF, isotropic and anisotropic: the γ → ∞ limit of STD (seed 001, §2, Table 1).
+
+use crate::error::{ParamError, QueryError};
+use crate::geometry::{normal_from_slopes, Vec3};
+use crate::model::{
+    check_alpha, elliptic_direction, lambda_both_hemispheres, scale_along, standardized_cotangent,
+    Model, Ndf, NormalSampler, SlopeDistribution, Smith,
+};
+use crate::spec::ModelSpec;
+use std::f64::consts::PI;
+
+/// Beckmann NDF with roughness `alpha_x`, `alpha_y` (seed 001, Table 1, row γ → ∞):
+///
+/// ```text
+/// D(m)   = exp(−tan²θ (cos²φ/αx² + sin²φ/αy²)) / (π αx αy cos⁴θ)
+/// P22    = exp(−p²/αx² − q²/αy²) / (π αx αy)
+/// Λ(θ,φ) = ½ (e^{−a²}/(a √π) − erfc(a)),  a = cot θ / α(φ),  α(φ)² = αx² cos²φ + αy² sin²φ
+/// ```
+///
+/// Domain: αx, αy finite and > 0 (tested 1e-4 … 10); any direction (Λ below the horizon by
+/// Λ(−w) = −1 − Λ(w)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Beckmann {
+    alpha_x: f64,
+    alpha_y: f64,
+    described_as: Option<ModelSpec>,
+}
+
+impl Beckmann {
+    /// A validated Beckmann NDF.
+    pub fn new(alpha_x: f64, alpha_y: f64) -> Result<Self, ParamError> {
+        Ok(Self {
+            alpha_x: check_alpha("alpha_x", alpha_x)?,
+            alpha_y: check_alpha("alpha_y", alpha_y)?,
+            described_as: None,
+        })
+    }
+
+    /// The same model presented under another spec (STD with `gamma: "inf"` is Beckmann
+    /// exactly).
+    pub fn described_as(mut self, spec: ModelSpec) -> Self {
+        self.described_as = Some(spec);
+        self
+    }
+
+    /// The roughness (αx, αy).
+    pub fn alpha(&self) -> (f64, f64) {
+        (self.alpha_x, self.alpha_y)
+    }
+
+    /// Λ as a function of the standardized cotangent a = cot θ / α(φ) ≥ 0, by the
+    /// cancellation-free evaluation of `special::student_tail::beckmann_lambda`.
+    pub fn lambda_of(a: f64) -> f64 {
+        crate::special::student_tail::beckmann_lambda(a)
+    }
+
+    /// Seed 001, Table 1, row γ → ∞, evaluated as printed:
+    /// `½ (σ e^{−μ²/σ²}/(μ √π) + erf(μ/σ) − 1)` with a = μ/σ. Correct, but it subtracts
+    /// nearly equal numbers near normal incidence (kept to measure that loss).
+    pub fn lambda_table1(a: f64) -> f64 {
+        0.5 * ((-a * a).exp() / (a * PI.sqrt()) + statrs::function::erf::erf(a) - 1.0)
+    }
+}
+
+impl Ndf for Beckmann {
+    fn d(&self, m: Vec3) -> f64 {
+        let mz = m[2];
+        if mz <= 0.0 {
+            return 0.0;
+        }
+        let z2 = mz * mz;
+        let u = (m[0] / self.alpha_x).powi(2) + (m[1] / self.alpha_y).powi(2);
+        let e = (-u / z2).exp();
+        if e == 0.0 {
+            return 0.0;
+        }
+        e / (PI * self.alpha_x * self.alpha_y * z2 * z2)
+    }
+}
+
+impl Smith for Beckmann {
+    fn lambda(&self, w: Vec3) -> f64 {
+        let a = standardized_cotangent(self.alpha_x, self.alpha_y, w);
+        lambda_both_hemispheres(a, Self::lambda_of)
+    }
+
+    fn lambda_routes(&self) -> Vec<&'static str> {
+        vec!["default", "table1"]
+    }
+
+    fn lambda_route(&self, w: Vec3, route: &str) -> Result<f64, QueryError> {
+        let a = standardized_cotangent(self.alpha_x, self.alpha_y, w);
+        match route {
+            "default" => Ok(self.lambda(w)),
+            "table1" => Ok(lambda_both_hemispheres(a, Self::lambda_table1)),
+            _ => Err(QueryError::Route {
+                route: route.to_string(),
+                reason: format!("Beckmann Λ routes: {}", self.lambda_routes().join(", ")),
+            }),
+        }
+    }
+}
+
+impl NormalSampler for Beckmann {
+    /// Slope-space inversion (seed 001, eq 40 with the quadrant fixed, and eq 42 in the limit
+    /// γ → ∞): φ from u1 and tan²θ A(φ) = −ln(1 − u2).
+    fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
+        let (dx, dy) = elliptic_direction(self.alpha_x, self.alpha_y, u[0]);
+        let r = (-(-u[1]).ln_1p()).sqrt();
+        normal_from_slopes(r * dx, r * dy)
+    }
+}
+
+impl SlopeDistribution for Beckmann {
+    fn p22(&self, p: f64, q: f64) -> f64 {
+        (-(p / self.alpha_x).powi(2) - (q / self.alpha_y).powi(2)).exp()
+            / (PI * self.alpha_x * self.alpha_y)
+    }
+
+    fn p2(&self, q: f64, phi: f64) -> f64 {
+        let s = scale_along(self.alpha_x, self.alpha_y, phi);
+        (-(q / s).powi(2)).exp() / (s * PI.sqrt())
+    }
+
+    /// ν₂ₖ = α(φ)^{2k} Γ(k + ½)/√π = α(φ)^{2k} (2k−1)!!/2^k (the γ → ∞ limit of seed 001 eq 7).
+    fn slope_moment(&self, k: u32, phi: f64) -> Option<f64> {
+        let s2 = scale_along(self.alpha_x, self.alpha_y, phi).powi(2);
+        Some((1..=k).fold(1.0, |acc, j| acc * s2 * (2 * j - 1) as f64 / 2.0))
+    }
+}
+
+impl Model for Beckmann {
+    fn spec(&self) -> ModelSpec {
+        self.described_as
+            .clone()
+            .unwrap_or(if self.alpha_x == self.alpha_y {
+                ModelSpec::Beckmann {
+                    alpha: Some(self.alpha_x),
+                    alpha_x: None,
+                    alpha_y: None,
+                }
+            } else {
+                ModelSpec::Beckmann {
+                    alpha: None,
+                    alpha_x: Some(self.alpha_x),
+                    alpha_y: Some(self.alpha_y),
+                }
+            })
+    }
+
+    fn family(&self) -> &'static str {
+        self.described_as
+            .as_ref()
+            .map(ModelSpec::family)
+            .unwrap_or("beckmann")
+    }
+
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        Some(self)
+    }
+
+    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+        Some(self)
+    }
+
+    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
+        Some(self)
+    }
+}

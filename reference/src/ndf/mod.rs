@@ -1,0 +1,10 @@
+//! Normal distribution functions, one model per file.
+
+pub mod beckmann;
+pub mod ggx;
+pub mod student;
+pub mod student_lambda;
+
+pub use beckmann::Beckmann;
+pub use ggx::Ggx;
+pub use student::Student;

@@ -1,0 +1,300 @@
+//! The routes to Smith Λ of the Student-t family (seed 001): the stable default, the ₂F₁ form
+//! (eq 21), the incomplete-beta cross-check, the integer-γ (eq 29–30) and half-integer-γ
+//! (eq 36–37) finite sums, and the Table 1 rows, printed and corrected.
+//!
+//! Every route is a function of the shape C = γ and the standardized cotangent
+//! x = cot θ / s(φ) ≥ 0 (s the Student scale along the azimuth of w; for STD, s = σ√(γ−1), so
+//! μ/σ = x √(γ−1)). All routes give the same Λ where they apply; they differ in cost, domain
+//! and rounding behaviour, which the harness measures.
+
+use crate::error::QueryError;
+use crate::special::{hyp2f1, student_tail};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// A route: Λ as a function of (C, x) for x ∈ (0, ∞).
+pub type RouteFn = fn(f64, f64) -> f64;
+
+/// The named routes with a one-line description; the first is the default.
+pub const ROUTES: &[(&str, &str)] = &[
+    (
+        "stable",
+        "cancellation-free evaluation by regime (special::student_tail), any γ > 1.5",
+    ),
+    (
+        "2f1",
+        "seed 001 eq 21 with the hand-written ₂F₁ (special::hyp2f1), any γ > 1.5",
+    ),
+    (
+        "2f1_algorithm2",
+        "eq 21 with ₂F₁ by seed 001 §8 Algorithm 2 as printed",
+    ),
+    (
+        "incomplete_beta",
+        "N w^(C−3/2)/((2C−3)x) − ½ I_w(C−1, ½), w = 1/(1+x²), via statrs",
+    ),
+    ("integer", "seed 001 eq 29–30, integer γ ≥ 2"),
+    (
+        "half_integer",
+        "seed 001 eq 29 with eq 36–37, γ ∈ {5/2, 7/2, …}",
+    ),
+    (
+        "table1",
+        "seed 001 Table 1 rows, corrected, γ ∈ {2, 5/2, 3, 7/2, 4}",
+    ),
+    (
+        "table1_printed",
+        "seed 001 Table 1 rows as printed, γ ∈ {2, 5/2, 3, 7/2, 4}",
+    ),
+];
+
+/// Looks up a route by name (`default` is `stable`) and checks that it applies at C.
+pub fn route(name: &str, c: f64) -> Result<RouteFn, QueryError> {
+    let unavailable = |reason: String| QueryError::Route {
+        route: name.to_string(),
+        reason,
+    };
+    let f: RouteFn = match name {
+        "default" | "stable" => lambda_stable,
+        "2f1" => lambda_2f1,
+        "2f1_algorithm2" => lambda_2f1_algorithm2,
+        "incomplete_beta" => lambda_incomplete_beta,
+        "integer" => {
+            if !(c.fract() == 0.0 && (2.0..=INTEGER_MAX).contains(&c)) {
+                return Err(unavailable(format!(
+                    "needs an integer γ in [2, {INTEGER_MAX}] (got {c})"
+                )));
+            }
+            lambda_integer
+        }
+        "half_integer" => {
+            if !((c - 0.5).fract() == 0.0 && (2.5..=INTEGER_MAX).contains(&c)) {
+                return Err(unavailable(format!(
+                    "needs γ − ½ an integer ≥ 2, γ ≤ {INTEGER_MAX} (got {c})"
+                )));
+            }
+            lambda_half_integer
+        }
+        "table1" | "table1_printed" => {
+            if ![2.0, 2.5, 3.0, 3.5, 4.0].contains(&c) {
+                return Err(unavailable(format!(
+                    "Table 1 has rows for γ ∈ {{2, 5/2, 3, 7/2, 4}} only (got {c})"
+                )));
+            }
+            if name == "table1" {
+                lambda_table1
+            } else {
+                lambda_table1_printed
+            }
+        }
+        _ => {
+            let known: Vec<&str> = ROUTES.iter().map(|r| r.0).collect();
+            return Err(unavailable(format!("known routes: {}", known.join(", "))));
+        }
+    };
+    Ok(f)
+}
+
+/// The largest γ the finite-sum routes accept: their alternating binomial sums lose about
+/// 0.6 γ decimal digits and overflow f64 near γ ≈ 500; beyond a few tens they are useless, and
+/// the harness shows that rather than hiding it.
+pub const INTEGER_MAX: f64 = 1000.0;
+
+/// N_C = Γ(C − ½)/(√π Γ(C − 1)), the constant of the standardized P2 (seed 001 eq 15 with
+/// σ√(γ−1) = 1), accurate for every C > 1 (the Γ ratio by `special::student_tail`).
+pub fn p2_norm(c: f64) -> f64 {
+    student_tail::ln_gamma_ratio(c).exp() / PI.sqrt()
+}
+
+/// Shared end-point values: Λ(x = 0) = ∞ (grazing), Λ(x = ∞) = 0 (normal incidence).
+#[inline]
+fn end_points(x: f64) -> Option<f64> {
+    if x == 0.0 {
+        Some(f64::INFINITY)
+    } else if x == f64::INFINITY {
+        Some(0.0)
+    } else {
+        None
+    }
+}
+
+/// The default route: Λ_C(x) by `special::student_tail::student_lambda`, whose relative error
+/// stays at the 1e-14 level over 1.5 < C ≤ 1e8 and 0 ≤ x ≤ ∞ (no cancellation near normal
+/// incidence).
+pub fn lambda_stable(c: f64, x: f64) -> f64 {
+    student_tail::student_lambda(c, x)
+}
+
+/// The first term of eq 21 in standardized form, N (1 + x²)^{3/2 − C} / ((2C − 3) x).
+fn eq21_first_term(c: f64, x: f64) -> f64 {
+    p2_norm(c) * ((1.5 - c) * (x * x).ln_1p()).exp() / ((2.0 * c - 3.0) * x)
+}
+
+/// Seed 001 eq 21 (also eq 5 for D^G):
+///
+/// ```text
+/// Λ = Γ(γ−½)/(Γ(γ)√π) ( (γ−1)^γ/(2γ−3) · σ((γ−1) + μ²/σ²)^{3/2−γ}/μ
+///                       + √(γ−1) μ/σ ₂F₁(½, γ−½; 3/2; −μ²/((γ−1)σ²)) ) − ½
+///   = N (1+x²)^{3/2−C} / ((2C−3) x) + N x ₂F₁(½, C−½; 3/2; −x²) − ½
+/// ```
+///
+/// Correct as printed (ERRATA.md lists the checks), for C > 3/2. It subtracts nearly equal
+/// terms as x grows (near normal incidence): the relative error grows like x^{2C−2} · 1e-16.
+pub fn lambda_2f1(c: f64, x: f64) -> f64 {
+    if let Some(v) = end_points(x) {
+        return v;
+    }
+    eq21_first_term(c, x) + p2_norm(c) * x * hyp2f1::hyp2f1_lambda(c, -x * x) - 0.5
+}
+
+/// Eq 21 with ₂F₁ evaluated by seed 001 §8 Algorithm 2 as printed (with the general Gauss
+/// series in place of GSL): kept to measure where that algorithm fails (integer γ hits the
+/// poles of Γ(1 − γ) and Γ(2 − γ)).
+pub fn lambda_2f1_algorithm2(c: f64, x: f64) -> f64 {
+    if let Some(v) = end_points(x) {
+        return v;
+    }
+    eq21_first_term(c, x) + p2_norm(c) * x * hyp2f1::hyp2f1_lambda_algorithm2(c, -x * x) - 0.5
+}
+
+/// Λ through the regularized incomplete beta function (statrs), an independent cross-check of
+/// eq 21: with w = 1/(1 + x²), ∫_x^∞ (1+t²)^{1/2−C} dt = ½ B(C−1, ½) I_w(C−1, ½), so
+///
+/// ```text
+/// Λ = N w^{C − 3/2} / ((2C − 3) x) − ½ I_w(C − 1, ½)
+/// ```
+///
+/// Same cancellation as eq 21 near normal incidence.
+pub fn lambda_incomplete_beta(c: f64, x: f64) -> f64 {
+    if let Some(v) = end_points(x) {
+        return v;
+    }
+    let w = 1.0 / (1.0 + x * x);
+    eq21_first_term(c, x) - 0.5 * statrs::function::beta::beta_reg(c - 1.0, 0.5, w)
+}
+
+/// Binomial coefficients C(n, k) for k = 0..=n, as f64.
+fn binomials(n: u64) -> impl Iterator<Item = f64> {
+    (0..=n).scan(1.0, move |b, k| {
+        let current = *b;
+        *b = *b * (n - k) as f64 / (k + 1) as f64;
+        Some(current)
+    })
+}
+
+/// Seed 001 eq 29–30, integer γ ≥ 2, as printed (they are correct):
+///
+/// ```text
+/// Λ  = (γ−1) A1 ( (σ/μ)√(γ−1) (1 + μ²/((γ−1)σ²))^{3/2−γ} / (2γ−3) − A2 )
+/// A1 = (2γ−2)! / (2^{2γ−2} (γ−1)!²)
+/// A2 = Σ_{k=0}^{γ−2} C(γ−2, k) (−1)^k/(2k+1) A3(k)
+/// A3 = 1 − (μ / (σ √((γ−1) + μ²/σ²)))^{2k+1}
+/// ```
+///
+/// i.e. with x: (σ/μ)√(γ−1) = 1/x and μ/(σ√(γ−1+μ²/σ²)) = x/√(1+x²). The alternating sum
+/// cancels: accurate for small γ only (the harness measures how far).
+pub fn lambda_integer(c: f64, x: f64) -> f64 {
+    if let Some(v) = end_points(x) {
+        return v;
+    }
+    let n = c as u64;
+    let a1 = (1..n).fold(1.0, |acc, j| acc * (2 * j - 1) as f64 / (2 * j) as f64);
+    let s = x / (1.0 + x * x).sqrt();
+    let a2: f64 = binomials(n - 2)
+        .enumerate()
+        .map(|(k, b)| {
+            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+            b * sign / (2 * k + 1) as f64 * (1.0 - s.powi(2 * k as i32 + 1))
+        })
+        .sum();
+    let first = ((1.5 - c) * (x * x).ln_1p()).exp() / (x * (2.0 * c - 3.0));
+    (c - 1.0) * a1 * (first - a2)
+}
+
+/// Seed 001 eq 29 with eq 36–37, half-integer γ = n + 3/2, n ≥ 1:
+///
+/// ```text
+/// A1  = (2/π) Σ_{k=0}^{γ−3/2} C(γ−3/2, k) (−1)^k/(2k+1)
+/// A2  = A21 / 2^{2γ−4} + A22 / 2^{2γ−3}
+/// A21 = Σ_{k=0}^{γ−5/2} C(2γ−3, k)/(2γ−3−2k) · (−sin((2γ−3−2k) arctan(μ/(√(γ−1) σ))))
+/// A22 = C(2γ−3, γ−3/2) (π/2 − arctan(μ/(√(γ−1) σ)))
+/// ```
+///
+/// Correct as printed (with arctan(μ/(√(γ−1)σ)) = arctan x). Alternating sums: small γ only.
+pub fn lambda_half_integer(c: f64, x: f64) -> f64 {
+    if let Some(v) = end_points(x) {
+        return v;
+    }
+    let n = (c - 1.5).round() as u64;
+    let m = 2 * n; // 2γ − 3
+    let a1 = 2.0 / PI
+        * binomials(n)
+            .enumerate()
+            .map(|(k, b)| if k % 2 == 0 { b } else { -b } / (2 * k + 1) as f64)
+            .sum::<f64>();
+    let x0 = x.atan();
+    let central = binomials(m).nth(n as usize).unwrap_or(f64::NAN);
+    let a21: f64 = binomials(m)
+        .take(n as usize)
+        .enumerate()
+        .map(|(k, b)| {
+            let j = (m - 2 * k as u64) as f64;
+            -b * (j * x0).sin() / j
+        })
+        .sum();
+    let a22 = central * (FRAC_PI_2 - x0);
+    let a2 = a21 / 2f64.powi(m as i32 - 1) + a22 / 2f64.powi(m as i32);
+    let first = ((1.5 - c) * (x * x).ln_1p()).exp() / (x * (2.0 * c - 3.0));
+    (c - 1.0) * a1 * (first - a2)
+}
+
+/// Seed 001 Table 1, Λ rows for γ = 2, 5/2, 3, 7/2, 4, corrected where the printed row is
+/// wrong (γ = 7/2, ERRATA.md). With a = μ/σ = x√(γ−1):
+///
+/// ```text
+/// γ = 2:   ½ (√(a² + 1)/a − 1)
+/// γ = 5/2: arctan(√(2/3) a)/π − ½ + √(3/2)/(π a)
+/// γ = 3:   ½ ((a⁴ + 3a² + 2) / (a (a² + 2)^{3/2}) − 1)
+/// γ = 7/2: arctan(x)/π − ½ + (3x⁴ + 5x² + 2) / (3π x (1 + x²)²),   x = √(2/5) a
+/// γ = 4:   ½ ((8a⁶ + 60a⁴ + 135a² + 81) / (8a (a² + 3)^{5/2}) − 1)
+/// ```
+pub fn lambda_table1(c: f64, x: f64) -> f64 {
+    if let Some(v) = end_points(x) {
+        return v;
+    }
+    if c == 3.5 {
+        let x2 = x * x;
+        return x.atan() / PI - 0.5
+            + (3.0 * x2 * x2 + 5.0 * x2 + 2.0) / (3.0 * PI * x * (1.0 + x2).powi(2));
+    }
+    lambda_table1_printed(c, x)
+}
+
+/// Seed 001 Table 1, Λ rows exactly as printed (a = μ/σ = x√(γ−1)); the γ = 7/2 row is wrong:
+///
+/// ```text
+/// γ = 7/2 (printed): arctan(√(2/5) a)/(3π) − 1 + 5√(5/2) (−6a⁴ + 17a² + 8) / (6π a (2a² + 5))
+/// ```
+pub fn lambda_table1_printed(c: f64, x: f64) -> f64 {
+    if let Some(v) = end_points(x) {
+        return v;
+    }
+    let a = x * (c - 1.0).sqrt();
+    let a2 = a * a;
+    if c == 2.0 {
+        0.5 * ((a2 + 1.0).sqrt() / a - 1.0)
+    } else if c == 2.5 {
+        ((2.0f64 / 3.0).sqrt() * a).atan() / PI - 0.5 + 1.5f64.sqrt() / (PI * a)
+    } else if c == 3.0 {
+        0.5 * ((a2 * a2 + 3.0 * a2 + 2.0) / (a * (a2 + 2.0).powf(1.5)) - 1.0)
+    } else if c == 3.5 {
+        ((0.4f64).sqrt() * a).atan() / (3.0 * PI) - 1.0
+            + 5.0 * 2.5f64.sqrt() * (-6.0 * a2 * a2 + 17.0 * a2 + 8.0)
+                / (6.0 * PI * a * (2.0 * a2 + 5.0))
+    } else if c == 4.0 {
+        0.5 * ((8.0 * a2 * a2 * a2 + 60.0 * a2 * a2 + 135.0 * a2 + 81.0)
+            / (8.0 * a * (a2 + 3.0).powf(2.5))
+            - 1.0)
+    } else {
+        f64::NAN
+    }
+}

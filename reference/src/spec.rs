@@ -1,0 +1,286 @@
+//! Models described as data (`ModelSpec`, serde) and built into validated models.
+
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use crate::error::ParamError;
+use crate::model::Model;
+use crate::ndf::{Beckmann, Ggx, Student};
+
+/// A model described as data, e.g. `{"family": "std", "gamma": 2.5, "alpha": 0.3}`
+/// (DESIGN.md, "Evaluating closed forms"). Unknown keys are errors.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "family", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ModelSpec {
+    /// Beckmann (seed 001, Table 1, γ → ∞).
+    Beckmann {
+        /// Isotropic roughness.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha: Option<f64>,
+        /// Roughness along x.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_x: Option<f64>,
+        /// Roughness along y.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_y: Option<f64>,
+    },
+    /// GGX / Trowbridge–Reitz (seed 001, Table 1, γ = 2).
+    Ggx {
+        /// Isotropic roughness.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha: Option<f64>,
+        /// Roughness along x.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_x: Option<f64>,
+        /// Roughness along y.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_y: Option<f64>,
+    },
+    /// Student's t NDF, STD (seed 001, f = 1/(γ−1)); `gamma: "inf"` is Beckmann.
+    Std {
+        /// Shape γ > 1, or +∞.
+        #[serde(with = "gamma_serde")]
+        gamma: f64,
+        /// Isotropic roughness.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha: Option<f64>,
+        /// Roughness along x.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_x: Option<f64>,
+        /// Roughness along y.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_y: Option<f64>,
+    },
+    /// Hyper-Cauchy (seed 001, eq 8, f = 1).
+    HyperCauchy {
+        /// Shape γ > 1.
+        #[serde(with = "gamma_serde")]
+        gamma: f64,
+        /// Isotropic roughness.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha: Option<f64>,
+        /// Roughness along x.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_x: Option<f64>,
+        /// Roughness along y.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_y: Option<f64>,
+    },
+    /// The fixed-variance Student member (seed 001, eq 9, f = 1/(γ−2)); `gamma: "inf"` is
+    /// Beckmann.
+    StudentFixedVariance {
+        /// Shape γ > 2, or +∞.
+        #[serde(with = "gamma_serde")]
+        gamma: f64,
+        /// Isotropic roughness.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha: Option<f64>,
+        /// Roughness along x.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_x: Option<f64>,
+        /// Roughness along y.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_y: Option<f64>,
+    },
+    /// The general isotropic family D^G(B, C) (seed 001, eq 1–2).
+    StudentGeneral {
+        /// B > 0.
+        b: f64,
+        /// C > 1.
+        c: f64,
+    },
+}
+
+/// Resolves `alpha` or (`alpha_x`, `alpha_y`) into validated per-axis roughness.
+pub fn resolve_roughness(
+    alpha: Option<f64>,
+    alpha_x: Option<f64>,
+    alpha_y: Option<f64>,
+) -> Result<(f64, f64), ParamError> {
+    match (alpha, alpha_x, alpha_y) {
+        (Some(a), None, None) => {
+            let a = crate::model::check_alpha("alpha", a)?;
+            Ok((a, a))
+        }
+        (None, Some(ax), Some(ay)) => Ok((
+            crate::model::check_alpha("alpha_x", ax)?,
+            crate::model::check_alpha("alpha_y", ay)?,
+        )),
+        _ => Err(ParamError::Combination(
+            "give either alpha, or both alpha_x and alpha_y".to_string(),
+        )),
+    }
+}
+
+impl ModelSpec {
+    /// The family name, as written in the spec's `family` key.
+    pub fn family(&self) -> &'static str {
+        match self {
+            ModelSpec::Beckmann { .. } => "beckmann",
+            ModelSpec::Ggx { .. } => "ggx",
+            ModelSpec::Std { .. } => "std",
+            ModelSpec::HyperCauchy { .. } => "hyper_cauchy",
+            ModelSpec::StudentFixedVariance { .. } => "student_fixed_variance",
+            ModelSpec::StudentGeneral { .. } => "student_general",
+        }
+    }
+
+    /// Validates the parameters and builds the model.
+    pub fn build(&self) -> Result<Box<dyn Model>, ParamError> {
+        use crate::ndf::student::Member;
+        Ok(match *self {
+            ModelSpec::Beckmann {
+                alpha,
+                alpha_x,
+                alpha_y,
+            } => {
+                let (ax, ay) = resolve_roughness(alpha, alpha_x, alpha_y)?;
+                Box::new(Beckmann::new(ax, ay)?)
+            }
+            ModelSpec::Ggx {
+                alpha,
+                alpha_x,
+                alpha_y,
+            } => {
+                let (ax, ay) = resolve_roughness(alpha, alpha_x, alpha_y)?;
+                Box::new(Ggx::new(ax, ay)?)
+            }
+            ModelSpec::Std {
+                gamma,
+                alpha,
+                alpha_x,
+                alpha_y,
+            } => {
+                let (ax, ay) = resolve_roughness(alpha, alpha_x, alpha_y)?;
+                if gamma == f64::INFINITY {
+                    Box::new(Beckmann::new(ax, ay)?.described_as(self.clone()))
+                } else {
+                    Box::new(Student::new(Member::Std, gamma, ax, ay)?)
+                }
+            }
+            ModelSpec::HyperCauchy {
+                gamma,
+                alpha,
+                alpha_x,
+                alpha_y,
+            } => {
+                let (ax, ay) = resolve_roughness(alpha, alpha_x, alpha_y)?;
+                Box::new(Student::new(Member::HyperCauchy, gamma, ax, ay)?)
+            }
+            ModelSpec::StudentFixedVariance {
+                gamma,
+                alpha,
+                alpha_x,
+                alpha_y,
+            } => {
+                let (ax, ay) = resolve_roughness(alpha, alpha_x, alpha_y)?;
+                if gamma == f64::INFINITY {
+                    Box::new(Beckmann::new(ax, ay)?.described_as(self.clone()))
+                } else {
+                    Box::new(Student::new(Member::FixedVariance, gamma, ax, ay)?)
+                }
+            }
+            ModelSpec::StudentGeneral { b, c } => Box::new(Student::general(b, c)?),
+        })
+    }
+}
+
+/// γ as a JSON number, or the string `"inf"` for +∞.
+mod gamma_serde {
+    use super::*;
+
+    pub fn serialize<S: Serializer>(gamma: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if *gamma == f64::INFINITY {
+            s.serialize_str("inf")
+        } else {
+            s.serialize_f64(*gamma)
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum NumberOrString {
+            Number(f64),
+            Text(String),
+        }
+        match NumberOrString::deserialize(d)? {
+            NumberOrString::Number(x) => Ok(x),
+            NumberOrString::Text(t) if matches!(t.as_str(), "inf" | "infinity" | "Infinity") => {
+                Ok(f64::INFINITY)
+            }
+            NumberOrString::Text(t) => Err(serde::de::Error::custom(format!(
+                "gamma must be a number or \"inf\" (got {t:?})"
+            ))),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<ModelSpec, serde_json::Error> {
+        serde_json::from_str(text)
+    }
+
+    #[test]
+    fn parse_build_and_round_trip() {
+        let s = parse(r#"{"family":"std","gamma":"inf","alpha":0.3}"#).expect("parses");
+        assert!(matches!(s, ModelSpec::Std { gamma, .. } if gamma == f64::INFINITY));
+        let m = s.build().expect("builds");
+        assert_eq!(m.family(), "std");
+        assert_eq!(m.spec(), s);
+        let text = serde_json::to_string(&s).unwrap();
+        assert_eq!(text, r#"{"family":"std","gamma":"inf","alpha":0.3}"#);
+        let s =
+            parse(r#"{"family":"hyper_cauchy","gamma":3,"alpha_x":0.1,"alpha_y":0.2}"#).unwrap();
+        assert_eq!(s.build().unwrap().spec(), s);
+        let s = parse(r#"{"family":"student_general","b":4,"c":2.5}"#).unwrap();
+        assert_eq!(s.build().unwrap().spec(), s);
+    }
+
+    #[test]
+    fn unknown_keys_and_bad_gamma_are_errors() {
+        let e = parse(r#"{"family":"ggx","alpha":0.3,"gamma":2}"#).unwrap_err();
+        assert!(e.to_string().contains("gamma"), "{e}");
+        assert!(parse(r#"{"family":"std","gamma":"many","alpha":0.3}"#).is_err());
+        assert!(parse(r#"{"family":"nope","alpha":0.3}"#).is_err());
+    }
+
+    #[test]
+    fn bad_parameters_are_typed_errors() {
+        let e = resolve_roughness(Some(0.1), Some(0.2), None).unwrap_err();
+        assert!(matches!(e, ParamError::Combination(_)));
+        let e = resolve_roughness(Some(f64::NAN), None, None).unwrap_err();
+        assert!(matches!(e, ParamError::AlphaNotPositive { .. }));
+        let e = resolve_roughness(None, Some(0.1), Some(-1.0)).unwrap_err();
+        assert!(matches!(
+            e,
+            ParamError::AlphaNotPositive {
+                name: "alpha_y",
+                ..
+            }
+        ));
+        for gamma in [1.0, 0.5, f64::NAN, 2e8] {
+            let e = parse(&format!(
+                r#"{{"family":"std","gamma":{},"alpha":0.3}}"#,
+                if gamma.is_nan() {
+                    "\"nan\"".to_string()
+                } else {
+                    gamma.to_string()
+                }
+            ));
+            match e {
+                Ok(s) => assert!(matches!(
+                    s.build().map(|_| ()).unwrap_err(),
+                    ParamError::GammaOutOfRange { .. }
+                )),
+                Err(_) => assert!(gamma.is_nan()),
+            }
+        }
+        let e = parse(r#"{"family":"student_fixed_variance","gamma":2,"alpha":0.3}"#).unwrap();
+        assert!(e.build().is_err());
+        let e = parse(r#"{"family":"student_general","b":0,"c":2.5}"#).unwrap();
+        assert!(e.build().is_err());
+    }
+}

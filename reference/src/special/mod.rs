@@ -1,0 +1,5 @@
+//! Special functions no well-kept crate provides at the accuracy and over the domain the
+//! closed forms need; everything else comes from statrs.
+
+pub mod hyp2f1;
+pub mod student_tail;
