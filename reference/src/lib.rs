@@ -11,6 +11,8 @@ pub mod model;
 pub mod ndf;
 pub mod spec;
 pub mod special;
+#[cfg(test)]
+mod test_support;
 
 pub use error::{ParamError, QueryError};
 pub use geometry::Vec3;

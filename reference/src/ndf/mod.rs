@@ -5,6 +5,9 @@ pub mod ggx;
 pub mod student;
 pub mod student_lambda;
 
+#[cfg(test)]
+mod conformance;
+
 pub use beckmann::Beckmann;
 pub use ggx::Ggx;
 pub use student::Student;

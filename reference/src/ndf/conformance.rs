@@ -1,0 +1,133 @@
+//! Test-only conformance checks shared by every NDF's unit tests: each closed form against an
+//! independent numerical integral of its definition (test_support quadrature), and sampling
+//! inversions against their densities.
+
+use crate::geometry::{dot, from_spherical, Vec3};
+use crate::model::{NormalSampler, SlopeDistribution, Smith};
+use crate::test_support::{integrate, integrate_line, integrate_tail, rel_err};
+use std::f64::consts::{PI, TAU};
+
+/// ∫ D(m) (m·n) dm over the hemisphere, in slope-radius coordinates r = tan θ along each
+/// azimuth (dm = sin θ dθ dφ, cos θ sin θ dθ = r dr/(1 + r²)²); `radial_scale(φ)` is the slope
+/// width along φ, used only to place the quadrature nodes.
+pub fn normalization(d: &dyn Fn(Vec3) -> f64, radial_scale: &dyn Fn(f64) -> f64) -> f64 {
+    let inner = |phi: f64| {
+        let (s, c) = phi.sin_cos();
+        let f = |r: f64| {
+            let z = 1.0 / (1.0 + r * r).sqrt();
+            d([r * z * c, r * z * s, z]) * r * z.powi(4)
+        };
+        integrate_tail(&f, 0.0, radial_scale(phi), 1e-13)
+    };
+    // Four quarter-periods: the integrand is smooth and periodic in φ.
+    (0..4)
+        .map(|k| {
+            let a = k as f64 * PI / 2.0;
+            integrate(&inner, a, a + PI / 2.0, 1e-13, 0.0).0
+        })
+        .sum()
+}
+
+/// P2(q) along azimuth φ as the marginal ∫ P22 dp of the rotated slope (q along φ, p across).
+pub fn p2_marginal(slopes: &dyn SlopeDistribution, q: f64, phi: f64, scale: f64) -> f64 {
+    let (s, c) = phi.sin_cos();
+    let f = |p: f64| slopes.p22(q * c - p * s, q * s + p * c);
+    integrate_line(&f, scale, 1e-13)
+}
+
+/// Smith Λ(w) from its definition (seed 001 eq 17): (1/μ) ∫_μ^∞ (q − μ) P2(q) dq, μ = cot θ,
+/// with P2 along the azimuth of w.
+pub fn lambda_integral(slopes: &dyn SlopeDistribution, w: Vec3, scale: f64) -> f64 {
+    let sin_theta = (w[0] * w[0] + w[1] * w[1]).sqrt();
+    let mu = w[2] / sin_theta;
+    let phi = w[1].atan2(w[0]);
+    let f = |q: f64| (q - mu) * slopes.p2(q, phi);
+    integrate_tail(&f, mu, scale, 1e-14) / mu
+}
+
+/// The slope moment ν₂ₖ = ∫ q^{2k} P2(q) dq along φ.
+pub fn moment_integral(slopes: &dyn SlopeDistribution, k: u32, phi: f64, scale: f64) -> f64 {
+    integrate_line(&|q| q.powi(2 * k as i32) * slopes.p2(q, phi), scale, 1e-13)
+}
+
+/// Asserts Λ against its integral at every θ of `thetas` and φ of `phis`; returns the max
+/// relative error.
+pub fn assert_lambda(
+    smith: &dyn Smith,
+    slopes: &dyn SlopeDistribution,
+    scale: f64,
+    thetas: &[f64],
+    phis: &[f64],
+    tol: f64,
+    label: &str,
+) -> f64 {
+    let mut worst: f64 = 0.0;
+    for &theta in thetas {
+        for &phi in phis {
+            let w = from_spherical(theta, phi);
+            let got = smith.lambda(w);
+            let want = lambda_integral(slopes, w, scale);
+            let e = rel_err(got, want);
+            // Values below 1e-290 are at the edge of f64: compare absolutely there.
+            let ok = e <= tol || (want.abs() < 1e-290 && got.abs() < 1e-290);
+            assert!(
+                ok,
+                "{label}: Λ(θ={theta}, φ={phi}) = {got:e}, integral {want:e}, rel err {e:e} > {tol:e}"
+            );
+            if want.abs() >= 1e-290 {
+                worst = worst.max(e);
+            }
+            // Λ(−w) = −1 − Λ(w) and G1 in [0, 1].
+            let below = smith.lambda([-w[0], -w[1], -w[2]]);
+            assert!((below + 1.0 + got).abs() <= 1e-12 * (1.0 + got.abs()), "{label}: Λ(−w)");
+            let g1 = smith.g1(w, [0.0, 0.0, 1.0]);
+            assert!((0.0..=1.0).contains(&g1), "{label}: G1 = {g1}");
+        }
+    }
+    eprintln!("{label}: max rel err of Λ against its integral: {worst:.2e}");
+    worst
+}
+
+/// Checks a normal sampler: the Jacobian of u ↦ m (solid angle per unit area of u, by central
+/// differences) is 1/pdf_wm(m), and the samples lie on the unit upper hemisphere. Returns the
+/// max relative error.
+pub fn assert_sampler_density(sampler: &dyn NormalSampler, tol: f64, label: &str) -> f64 {
+    let mut worst: f64 = 0.0;
+    let h = 1e-6;
+    for i in 1..12 {
+        for j in 1..12 {
+            let u = [i as f64 / 12.0 + 0.013, j as f64 / 12.0 * 0.97];
+            let m = sampler.sample_wm(u);
+            assert!((dot(m, m) - 1.0).abs() < 1e-12 && m[2] >= 0.0, "{label}: m = {m:?}");
+            let d1 = diff(sampler, u, [h, 0.0]);
+            let d2 = diff(sampler, u, [0.0, h]);
+            let cross = [
+                d1[1] * d2[2] - d1[2] * d2[1],
+                d1[2] * d2[0] - d1[0] * d2[2],
+                d1[0] * d2[1] - d1[1] * d2[0],
+            ];
+            let area = dot(cross, cross).sqrt();
+            let pdf = sampler.pdf_wm(m);
+            if pdf < 1e-8 || m[2] < 1e-4 {
+                continue; // the finite differences are meaningless where m is on the horizon
+            }
+            let e = rel_err(1.0 / area, pdf);
+            assert!(e <= tol, "{label}: u = {u:?}: 1/|J| = {}, pdf = {pdf}, rel err {e:e}", 1.0 / area);
+            worst = worst.max(e);
+        }
+    }
+    eprintln!("{label}: max rel err of the sampler's Jacobian against pdf_wm: {worst:.2e}");
+    worst
+}
+
+fn diff(sampler: &dyn NormalSampler, u: [f64; 2], h: [f64; 2]) -> Vec3 {
+    let a = sampler.sample_wm([u[0] + h[0], u[1] + h[1]]);
+    let b = sampler.sample_wm([u[0] - h[0], u[1] - h[1]]);
+    let n = 2.0 * (h[0] + h[1]);
+    [(a[0] - b[0]) / n, (a[1] - b[1]) / n, (a[2] - b[2]) / n]
+}
+
+/// The azimuth of a normal in [0, 2π).
+pub fn azimuth(m: Vec3) -> f64 {
+    m[1].atan2(m[0]).rem_euclid(TAU)
+}
