@@ -5,7 +5,7 @@
 use crate::geometry::{dot, from_spherical, Vec3};
 use crate::model::{NormalSampler, SlopeDistribution, Smith};
 use crate::test_support::{integrate, integrate_line, integrate_tail, rel_err};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::PI;
 
 /// ∫ D(m) (m·n) dm over the hemisphere, in slope-radius coordinates r = tan θ along each
 /// azimuth (dm = sin θ dθ dφ, cos θ sin θ dθ = r dr/(1 + r²)²); `radial_scale(φ)` is the slope
@@ -79,7 +79,10 @@ pub fn assert_lambda(
             }
             // Λ(−w) = −1 − Λ(w) and G1 in [0, 1].
             let below = smith.lambda([-w[0], -w[1], -w[2]]);
-            assert!((below + 1.0 + got).abs() <= 1e-12 * (1.0 + got.abs()), "{label}: Λ(−w)");
+            assert!(
+                (below + 1.0 + got).abs() <= 1e-12 * (1.0 + got.abs()),
+                "{label}: Λ(−w)"
+            );
             let g1 = smith.g1(w, [0.0, 0.0, 1.0]);
             assert!((0.0..=1.0).contains(&g1), "{label}: G1 = {g1}");
         }
@@ -98,7 +101,10 @@ pub fn assert_sampler_density(sampler: &dyn NormalSampler, tol: f64, label: &str
         for j in 1..12 {
             let u = [i as f64 / 12.0 + 0.013, j as f64 / 12.0 * 0.97];
             let m = sampler.sample_wm(u);
-            assert!((dot(m, m) - 1.0).abs() < 1e-12 && m[2] >= 0.0, "{label}: m = {m:?}");
+            assert!(
+                (dot(m, m) - 1.0).abs() < 1e-12 && m[2] >= 0.0,
+                "{label}: m = {m:?}"
+            );
             let d1 = diff(sampler, u, [h, 0.0]);
             let d2 = diff(sampler, u, [0.0, h]);
             let cross = [
@@ -112,7 +118,11 @@ pub fn assert_sampler_density(sampler: &dyn NormalSampler, tol: f64, label: &str
                 continue; // the finite differences are meaningless where m is on the horizon
             }
             let e = rel_err(1.0 / area, pdf);
-            assert!(e <= tol, "{label}: u = {u:?}: 1/|J| = {}, pdf = {pdf}, rel err {e:e}", 1.0 / area);
+            assert!(
+                e <= tol,
+                "{label}: u = {u:?}: 1/|J| = {}, pdf = {pdf}, rel err {e:e}",
+                1.0 / area
+            );
             worst = worst.max(e);
         }
     }
@@ -127,7 +137,61 @@ fn diff(sampler: &dyn NormalSampler, u: [f64; 2], h: [f64; 2]) -> Vec3 {
     [(a[0] - b[0]) / n, (a[1] - b[1]) / n, (a[2] - b[2]) / n]
 }
 
-/// The azimuth of a normal in [0, 2π).
-pub fn azimuth(m: Vec3) -> f64 {
-    m[1].atan2(m[0]).rem_euclid(TAU)
+/// The conformance suite of an elliptic NDF with a closed-form Smith Λ, P2 and sampler, at
+/// roughness `(alpha_x, alpha_y)`: normalization, P2 as the marginal of P22, D = P22/cos⁴θ,
+/// Λ against its defining integral (and Λ(−w), G1 ∈ [0, 1]), the sampler's Jacobian, and
+/// the slope moments that exist against their integrals. `width` is the slope width used to
+/// place quadrature nodes. Returns the worst relative errors (normalization, P2, Λ, moments).
+pub fn assert_elliptic_model<M>(model: &M, alpha: (f64, f64), width: f64, label: &str) -> [f64; 4]
+where
+    M: Smith + NormalSampler + SlopeDistribution,
+{
+    let (ax, ay) = alpha;
+    let radial = |phi: f64| {
+        let (s, c) = phi.sin_cos();
+        width / ((c / ax).powi(2) + (s / ay).powi(2)).sqrt()
+    };
+    let n = normalization(&|w| model.d(w), &radial);
+    assert!((n - 1.0).abs() < 1e-10, "{label}: ∫ D cos θ dω = {n}");
+    let mut worst_p2: f64 = 0.0;
+    for &phi in &[0.0f64, 0.7, 2.0] {
+        let s = (ax * phi.cos()).hypot(ay * phi.sin());
+        for &q in &[0.0, 0.4 * s, 3.0 * s] {
+            let want = p2_marginal(model, q, phi, s * width);
+            let e = rel_err(model.p2(q, phi), want);
+            assert!(e < 1e-10, "{label}: P2({q}, {phi}) rel err {e:e}");
+            worst_p2 = worst_p2.max(e);
+        }
+    }
+    for &(theta, phi) in &[(0.0, 0.0), (0.4, 0.3), (1.2, 2.5), (1.5, 4.0)] {
+        let w = from_spherical(theta, phi);
+        let want = model.p22(w[0] / w[2], w[1] / w[2]) / w[2].powi(4);
+        assert!(rel_err(model.d(w), want) < 1e-12, "{label}: D vs P22/cos⁴θ");
+    }
+    let thetas = [1e-3, 0.05, 0.3, 0.8, 1.2, 1.5, 1.57];
+    let phis: &[f64] = if ax == ay { &[0.0] } else { &[0.0, 0.9, 2.0] };
+    let worst_lambda = assert_lambda(
+        model,
+        model,
+        ax.max(ay) * width,
+        &thetas,
+        phis,
+        1e-10,
+        label,
+    );
+    assert_sampler_density(model, 1e-6, label);
+    let mut worst_moment: f64 = 0.0;
+    for k in 1..=3 {
+        for &phi in &[0.0f64, 1.1] {
+            let s = (ax * phi.cos()).hypot(ay * phi.sin());
+            if let Some(v) = model.slope_moment(k, phi) {
+                let want = moment_integral(model, k, phi, s * width);
+                let e = rel_err(v, want);
+                assert!(e < 1e-10, "{label}: ν{} rel err {e:e}", 2 * k);
+                worst_moment = worst_moment.max(e);
+            }
+        }
+    }
+    eprintln!("{label}: |∫D cos − 1| = {:.1e}, P2 {worst_p2:.1e}, Λ {worst_lambda:.1e}, moments {worst_moment:.1e}", (n - 1.0).abs());
+    [(n - 1.0).abs(), worst_p2, worst_lambda, worst_moment]
 }

@@ -148,3 +148,56 @@ impl Model for Ggx {
         Some(self)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::from_spherical;
+    use crate::ndf::conformance::assert_elliptic_model;
+    use crate::test_support::rel_err;
+
+    #[test]
+    fn conforms_to_its_definitions() {
+        for &alpha in &[
+            (0.3, 0.3),
+            (0.05, 0.05),
+            (1.0, 1.0),
+            (0.1, 0.4),
+            (0.02, 0.8),
+        ] {
+            let m = Ggx::new(alpha.0, alpha.1).unwrap();
+            assert_elliptic_model(&m, alpha, 1.0, &format!("ggx α={alpha:?}"));
+        }
+    }
+
+    #[test]
+    fn slope_moments_diverge() {
+        // P2 ∝ (1 + q²/α²)^{−3/2}: ν2 = ∞, so variance and kurtosis are undefined.
+        let m = Ggx::new(0.3, 0.3).unwrap();
+        assert_eq!(m.slope_moment(1, 0.0), None);
+        assert_eq!(m.variance(0.0), None);
+        assert_eq!(m.excess_kurtosis(), None);
+    }
+
+    #[test]
+    fn table1_route_agrees_away_from_normal_incidence() {
+        let m = Ggx::new(0.3, 0.3).unwrap();
+        for &theta in &[0.8, 1.2, 1.5] {
+            let w = from_spherical(theta, 0.0);
+            let e = rel_err(m.lambda_route(w, "table1").unwrap(), m.lambda(w));
+            assert!(e < 1e-13, "θ = {theta}: {e:e}");
+        }
+        // Near normal incidence ½(√(1 + 1/a²) − 1) cancels: a = 1e5 loses ~10 digits.
+        let w = from_spherical((1.0f64 / 3e4).atan(), 0.0);
+        let (t, d) = (m.lambda_route(w, "table1").unwrap(), m.lambda(w));
+        assert!(rel_err(d, 0.25e-10) < 1e-9, "default {d:e}");
+        assert!(rel_err(t, d) > 1e-8, "table1 {t:e} vs {d:e}");
+    }
+
+    #[test]
+    fn parameters_are_validated() {
+        assert!(Ggx::new(0.0, 0.3).is_err());
+        assert!(Ggx::new(-1.0, 0.3).is_err());
+        assert!(Ggx::new(0.3, f64::NAN).is_err());
+    }
+}

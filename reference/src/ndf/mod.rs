@@ -7,6 +7,8 @@ pub mod student_lambda;
 
 #[cfg(test)]
 mod conformance;
+#[cfg(test)]
+mod student_errata;
 
 pub use beckmann::Beckmann;
 pub use ggx::Ggx;

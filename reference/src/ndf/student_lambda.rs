@@ -11,8 +11,9 @@ use crate::error::QueryError;
 use crate::special::{hyp2f1, student_tail};
 use std::f64::consts::{FRAC_PI_2, PI};
 
-/// A route: Λ as a function of (C, x) for x ∈ (0, ∞).
-pub type RouteFn = fn(f64, f64) -> f64;
+/// A route: Λ as a function of (C, x, σ) for x ∈ (0, ∞), σ = s(φ)/√(C − 1) the STD roughness
+/// along the azimuth of w (only the printed eq 36–37 depends on σ separately: it is wrong).
+pub type RouteFn = fn(f64, f64, f64) -> f64;
 
 /// The named routes with a one-line description; the first is the default.
 pub const ROUTES: &[(&str, &str)] = &[
@@ -29,13 +30,21 @@ pub const ROUTES: &[(&str, &str)] = &[
         "eq 21 with ₂F₁ by seed 001 §8 Algorithm 2 as printed",
     ),
     (
+        "2f1_algorithm2_corrected",
+        "eq 21 with ₂F₁ by seed 001 §8 Algorithm 2, printed errors corrected",
+    ),
+    (
         "incomplete_beta",
         "N w^(C−3/2)/((2C−3)x) − ½ I_w(C−1, ½), w = 1/(1+x²), via statrs",
     ),
     ("integer", "seed 001 eq 29–30, integer γ ≥ 2"),
     (
         "half_integer",
-        "seed 001 eq 29 with eq 36–37, γ ∈ {5/2, 7/2, …}",
+        "seed 001 eq 29 with eq 36–37 corrected, γ ∈ {5/2, 7/2, …}",
+    ),
+    (
+        "half_integer_printed",
+        "seed 001 eq 29 with eq 36–37 as printed (arctan(μ/√((γ−1)σ))), γ ∈ {5/2, 7/2, …}",
     ),
     (
         "table1",
@@ -54,25 +63,30 @@ pub fn route(name: &str, c: f64) -> Result<RouteFn, QueryError> {
         reason,
     };
     let f: RouteFn = match name {
-        "default" | "stable" => lambda_stable,
-        "2f1" => lambda_2f1,
-        "2f1_algorithm2" => lambda_2f1_algorithm2,
-        "incomplete_beta" => lambda_incomplete_beta,
+        "default" | "stable" => |c, x, _| lambda_stable(c, x),
+        "2f1" => |c, x, _| lambda_2f1(c, x),
+        "2f1_algorithm2" => |c, x, _| lambda_2f1_algorithm2(c, x),
+        "2f1_algorithm2_corrected" => |c, x, _| lambda_2f1_algorithm2_corrected(c, x),
+        "incomplete_beta" => |c, x, _| lambda_incomplete_beta(c, x),
         "integer" => {
             if !(c.fract() == 0.0 && (2.0..=INTEGER_MAX).contains(&c)) {
                 return Err(unavailable(format!(
                     "needs an integer γ in [2, {INTEGER_MAX}] (got {c})"
                 )));
             }
-            lambda_integer
+            |c, x, _| lambda_integer(c, x)
         }
-        "half_integer" => {
+        "half_integer" | "half_integer_printed" => {
             if !((c - 0.5).fract() == 0.0 && (2.5..=INTEGER_MAX).contains(&c)) {
                 return Err(unavailable(format!(
                     "needs γ − ½ an integer ≥ 2, γ ≤ {INTEGER_MAX} (got {c})"
                 )));
             }
-            lambda_half_integer
+            if name == "half_integer" {
+                |c, x, _| lambda_half_integer(c, x)
+            } else {
+                lambda_half_integer_printed
+            }
         }
         "table1" | "table1_printed" => {
             if ![2.0, 2.5, 3.0, 3.5, 4.0].contains(&c) {
@@ -81,9 +95,9 @@ pub fn route(name: &str, c: f64) -> Result<RouteFn, QueryError> {
                 )));
             }
             if name == "table1" {
-                lambda_table1
+                |c, x, _| lambda_table1(c, x)
             } else {
-                lambda_table1_printed
+                |c, x, _| lambda_table1_printed(c, x)
             }
         }
         _ => {
@@ -100,9 +114,9 @@ pub fn route(name: &str, c: f64) -> Result<RouteFn, QueryError> {
 pub const INTEGER_MAX: f64 = 1000.0;
 
 /// N_C = Γ(C − ½)/(√π Γ(C − 1)), the constant of the standardized P2 (seed 001 eq 15 with
-/// σ√(γ−1) = 1), accurate for every C > 1 (the Γ ratio by `special::student_tail`).
+/// σ√(γ−1) = 1), accurate to a few ulps for every C > 1 (`special::hyp2f1::student_norm`).
 pub fn p2_norm(c: f64) -> f64 {
-    student_tail::ln_gamma_ratio(c).exp() / PI.sqrt()
+    hyp2f1::student_norm(c)
 }
 
 /// Shared end-point values: Λ(x = 0) = ∞ (grazing), Λ(x = ∞) = 0 (normal incidence).
@@ -154,6 +168,16 @@ pub fn lambda_2f1_algorithm2(c: f64, x: f64) -> f64 {
         return v;
     }
     eq21_first_term(c, x) + p2_norm(c) * x * hyp2f1::hyp2f1_lambda_algorithm2(c, -x * x) - 0.5
+}
+
+/// Eq 21 with ₂F₁ by Algorithm 2 with its printed errors corrected
+/// (`special::hyp2f1::hyp2f1_lambda_algorithm2_corrected`).
+pub fn lambda_2f1_algorithm2_corrected(c: f64, x: f64) -> f64 {
+    if let Some(v) = end_points(x) {
+        return v;
+    }
+    eq21_first_term(c, x) + p2_norm(c) * x * hyp2f1::hyp2f1_lambda_algorithm2_corrected(c, -x * x)
+        - 0.5
 }
 
 /// Λ through the regularized incomplete beta function (statrs), an independent cross-check of
@@ -210,17 +234,28 @@ pub fn lambda_integer(c: f64, x: f64) -> f64 {
     (c - 1.0) * a1 * (first - a2)
 }
 
-/// Seed 001 eq 29 with eq 36–37, half-integer γ = n + 3/2, n ≥ 1:
+/// Seed 001 eq 29 with eq 36–37, half-integer γ = n + 3/2, n ≥ 1, corrected (ERRATA.md: the
+/// printed arctan(μ/√((γ−1)σ)) is arctan(μ/(σ√(γ−1))) = arctan x):
 ///
 /// ```text
 /// A1  = (2/π) Σ_{k=0}^{γ−3/2} C(γ−3/2, k) (−1)^k/(2k+1)
 /// A2  = A21 / 2^{2γ−4} + A22 / 2^{2γ−3}
-/// A21 = Σ_{k=0}^{γ−5/2} C(2γ−3, k)/(2γ−3−2k) · (−sin((2γ−3−2k) arctan(μ/(√(γ−1) σ))))
-/// A22 = C(2γ−3, γ−3/2) (π/2 − arctan(μ/(√(γ−1) σ)))
+/// A21 = Σ_{k=0}^{γ−5/2} C(2γ−3, k)/(2γ−3−2k) · (−sin((2γ−3−2k) arctan(μ/(σ√(γ−1)))))
+/// A22 = C(2γ−3, γ−3/2) (π/2 − arctan(μ/(σ√(γ−1))))
 /// ```
 ///
-/// Correct as printed (with arctan(μ/(√(γ−1)σ)) = arctan x). Alternating sums: small γ only.
+/// Alternating sums: accurate for small γ only (the harness measures how far).
 pub fn lambda_half_integer(c: f64, x: f64) -> f64 {
+    half_integer_with_angle(c, x, x.atan())
+}
+
+/// Seed 001 eq 36–37 as printed, with arctan(μ/√((γ−1)σ)) = arctan(x √σ)
+/// (μ = cot θ, x = μ/(σ√(γ−1))): right only where σ = 1. Kept to demonstrate the erratum.
+pub fn lambda_half_integer_printed(c: f64, x: f64, sigma: f64) -> f64 {
+    half_integer_with_angle(c, x, (x * sigma.sqrt()).atan())
+}
+
+fn half_integer_with_angle(c: f64, x: f64, x0: f64) -> f64 {
     if let Some(v) = end_points(x) {
         return v;
     }
@@ -231,7 +266,6 @@ pub fn lambda_half_integer(c: f64, x: f64) -> f64 {
             .enumerate()
             .map(|(k, b)| if k % 2 == 0 { b } else { -b } / (2 * k + 1) as f64)
             .sum::<f64>();
-    let x0 = x.atan();
     let central = binomials(m).nth(n as usize).unwrap_or(f64::NAN);
     let a21: f64 = binomials(m)
         .take(n as usize)

@@ -1,5 +1,6 @@
 //! Special functions no well-kept crate provides at the accuracy and over the domain the
-//! closed forms need; everything else comes from statrs.
+//! closed forms need; everything else comes from statrs and libm.
 
+pub mod gamma_ratio;
 pub mod hyp2f1;
 pub mod student_tail;
