@@ -4,7 +4,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::error::ParamError;
 use crate::model::Model;
-use crate::ndf::{Beckmann, Ggx, Student};
+use crate::ndf::{Beckmann, Blend, Ggx, PiecewiseLinear, Profile, Student};
 
 /// A model described as data, e.g. `{"family": "std", "gamma": 2.5, "alpha": 0.3}`
 /// (DESIGN.md, "Evaluating closed forms"). Unknown keys are errors.
@@ -88,6 +88,21 @@ pub enum ModelSpec {
         /// C > 1.
         c: f64,
     },
+    /// The piecewise-linear NDF (seed 000, eq 1–5).
+    PiecewiseLinear {
+        /// The profile D_x (alone: the isotropic D_iso).
+        x: Profile,
+        /// The profile D_y of the anisotropic blend (eq 1).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        y: Option<Profile>,
+    },
+    /// Two isotropic models combined by eq 1 of seed 000.
+    Blend {
+        /// The model along x.
+        x: Box<ModelSpec>,
+        /// The model along y.
+        y: Box<ModelSpec>,
+    },
 }
 
 /// Resolves `alpha` or (`alpha_x`, `alpha_y`) into validated per-axis roughness.
@@ -121,6 +136,8 @@ impl ModelSpec {
             ModelSpec::HyperCauchy { .. } => "hyper_cauchy",
             ModelSpec::StudentFixedVariance { .. } => "student_fixed_variance",
             ModelSpec::StudentGeneral { .. } => "student_general",
+            ModelSpec::PiecewiseLinear { .. } => "piecewise_linear",
+            ModelSpec::Blend { .. } => "blend",
         }
     }
 
@@ -180,6 +197,10 @@ impl ModelSpec {
                 }
             }
             ModelSpec::StudentGeneral { b, c } => Box::new(Student::general(b, c)?),
+            ModelSpec::PiecewiseLinear { ref x, ref y } => {
+                Box::new(PiecewiseLinear::new(x.clone(), y.clone())?)
+            }
+            ModelSpec::Blend { ref x, ref y } => Box::new(Blend::new(x.build()?, y.build()?)?),
         })
     }
 }

@@ -79,7 +79,10 @@ pub fn assert_lambda(
             }
             // Λ(−w) = −1 − Λ(w) and G1 in [0, 1].
             let below = smith.lambda([-w[0], -w[1], -w[2]]);
-            assert!((below + 1.0 + got).abs() <= 1e-12 * (1.0 + got.abs()), "{label}: Λ(−w)");
+            assert!(
+                (below + 1.0 + got).abs() <= 1e-12 * (1.0 + got.abs()),
+                "{label}: Λ(−w)"
+            );
             let g1 = smith.g1(w, [0.0, 0.0, 1.0]);
             assert!((0.0..=1.0).contains(&g1), "{label}: G1 = {g1}");
         }
@@ -98,7 +101,10 @@ pub fn assert_sampler_density(sampler: &dyn NormalSampler, tol: f64, label: &str
         for j in 1..12 {
             let u = [i as f64 / 12.0 + 0.013, j as f64 / 12.0 * 0.97];
             let m = sampler.sample_wm(u);
-            assert!((dot(m, m) - 1.0).abs() < 1e-12 && m[2] >= 0.0, "{label}: m = {m:?}");
+            assert!(
+                (dot(m, m) - 1.0).abs() < 1e-12 && m[2] >= 0.0,
+                "{label}: m = {m:?}"
+            );
             let d1 = diff(sampler, u, [h, 0.0]);
             let d2 = diff(sampler, u, [0.0, h]);
             let cross = [
@@ -112,7 +118,11 @@ pub fn assert_sampler_density(sampler: &dyn NormalSampler, tol: f64, label: &str
                 continue; // the finite differences are meaningless where m is on the horizon
             }
             let e = rel_err(1.0 / area, pdf);
-            assert!(e <= tol, "{label}: u = {u:?}: 1/|J| = {}, pdf = {pdf}, rel err {e:e}", 1.0 / area);
+            assert!(
+                e <= tol,
+                "{label}: u = {u:?}: 1/|J| = {}, pdf = {pdf}, rel err {e:e}",
+                1.0 / area
+            );
             worst = worst.max(e);
         }
     }

@@ -362,7 +362,11 @@ mod tests {
                 let (p, q) = (w[0] / w[2], w[1] / w[2]);
                 let want = m.p22(p, q) / w[2].powi(4);
                 let e = rel_err(m.d(w), want);
-                assert!(e < 1e-12, "{:?}: D vs P22/cos⁴θ at θ={theta}: {e:e}", m.spec());
+                assert!(
+                    e < 1e-12,
+                    "{:?}: D vs P22/cos⁴θ at θ={theta}: {e:e}",
+                    m.spec()
+                );
             }
         }
         eprintln!("Student family: max rel err of P2 against ∫ P22 dp: {worst:.2e}");
@@ -404,7 +408,11 @@ mod tests {
     #[test]
     fn slope_moments_match_integrals_and_eq7_claims() {
         for &g in &[2.5, 3.5, 4.5, 7.5, 100.0] {
-            for m in [std(g, 0.3, 0.3), std(g, 0.1, 0.4), Student::general(2.0, g).unwrap()] {
+            for m in [
+                std(g, 0.3, 0.3),
+                std(g, 0.1, 0.4),
+                Student::general(2.0, g).unwrap(),
+            ] {
                 for k in 0..4u32 {
                     let got = m.slope_moment(k, 0.6);
                     if g <= 1.0 + k as f64 {
@@ -509,11 +517,21 @@ mod tests {
             let s = std(g, 0.3, 0.3);
             let ed = rel_err(s.d(w_d), b.d(w_d));
             let el = rel_err(s.lambda(w_l), b.lambda(w_l));
-            eprintln!("γ = {g:e}: |ΔD|/D = {ed:.3e} (γ·err {:.3}), |ΔΛ|/Λ = {el:.3e} (γ·err {:.3})", ed * g, el * g);
+            eprintln!(
+                "γ = {g:e}: |ΔD|/D = {ed:.3e} (γ·err {:.3}), |ΔΛ|/Λ = {el:.3e} (γ·err {:.3})",
+                ed * g,
+                el * g
+            );
             if let Some((pd, pl)) = prev {
                 // Each factor 100 in γ divides the error by ≈ 100 (rate 1/γ).
-                assert!((60.0..160.0).contains(&(pd / ed)), "D rate: {pd:e} → {ed:e}");
-                assert!((60.0..160.0).contains(&(pl / el)), "Λ rate: {pl:e} → {el:e}");
+                assert!(
+                    (60.0..160.0).contains(&(pd / ed)),
+                    "D rate: {pd:e} → {ed:e}"
+                );
+                assert!(
+                    (60.0..160.0).contains(&(pl / el)),
+                    "Λ rate: {pl:e} → {el:e}"
+                );
             }
             prev = Some((ed, el));
         }
@@ -528,7 +546,9 @@ mod tests {
                 let w = from_spherical(theta, 0.0);
                 let reference = m.lambda(w);
                 for route in m.lambda_routes() {
-                    let Ok(v) = m.lambda_route(w, route) else { continue };
+                    let Ok(v) = m.lambda_route(w, route) else {
+                        continue;
+                    };
                     if route == "table1_printed" && g == 3.5 {
                         // The printed γ = 7/2 row is wrong (ERRATA.md): an expected failure.
                         assert!(rel_err(v, reference) > 0.1, "γ=7/2 printed row agreed: {v}");
@@ -538,13 +558,22 @@ mod tests {
                         continue; // measured by its own test in special::hyp2f1
                     }
                     let e = rel_err(v, reference);
-                    assert!(e < 1e-11, "γ={g} θ={theta} route {route}: {v} vs {reference} ({e:e})");
+                    assert!(
+                        e < 1e-11,
+                        "γ={g} θ={theta} route {route}: {v} vs {reference} ({e:e})"
+                    );
                 }
             }
         }
-        assert!(std(2.7, 0.3, 0.3).lambda_route([0.0, 0.6, 0.8], "integer").is_err());
-        assert!(std(3.0, 0.3, 0.3).lambda_route([0.0, 0.6, 0.8], "half_integer").is_err());
-        assert!(std(3.0, 0.3, 0.3).lambda_route([0.0, 0.6, 0.8], "nope").is_err());
+        assert!(std(2.7, 0.3, 0.3)
+            .lambda_route([0.0, 0.6, 0.8], "integer")
+            .is_err());
+        assert!(std(3.0, 0.3, 0.3)
+            .lambda_route([0.0, 0.6, 0.8], "half_integer")
+            .is_err());
+        assert!(std(3.0, 0.3, 0.3)
+            .lambda_route([0.0, 0.6, 0.8], "nope")
+            .is_err());
     }
 
     #[test]
