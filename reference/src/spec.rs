@@ -261,6 +261,40 @@ mod tests {
     }
 
     #[test]
+    fn piecewise_and_blend_specs_round_trip() {
+        let text = r#"{"family":"piecewise_linear","x":{"theta":[0.0,0.5,1.5707963267948966],"value":[2.0,1.0,0.0]}}"#;
+        let s = parse(text).unwrap();
+        assert_eq!(s.family(), "piecewise_linear");
+        let m = s.build().unwrap();
+        assert_eq!(m.family(), "piecewise_linear");
+        assert_eq!(m.spec(), s);
+        assert_eq!(serde_json::to_string(&s).unwrap(), text);
+        let text = r#"{"family":"piecewise_linear","x":{"theta":[0.0,1.5707963267948966],"value":[1.0,0.0]},"y":{"theta":[0.0,0.7,1.5707963267948966],"value":[0.0,3.0,1.0]}}"#;
+        let s = parse(text).unwrap();
+        assert_eq!(s.build().unwrap().spec(), s);
+        assert_eq!(serde_json::to_string(&s).unwrap(), text);
+        let text = r#"{"family":"blend","x":{"family":"ggx","alpha":0.2},"y":{"family":"beckmann","alpha":0.5}}"#;
+        let s = parse(text).unwrap();
+        assert_eq!(s.family(), "blend");
+        assert_eq!(s.build().unwrap().spec(), s);
+        assert_eq!(serde_json::to_string(&s).unwrap(), text);
+        // Unknown keys (also inside a profile) and bad profiles are errors.
+        assert!(parse(r#"{"family":"piecewise_linear","x":{"theta":[0,1.5707963267948966],"value":[1,1],"n":2}}"#).is_err());
+        assert!(parse(r#"{"family":"piecewise_linear","x":{"theta":[0,1.5707963267948966],"value":[1,1]},"z":1}"#).is_err());
+        let s =
+            parse(r#"{"family":"piecewise_linear","x":{"theta":[0,1.5],"value":[1,1]}}"#).unwrap();
+        assert!(matches!(
+            s.build().map(|_| ()).unwrap_err(),
+            ParamError::InvalidProfile { .. }
+        ));
+        let s = parse(r#"{"family":"blend","x":{"family":"ggx","alpha_x":0.1,"alpha_y":0.3},"y":{"family":"ggx","alpha":0.2}}"#).unwrap();
+        assert!(matches!(
+            s.build().map(|_| ()).unwrap_err(),
+            ParamError::NotIsotropic { .. }
+        ));
+    }
+
+    #[test]
     fn unknown_keys_and_bad_gamma_are_errors() {
         let e = parse(r#"{"family":"ggx","alpha":0.3,"gamma":2}"#).unwrap_err();
         assert!(e.to_string().contains("gamma"), "{e}");
