@@ -227,6 +227,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::excessive_precision)] // the reference values as mpmath printed them
     fn blend_of_a_model_with_itself_has_its_lambda() {
         // Eq 1 with D_x = D_y is D itself: Λ must be GGX's closed form, and Beckmann's
         // ½ (e^{−a²}/(a√π) − erfc a), a = cot θ/α, here from mpmath 1.3 at 50 digits (the

@@ -1395,4 +1395,44 @@ pub(crate) mod tests {
         let b = m.lambda(from_spherical(0.9, 1.0));
         assert!(rel_err(a, b) < 1e-13);
     }
+
+    #[test]
+    fn printed_eq23_partial_segment_and_its_extracted_y_line() {
+        // Eq 23's partial A over [θ_k, E] is right with cos 2θ_o (from −cos 2E); the y line as
+        // extracted reads cos 2φ_o there (ERRATA-000 E5), which is wrong whenever φ_o ≠ θ_o.
+        let (a, b, tk, theta_o, phi_o) = (0.7f64, 0.4f64, 0.2f64, 0.9f64, 0.3f64);
+        let e = FRAC_PI_2 - theta_o;
+        let with = |c: f64| {
+            (a * ((2.0 * tk).cos() + c)
+                + 2.0 * (e - tk) * (a * (tk + e) + 2.0 * b)
+                + 2.0 * (a * tk + b) * (2.0 * tk).sin()
+                - 2.0 * (a * e + b) * (2.0 * theta_o).sin())
+                / 8.0
+        };
+        let want = de(&|t: f64| (a * t + b) * t.sin().powi(2), tk, e, 1e-15);
+        assert!(rel_err(with((2.0 * theta_o).cos()), want) < 1e-13);
+        assert!(rel_err(with((2.0 * phi_o).cos()), want) > 1e-2);
+    }
+
+    #[test]
+    fn eq34_display_is_i11_not_i1() {
+        // ERRATA-000 E11: eq 34 labels its display I₁ but it is I₁₁ = I₁ − cos θ_o/2; with the
+        // I₁ of eq 16 in eq 34, Λ comes out ½ too large.
+        let m = pl(
+            random_profile(2, 7, false),
+            Some(random_profile(3, 11, false)),
+        );
+        let (t, phi) = (0.8f64, 0.7f64);
+        let ds = domain_split(&m, t, (2.0 * phi).cos(), Remaining::Adaptive);
+        let c2 = (2.0 * phi).cos();
+        let display = t.sin()
+            * (m.kx * (3.0 + c2) / 3.0 * m.ax[m.ax.len() - 1]
+                + m.ky * (3.0 - c2) / 3.0 * m.ay[m.ay.len() - 1]);
+        assert!(rel_err(ds.i11, display) < 1e-15);
+        let exact = m.lambda(from_spherical(t, phi));
+        assert!((ds.lambda - exact).abs() < 1e-13);
+        let i1 = display + 0.5 * t.cos();
+        let misread = (i1 + ds.i2_1 + ds.i2_2) / t.cos() - 0.5;
+        assert!((misread - exact - 0.5).abs() < 1e-13);
+    }
 }
