@@ -254,22 +254,33 @@ pub fn domain_split(
 /// the lower end) with the breakpoints as interval ends; relative accuracy `rel`.
 pub fn p2(p: &PiecewiseLinear, q: f64, cos2phi: f64, rel: f64) -> f64 {
     let q = q.abs();
+    let eq = if q == 0.0 {
+        FRAC_PI_2
+    } else {
+        (1.0 / q).atan()
+    };
+    p2_co(p, q, eq, cos2phi, rel)
+}
+
+/// `p2` given also ε_q = π/2 − atan q (= atan(1/q)), so that cos θ = sin(ε_q − v²) keeps its
+/// relative accuracy for huge q (θ next to the horizon).
+fn p2_co(p: &PiecewiseLinear, q: f64, eq: f64, cos2phi: f64, rel: f64) -> f64 {
     let (cv2, sv2) = (0.5 * (1.0 + cos2phi), 0.5 * (1.0 - cos2phi));
-    let tq = q.atan();
-    let cos_tq = 1.0 / q.hypot(1.0);
+    let tq = FRAC_PI_2 - eq;
+    let cos_tq = eq.sin();
     let mut vs = vec![0.0];
     vs.extend(
         p.grid
             .iter()
             .filter(|&&t| t > tq && t < FRAC_PI_2)
-            .map(|&t| (t - tq).sqrt()),
+            .map(|&t| (eq - (FRAC_PI_2 - t)).max(0.0).sqrt()),
     );
-    vs.push((FRAC_PI_2 - tq).max(0.0).sqrt());
+    vs.push(eq.sqrt());
     let q2 = q * q;
     let f = |v: f64| {
         let d = v * v;
         let th = tq + d;
-        let (s, c) = th.sin_cos();
+        let (c, s) = (eq - d).sin_cos(); // cos θ, sin θ
         let pp2 = d.sin() / (c * cos_tq) * (s / c + q);
         let pv = pp2.sqrt();
         let (a, b) = (p.kx * p.d_x(th), p.ky * p.d_y(th));
@@ -289,12 +300,13 @@ pub fn p2(p: &PiecewiseLinear, q: f64, cos2phi: f64, rel: f64) -> f64 {
 ///
 /// ```text
 /// Λ(o) = 1/μ ∫_μ^∞ (q − μ) P₂(q) dq,   μ = cot θ_o
-///      = ∫_E^{π/2} sin(β − E) P₂(tan β) / (cos³β sin E) dβ      (q = tan β, E = π/2 − θ_o)
+///      = ∫_0^{θ_o} sin(θ_o − ε) P₂(cot ε) / (sin³ε cos θ_o) dε      (q = cot ε)
 /// ```
 ///
-/// P₂ by `p2` (relative 1e-13), the outer integral to relative 1e-12 with the breakpoints as
-/// interval ends (P₂(tan β) is not smooth where β crosses one). Nested quadrature: ~10⁵–10⁶
-/// evaluations of D; a cross-check of the exact route, not a fast path.
+/// P₂ by `p2` (relative 1e-13), the outer integral to relative 1e-12 with π/2 − θᵢ as interval
+/// ends (P₂(cot ε) is not smooth where atan q crosses a breakpoint). The co-angle ε keeps cos β
+/// and huge q accurate next to the horizon. Nested quadrature (~10⁴–10⁵ evaluations of D): a
+/// cross-check of the exact route, not a fast path.
 pub fn lambda_slope_space(p: &PiecewiseLinear, theta_o: f64, cos2phi: f64) -> f64 {
     if !(theta_o > 0.0) {
         return 0.0;
@@ -302,19 +314,27 @@ pub fn lambda_slope_space(p: &PiecewiseLinear, theta_o: f64, cos2phi: f64) -> f6
     if theta_o >= FRAC_PI_2 {
         return f64::INFINITY;
     }
-    let e = FRAC_PI_2 - theta_o;
+    // β = π/2 − ε: cos β = sin ε and q = cot ε stay accurate next to the horizon.
     let se = theta_o.cos();
-    let mut bs = vec![e];
-    bs.extend(p.grid.iter().copied().filter(|&t| t > e && t < FRAC_PI_2));
-    bs.push(FRAC_PI_2);
-    let f = |beta: f64| {
-        let cb = beta.cos();
-        let v = (beta - e).sin() * p2(p, beta.tan(), cos2phi, 1e-13) / (cb * cb * cb * se);
+    let mut cuts = vec![0.0];
+    let mut inner: Vec<f64> = p
+        .grid
+        .iter()
+        .map(|&t| FRAC_PI_2 - t)
+        .filter(|&x| x > 0.0 && x < theta_o)
+        .collect();
+    inner.reverse();
+    cuts.extend(inner);
+    cuts.push(theta_o);
+    let f = |eps: f64| {
+        let sb = eps.sin();
+        let q = 1.0 / eps.tan();
+        let v = (theta_o - eps).sin() * p2_co(p, q, eps, cos2phi, 1e-13) / (sb * sb * sb * se);
         if v.is_finite() {
             v
         } else {
             0.0
         }
     };
-    integrate(&f, &bs, 1e-12, 0.0).value
+    integrate(&f, &cuts, 1e-12, 0.0).value
 }
