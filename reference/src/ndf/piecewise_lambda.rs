@@ -174,7 +174,9 @@ pub struct DomainSplit {
 /// with A(E) = ∫₀^E D sin²θ dθ, T(E) = ∫₀^E D cos θ sin θ dθ in closed form (tables up to
 /// the segment of E, eq 15, plus the partial segment, eq 23). Λ_doc is by the trapezoid rule on
 /// E and the breakpoints above it (eq 28) or adaptively. The trapezoid route is the
-/// document's approximation: its measured error is in the unit tests and ERRATA-000. The
+/// document's approximation: measured relative error of G₁ ≤ 3.3e-2 with 5–11 irregular
+/// breakpoints and ≤ 3.2e-4 with 64 equal ones over θ_o ∈ [1e-3, 1.57] (largest where
+/// [E, π/2] falls in one coarse segment; ERRATA-000 E10); adaptively it is exact. The
 /// argument of arccos is clamped to [−1, 1] (rounding at θ = E). Near normal incidence the
 /// subtraction in eq 34 cancels: absolute accuracy ~1e-16/cos θ_o, not relative.
 pub fn domain_split(
