@@ -38,6 +38,26 @@ pub enum ParamError {
     /// The parameters were given in a combination the model does not accept.
     #[error("{0}")]
     Combination(String),
+    /// A piecewise-linear profile (breakpoints and values, seed 000 eq 4) is malformed.
+    #[error("profile {axis}: {requirement} (at index {index}, got {value})")]
+    InvalidProfile {
+        /// Which profile (`x`, `y`).
+        axis: &'static str,
+        /// The index of the offending breakpoint or value.
+        index: usize,
+        /// What the profile must satisfy, in words.
+        requirement: &'static str,
+        /// The offending number (a length, for length errors).
+        value: f64,
+    },
+    /// A model that must be isotropic (D depends on θ only) is not.
+    #[error("the {axis} model ({family}) must be isotropic")]
+    NotIsotropic {
+        /// Which slot (`x`, `y`).
+        axis: &'static str,
+        /// The model's family.
+        family: &'static str,
+    },
 }
 
 /// A query that is well-formed but that the model cannot answer as asked.

@@ -4,7 +4,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::error::ParamError;
 use crate::model::Model;
-use crate::ndf::{Beckmann, Ggx, Student};
+use crate::ndf::{Beckmann, Blend, Ggx, PiecewiseLinear, Profile, Student};
 
 /// A model described as data, e.g. `{"family": "std", "gamma": 2.5, "alpha": 0.3}`
 /// (DESIGN.md, "Evaluating closed forms"). Unknown keys are errors.
@@ -88,6 +88,21 @@ pub enum ModelSpec {
         /// C > 1.
         c: f64,
     },
+    /// The piecewise-linear NDF (seed 000, eq 1–5).
+    PiecewiseLinear {
+        /// The profile D_x (alone: the isotropic D_iso).
+        x: Profile,
+        /// The profile D_y of the anisotropic blend (eq 1).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        y: Option<Profile>,
+    },
+    /// Two isotropic models combined by eq 1 of seed 000.
+    Blend {
+        /// The model along x.
+        x: Box<ModelSpec>,
+        /// The model along y.
+        y: Box<ModelSpec>,
+    },
 }
 
 /// Resolves `alpha` or (`alpha_x`, `alpha_y`) into validated per-axis roughness.
@@ -121,6 +136,8 @@ impl ModelSpec {
             ModelSpec::HyperCauchy { .. } => "hyper_cauchy",
             ModelSpec::StudentFixedVariance { .. } => "student_fixed_variance",
             ModelSpec::StudentGeneral { .. } => "student_general",
+            ModelSpec::PiecewiseLinear { .. } => "piecewise_linear",
+            ModelSpec::Blend { .. } => "blend",
         }
     }
 
@@ -180,6 +197,10 @@ impl ModelSpec {
                 }
             }
             ModelSpec::StudentGeneral { b, c } => Box::new(Student::general(b, c)?),
+            ModelSpec::PiecewiseLinear { ref x, ref y } => {
+                Box::new(PiecewiseLinear::new(x.clone(), y.clone())?)
+            }
+            ModelSpec::Blend { ref x, ref y } => Box::new(Blend::new(x.build()?, y.build()?)?),
         })
     }
 }
@@ -237,6 +258,40 @@ mod tests {
         assert_eq!(s.build().unwrap().spec(), s);
         let s = parse(r#"{"family":"student_general","b":4,"c":2.5}"#).unwrap();
         assert_eq!(s.build().unwrap().spec(), s);
+    }
+
+    #[test]
+    fn piecewise_and_blend_specs_round_trip() {
+        let text = r#"{"family":"piecewise_linear","x":{"theta":[0.0,0.5,1.5707963267948966],"value":[2.0,1.0,0.0]}}"#;
+        let s = parse(text).unwrap();
+        assert_eq!(s.family(), "piecewise_linear");
+        let m = s.build().unwrap();
+        assert_eq!(m.family(), "piecewise_linear");
+        assert_eq!(m.spec(), s);
+        assert_eq!(serde_json::to_string(&s).unwrap(), text);
+        let text = r#"{"family":"piecewise_linear","x":{"theta":[0.0,1.5707963267948966],"value":[1.0,0.0]},"y":{"theta":[0.0,0.7,1.5707963267948966],"value":[0.0,3.0,1.0]}}"#;
+        let s = parse(text).unwrap();
+        assert_eq!(s.build().unwrap().spec(), s);
+        assert_eq!(serde_json::to_string(&s).unwrap(), text);
+        let text = r#"{"family":"blend","x":{"family":"ggx","alpha":0.2},"y":{"family":"beckmann","alpha":0.5}}"#;
+        let s = parse(text).unwrap();
+        assert_eq!(s.family(), "blend");
+        assert_eq!(s.build().unwrap().spec(), s);
+        assert_eq!(serde_json::to_string(&s).unwrap(), text);
+        // Unknown keys (also inside a profile) and bad profiles are errors.
+        assert!(parse(r#"{"family":"piecewise_linear","x":{"theta":[0,1.5707963267948966],"value":[1,1],"n":2}}"#).is_err());
+        assert!(parse(r#"{"family":"piecewise_linear","x":{"theta":[0,1.5707963267948966],"value":[1,1]},"z":1}"#).is_err());
+        let s =
+            parse(r#"{"family":"piecewise_linear","x":{"theta":[0,1.5],"value":[1,1]}}"#).unwrap();
+        assert!(matches!(
+            s.build().map(|_| ()).unwrap_err(),
+            ParamError::InvalidProfile { .. }
+        ));
+        let s = parse(r#"{"family":"blend","x":{"family":"ggx","alpha_x":0.1,"alpha_y":0.3},"y":{"family":"ggx","alpha":0.2}}"#).unwrap();
+        assert!(matches!(
+            s.build().map(|_| ()).unwrap_err(),
+            ParamError::NotIsotropic { .. }
+        ));
     }
 
     #[test]

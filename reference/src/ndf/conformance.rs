@@ -195,3 +195,8 @@ where
     eprintln!("{label}: |∫D cos − 1| = {:.1e}, P2 {worst_p2:.1e}, Λ {worst_lambda:.1e}, moments {worst_moment:.1e}", (n - 1.0).abs());
     [(n - 1.0).abs(), worst_p2, worst_lambda, worst_moment]
 }
+
+/// The azimuth of a normal in [0, 2π).
+pub fn azimuth(m: Vec3) -> f64 {
+    m[1].atan2(m[0]).rem_euclid(std::f64::consts::TAU)
+}

@@ -1,7 +1,11 @@
 //! Normal distribution functions, one model per file.
 
 pub mod beckmann;
+pub mod blend;
 pub mod ggx;
+pub mod piecewise;
+pub mod piecewise_lambda;
+pub mod piecewise_quadrature;
 pub mod student;
 pub mod student_lambda;
 
@@ -11,5 +15,7 @@ mod conformance;
 mod student_errata;
 
 pub use beckmann::Beckmann;
+pub use blend::Blend;
 pub use ggx::Ggx;
+pub use piecewise::{PiecewiseLinear, Profile};
 pub use student::Student;
