@@ -629,3 +629,71 @@ mod tests {
         assert!(Student::general(1.0, 1.0).is_err());
     }
 }
+
+/// The accuracy table of the closing note of issue 2: the max relative error of each Λ route
+/// against the defining integral (test quadrature), over γ, α ∈ {0.05, 0.3, 1} and θ from 0 to
+/// π/2. Run: `cargo test -p mfh-reference --release accuracy_table -- --ignored --nocapture`.
+#[cfg(test)]
+mod accuracy_table {
+    use super::*;
+    use crate::geometry::from_spherical;
+    use crate::ndf::conformance::lambda_integral;
+    use crate::test_support::rel_err;
+    use std::f64::consts::FRAC_PI_2;
+
+    #[test]
+    #[ignore = "prints the accuracy table (about a minute)"]
+    fn accuracy_table() {
+        let gammas = [1.6, 2.0, 2.5, 3.0, 3.5, 4.0, 7.5, 20.0, 100.0, 1e4];
+        let thetas: Vec<f64> = (1..=40)
+            .map(|i| FRAC_PI_2 * i as f64 / 41.0)
+            .chain([1e-3, 1e-2, 1.5707])
+            .collect();
+        println!(
+            "| route | {} |",
+            gammas.map(|g| format!("γ={g}")).join(" | ")
+        );
+        println!("|---|{}", "---|".repeat(gammas.len()));
+        for (route, _) in routes::ROUTES {
+            let mut row = Vec::new();
+            for &g in &gammas {
+                let mut worst: Option<f64> = None;
+                for &a in &[0.05, 0.3, 1.0] {
+                    let m = Student::new(Member::Std, g, a, a).unwrap();
+                    let width = 1.0 / (g - 1.0).max(1.0).sqrt();
+                    // End points are exact by construction in every route.
+                    let ends = [(0.0, 0.0), (FRAC_PI_2, f64::INFINITY)];
+                    for (theta, want) in ends {
+                        if let Ok(v) = m.lambda_route(from_spherical(theta, 0.0), route) {
+                            assert_eq!(v, want, "{route} γ={g} θ={theta}");
+                        }
+                    }
+                    for &theta in &thetas {
+                        let w = from_spherical(theta, 0.0);
+                        let Ok(v) = m.lambda_route(w, route) else {
+                            break;
+                        };
+                        let want = lambda_integral(&m, w, m.sx * width);
+                        if !(want > 1e-300) {
+                            continue;
+                        }
+                        let e = if v.is_finite() {
+                            rel_err(v, want)
+                        } else {
+                            f64::INFINITY
+                        };
+                        if *route == "stable" && e > 1e-12 {
+                            eprintln!("stable γ={g} α={a} θ={theta}: {v:e} vs {want:e} ({e:.1e})");
+                        }
+                        worst = Some(worst.unwrap_or(0.0).max(e));
+                    }
+                }
+                row.push(match worst {
+                    Some(e) => format!("{e:.1e}"),
+                    None => "—".to_string(),
+                });
+            }
+            println!("| `{route}` | {} |", row.join(" | "));
+        }
+    }
+}
