@@ -647,7 +647,7 @@ mod accuracy_table {
         let gammas = [1.6, 2.0, 2.5, 3.0, 3.5, 4.0, 7.5, 20.0, 100.0, 1e4];
         let thetas: Vec<f64> = (1..=40)
             .map(|i| FRAC_PI_2 * i as f64 / 41.0)
-            .chain([1e-3, 1e-2, 1.570_7])
+            .chain([1e-3, 1e-2, FRAC_PI_2 - 1e-4])
             .collect();
         println!(
             "| route | {} |",
