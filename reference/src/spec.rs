@@ -88,6 +88,13 @@ pub enum ModelSpec {
         /// C > 1.
         c: f64,
     },
+    /// A Gaussian distribution of slopes N(s̄, Σ) (seed 002, eq 1; slope sign of eq 11).
+    GaussianSlopes {
+        /// The mean slope s̄ = `[s̄x, s̄y]`.
+        mean: [f64; 2],
+        /// The covariance Σ = `[[σx², cxy], [cxy, σy²]]`, symmetric positive definite.
+        cov: [[f64; 2]; 2],
+    },
 }
 
 /// Resolves `alpha` or (`alpha_x`, `alpha_y`) into validated per-axis roughness.
@@ -121,6 +128,7 @@ impl ModelSpec {
             ModelSpec::HyperCauchy { .. } => "hyper_cauchy",
             ModelSpec::StudentFixedVariance { .. } => "student_fixed_variance",
             ModelSpec::StudentGeneral { .. } => "student_general",
+            ModelSpec::GaussianSlopes { .. } => "gaussian_slopes",
         }
     }
 
@@ -180,6 +188,9 @@ impl ModelSpec {
                 }
             }
             ModelSpec::StudentGeneral { b, c } => Box::new(Student::general(b, c)?),
+            ModelSpec::GaussianSlopes { mean, cov } => {
+                Box::new(crate::slopes::GaussianSlopes::new(mean, cov)?)
+            }
         })
     }
 }
