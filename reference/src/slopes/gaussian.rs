@@ -145,6 +145,12 @@ impl GaussianSlopes {
     /// Domain: θ ∈ [0, π/2], both ends included: θ = 0 gives (s̄, Σ) exactly; θ = π/2 is the
     /// limit μ = 0 (D_s ∝ p_s (−s_o)⁺). Only the direction of `w` matters. For w below the
     /// horizon the same formulas give the moments of the facets facing w (w = −z: none, NaN).
+    ///
+    /// Accuracy (unit tests, against 2-D quadrature of the definition with this model's D):
+    /// ≤ 8e-13 for regular Σ with z₀ down to −16, ≤ 5e-13 for correlation ±(1 − 1e-9) and
+    /// variance ratio 1e-8 except at z₀ ≈ −2000 (1.7e-10, where the quadrature's own rounding
+    /// dominates); the mean in units of max(|s̄ᵢ|, σᵢ), variances relative, the covariance as a
+    /// correlation.
     pub fn visible_moments(&self, w: Vec3) -> VisibleMoments {
         visible_core(self.mean, &self.sigma, w).unwrap_or(VisibleMoments {
             mean: [f64::NAN; 2],
