@@ -258,6 +258,23 @@ fn evaluate_quantity(
                 .ok_or_else(|| unsupported(model, quantity))?;
             Ok(number(sampler.pdf_wm(direction(q, "m")?)))
         }
+        "visible_moments" => {
+            let moments = model
+                .as_visible_moments()
+                .ok_or_else(|| unsupported(model, quantity))?;
+            let w = direction(q, "w")?;
+            let v = match route {
+                None => moments.visible_moments(w)?,
+                Some(r) => moments.visible_moments_route(w, r)?,
+            };
+            Ok(json!({
+                "mean": [number(v.mean[0]), number(v.mean[1])],
+                "cov": [
+                    [number(v.cov[0][0]), number(v.cov[0][1])],
+                    [number(v.cov[1][0]), number(v.cov[1][1])]
+                ],
+            }))
+        }
         other => Err(EvalError::Argument(format!(
             "unknown quantity {other:?} (known: d, lambda, g1, g2, p22, p2, slope_moment, \
              variance, excess_kurtosis, sample_wm, pdf_wm)"
@@ -457,5 +474,46 @@ mod tests {
         assert!((d0 - 1.0 / (std::f64::consts::PI * 0.25)).abs() < 1e-15);
         assert_eq!(lines[1]["error"]["kind"], "parse");
         assert_eq!(lines[2]["value"].as_array().unwrap().len(), 3);
+    }
+
+    #[test]
+    fn visible_moments_of_gaussian_slopes() {
+        let model =
+            r#"{"family":"gaussian_slopes","mean":[0.2,-0.1],"cov":[[0.04,0.01],[0.01,0.09]]}"#;
+        let v = value(&format!(
+            r#"{{"model":{model},"quantity":"visible_moments","theta":1.2,"phi":0.5}}"#
+        ));
+        let built: ModelSpec = serde_json::from_str(model).unwrap();
+        let built = built.build().unwrap();
+        let expected = built
+            .as_visible_moments()
+            .unwrap()
+            .visible_moments(from_spherical(1.2, 0.5))
+            .unwrap();
+        assert_eq!(v["mean"][1].as_f64().unwrap(), expected.mean[1]);
+        assert_eq!(v["cov"][0][1].as_f64().unwrap(), expected.cov[0][1]);
+        assert_eq!(v["cov"][1][1].as_f64().unwrap(), expected.cov[1][1]);
+        let printed = value(&format!(
+            r#"{{"model":{model},"quantity":"visible_moments","theta":1.2,"phi":0.5,"route":"pseudocode_printed"}}"#
+        ));
+        assert_ne!(printed["cov"], v["cov"]);
+        assert_eq!(
+            error_kind(&format!(
+                r#"{{"model":{model},"quantity":"visible_moments","theta":2.0}}"#
+            )),
+            "argument"
+        );
+        assert_eq!(
+            error_kind(&format!(
+                r#"{{"model":{model},"quantity":"visible_moments","theta":1.0,"route":"x"}}"#
+            )),
+            "route"
+        );
+        assert_eq!(
+            error_kind(
+                r#"{"model":{"family":"ggx","alpha":0.3},"quantity":"visible_moments","theta":1.0}"#
+            ),
+            "unsupported"
+        );
     }
 }

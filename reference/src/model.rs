@@ -125,6 +125,10 @@ pub trait Model: Ndf {
     fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
         None
     }
+    /// The visible-slope-moments capability (seed 002, D_s), if the model has one.
+    fn as_visible_moments(&self) -> Option<&dyn VisibleSlopeMoments> {
+        None
+    }
 }
 
 /// The roughness along an azimuth for an elliptic slope distribution with scales `(sx, sy)`,
@@ -184,4 +188,39 @@ pub(crate) fn check_alpha(name: &'static str, value: f64) -> Result<f64, crate::
 pub(crate) fn elliptic_direction(sx: f64, sy: f64, u1: f64) -> (f64, f64) {
     let (s, c) = (std::f64::consts::TAU * u1).sin_cos();
     (sx * c, sy * s)
+}
+
+/// The mean and covariance of a two-dimensional slope distribution, e.g. of the visible slopes
+/// D_s (seed 002, eq 19–23, 39–46).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VisibleMoments {
+    /// The mean slope `[s̄x, s̄y]`.
+    pub mean: [f64; 2],
+    /// The covariance `[[σx², cxy], [cxy, σy²]]`.
+    pub cov: [[f64; 2]; 2],
+}
+
+/// Moments of the distribution of visible slopes D_s(s) ∝ p_s(s) ⟨w·m(s)⟩⁺ / m_z(s) (seed 002,
+/// eq 12–13) for a view direction `w`.
+pub trait VisibleSlopeMoments {
+    /// The mean and covariance of D_s seen from `w` by the model's default (most accurate)
+    /// route; `w` must be finite, non-zero and in the upper hemisphere (w_z ≥ 0), otherwise
+    /// `QueryError::Argument`.
+    fn visible_moments(&self, w: Vec3) -> Result<VisibleMoments, QueryError>;
+
+    /// The names of the routes `visible_moments_route` accepts (the first is the default).
+    fn visible_moments_routes(&self) -> Vec<&'static str> {
+        vec!["default"]
+    }
+
+    /// The moments of D_s by a named route (e.g. a source's formulas as printed).
+    fn visible_moments_route(&self, w: Vec3, route: &str) -> Result<VisibleMoments, QueryError> {
+        match route {
+            "default" => self.visible_moments(w),
+            _ => Err(QueryError::Route {
+                route: route.to_string(),
+                reason: format!("known routes: {}", self.visible_moments_routes().join(", ")),
+            }),
+        }
+    }
 }

@@ -103,6 +103,13 @@ pub enum ModelSpec {
         /// The model along y.
         y: Box<ModelSpec>,
     },
+    /// A Gaussian distribution of slopes N(s̄, Σ) (seed 002, eq 1; slope sign of eq 11).
+    GaussianSlopes {
+        /// The mean slope s̄ = `[s̄x, s̄y]`.
+        mean: [f64; 2],
+        /// The covariance Σ = `[[σx², cxy], [cxy, σy²]]`, symmetric positive definite.
+        cov: [[f64; 2]; 2],
+    },
 }
 
 /// Resolves `alpha` or (`alpha_x`, `alpha_y`) into validated per-axis roughness.
@@ -138,6 +145,7 @@ impl ModelSpec {
             ModelSpec::StudentGeneral { .. } => "student_general",
             ModelSpec::PiecewiseLinear { .. } => "piecewise_linear",
             ModelSpec::Blend { .. } => "blend",
+            ModelSpec::GaussianSlopes { .. } => "gaussian_slopes",
         }
     }
 
@@ -201,6 +209,9 @@ impl ModelSpec {
                 Box::new(PiecewiseLinear::new(x.clone(), y.clone())?)
             }
             ModelSpec::Blend { ref x, ref y } => Box::new(Blend::new(x.build()?, y.build()?)?),
+            ModelSpec::GaussianSlopes { mean, cov } => {
+                Box::new(crate::slopes::GaussianSlopes::new(mean, cov)?)
+            }
         })
     }
 }

@@ -28,6 +28,15 @@ pub fn normalization(d: &dyn Fn(Vec3) -> f64, radial_scale: &dyn Fn(f64) -> f64)
         .sum()
 }
 
+/// ∫ D(m) (m·n) dm for an isotropic D: 2π times the radial integral at φ = 0.
+pub fn normalization_isotropic(d: &dyn Fn(Vec3) -> f64, radial_scale: f64) -> f64 {
+    let f = |r: f64| {
+        let z = 1.0 / (1.0 + r * r).sqrt();
+        d([r * z, 0.0, z]) * r * z.powi(4)
+    };
+    2.0 * PI * integrate_tail(&f, 0.0, radial_scale, 1e-13)
+}
+
 /// P2(q) along azimuth φ as the marginal ∫ P22 dp of the rotated slope (q along φ, p across).
 pub fn p2_marginal(slopes: &dyn SlopeDistribution, q: f64, phi: f64, scale: f64) -> f64 {
     let (s, c) = phi.sin_cos();

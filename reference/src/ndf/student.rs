@@ -343,7 +343,15 @@ mod tests {
     fn normalized_over_the_hemisphere() {
         let mut worst: f64 = 0.0;
         for m in members() {
-            let n = conformance::normalization(&|w| m.d(w), &radial_scale(&m));
+            // The 2-D integral of the anisotropic members costs ~1 s each: a subset of γ.
+            if m.sx != m.sy && ![1.2, 2.5, 1e8].contains(&m.c) {
+                continue;
+            }
+            let n = if m.sx == m.sy {
+                conformance::normalization_isotropic(&|w| m.d(w), radial_scale(&m)(0.0))
+            } else {
+                conformance::normalization(&|w| m.d(w), &radial_scale(&m))
+            };
             let e = (n - 1.0).abs();
             assert!(e < 1e-10, "{:?}: ∫ D cos θ dω = {n}", m.spec());
             worst = worst.max(e);
