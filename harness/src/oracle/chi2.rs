@@ -1,0 +1,1 @@
+//! Chi-square goodness-of-fit test of normal samplers (in progress).
