@@ -81,13 +81,24 @@ fn product_rule(f: &impl Fn(f64, f64) -> f64, x: [f64; 2], y: [f64; 2]) -> (f64,
     (k, (k - g).abs())
 }
 
+/// The accuracy asked of [`integrate_rectangle`]: the larger of an absolute error and a
+/// relative error (relative to the first K15 × K15 estimate of the whole rectangle).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerance {
+    /// Absolute error.
+    pub absolute: f64,
+    /// Relative error.
+    pub relative: f64,
+}
+
 /// ∫∫ f(x, y) dy dx over [x0, x1] × [y0, y1], bisecting into quadrants until the error
-/// estimate of each piece is at most its share of `tolerance` (absolute), or [`MAX_DEPTH`].
+/// estimate of each piece is at most its share of the tolerance, or [`MAX_DEPTH`] is reached
+/// (the returned error then still sums the estimates, so it stays honest).
 pub fn integrate_rectangle(
     f: &impl Fn(f64, f64) -> f64,
     x: [f64; 2],
     y: [f64; 2],
-    tolerance: f64,
+    tolerance: Tolerance,
 ) -> Estimate {
     fn go(
         f: &impl Fn(f64, f64) -> f64,
@@ -122,29 +133,45 @@ pub fn integrate_rectangle(
         out = sum;
         out
     }
-    go(f, x, y, tolerance, 0, None)
+    let whole = product_rule(f, x, y);
+    let tol = tolerance.absolute.max(tolerance.relative * whole.0.abs());
+    let mut e = go(f, x, y, tol, 0, Some(whole));
+    e.evaluations += 225;
+    e
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn abs(t: f64) -> Tolerance {
+        Tolerance {
+            absolute: t,
+            relative: 0.0,
+        }
+    }
+
     #[test]
     fn polynomials_and_a_peak() {
-        let e = integrate_rectangle(&|x, y| x.powi(5) * y.powi(3), [0.0, 2.0], [1.0, 3.0], 1e-12);
+        let e = integrate_rectangle(
+            &|x, y| x.powi(5) * y.powi(3),
+            [0.0, 2.0],
+            [1.0, 3.0],
+            abs(1e-12),
+        );
         assert!((e.value - 64.0 / 6.0 * 20.0).abs() < 1e-11, "{e:?}");
         assert_eq!(e.evaluations, 225);
         let f = |x: f64, y: f64| 1.0 / (1e-3 + x * x + y * y);
         // ∫∫ over [−1,1]² of 1/(ε + r²): reference from the polar split, checked by refinement.
-        let e = integrate_rectangle(&f, [-1.0, 1.0], [-1.0, 1.0], 1e-9);
-        let fine = integrate_rectangle(&f, [-1.0, 1.0], [-1.0, 1.0], 1e-12);
+        let e = integrate_rectangle(&f, [-1.0, 1.0], [-1.0, 1.0], abs(1e-9));
+        let fine = integrate_rectangle(&f, [-1.0, 1.0], [-1.0, 1.0], abs(1e-12));
         assert!(e.evaluations > 225);
         assert!(
             (e.value - fine.value).abs() <= e.error.max(1e-9),
             "{e:?} {fine:?}"
         );
         let g = |x: f64, y: f64| (x + 2.0 * y).exp();
-        let e = integrate_rectangle(&g, [0.0, 1.0], [0.0, 1.0], 1e-13);
+        let e = integrate_rectangle(&g, [0.0, 1.0], [0.0, 1.0], abs(1e-13));
         let exact = (1f64.exp() - 1.0) * (2f64.exp() - 1.0) / 2.0;
         assert!((e.value - exact).abs() < 1e-13, "{e:?}");
     }
