@@ -31,6 +31,33 @@ pub enum Command {
         #[arg(long)]
         input: Option<PathBuf>,
     },
+    /// Chi-square test of a model's normal sampler (sample_wm) against its pdf (pdf_wm) over
+    /// a grid of R cos θ-rows × 2R φ-columns of the upper hemisphere.
+    ///
+    /// Exit status 0 if the test passes, 1 if it fails, 2 on bad input.
+    Chi2 {
+        /// The model spec as JSON text, e.g. '{"family":"ggx","alpha":0.3}'.
+        #[arg(long)]
+        model: String,
+        /// Samples to draw.
+        #[arg(long, default_value_t = 1_000_000)]
+        samples: u64,
+        /// Grid resolution R: R cos θ-rows × 2R φ-columns.
+        #[arg(long, default_value_t = 32)]
+        resolution: usize,
+        /// Seed of the random streams (default: MFH_SEED, else a fixed seed).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Significance level.
+        #[arg(long, default_value_t = 1e-4)]
+        alpha: f64,
+        /// Print one JSON object.
+        #[arg(long)]
+        json: bool,
+        /// Write observed and expected count tables (JSON) into this folder.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 /// Runs the command line `args` (including the program name) with the given streams and
@@ -59,6 +86,27 @@ where
         }
     };
     match cli.command {
+        Command::Chi2 {
+            model,
+            samples,
+            resolution,
+            seed,
+            alpha,
+            json,
+            out,
+        } => crate::chi2_command::run_chi2(
+            &crate::chi2_command::Chi2Options {
+                model,
+                samples,
+                resolution,
+                seed,
+                alpha,
+                json,
+                out,
+            },
+            stdout,
+            stderr,
+        ),
         Command::Eval { input } => {
             let result = match input {
                 Some(path) => match std::fs::File::open(&path) {
@@ -86,5 +134,113 @@ where
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run_args(args: &[&str]) -> (i32, String, String) {
+        let (mut out, mut err) = (Vec::new(), Vec::new());
+        let code = run(
+            std::iter::once("mfh").chain(args.iter().copied()),
+            &mut std::io::empty(),
+            &mut out,
+            &mut err,
+        );
+        (
+            code,
+            String::from_utf8(out).unwrap(),
+            String::from_utf8(err).unwrap(),
+        )
+    }
+
+    #[test]
+    fn chi2_cli_json_pass_and_tables() {
+        let dir = std::env::temp_dir().join(format!("mfh-chi2-cli-{}", std::process::id()));
+        let (code, out, err) = run_args(&[
+            "chi2",
+            "--model",
+            r#"{"family":"ggx","alpha":0.3}"#,
+            "--samples",
+            "200000",
+            "--resolution",
+            "8",
+            "--seed",
+            "3",
+            "--json",
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{out}{err}");
+        let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+        assert_eq!(v["verdict"], "pass");
+        assert_eq!(v["samples"], 200000);
+        assert_eq!(v["dof"], 127);
+        for key in [
+            "statistic",
+            "p_value",
+            "samples_per_second",
+            "pooled_cells",
+            "expected_mass",
+            "expected_error_bound",
+            "integration_seconds",
+        ] {
+            assert!(v[key].is_number(), "{key}: {v}");
+        }
+        let table: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("chi2_observed.json")).unwrap())
+                .unwrap();
+        assert_eq!(table["counts"].as_array().unwrap().len(), 8);
+        assert_eq!(table["counts"][0].as_array().unwrap().len(), 16);
+        assert!(dir.join("chi2_expected.json").exists());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn chi2_cli_text_and_bad_input() {
+        let (code, out, _) = run_args(&[
+            "chi2",
+            "--model",
+            r#"{"family":"beckmann","alpha":0.5}"#,
+            "--samples",
+            "100000",
+            "--resolution",
+            "5",
+        ]);
+        assert_eq!(code, 0, "{out}");
+        assert!(
+            out.contains("verdict pass") && out.contains("samples/s"),
+            "{out}"
+        );
+        assert!(out.contains("reproduce: mfh chi2"), "{out}");
+        let (code, _, err) = run_args(&["chi2", "--model", "{\"family\":\"ggx\"}"]);
+        assert_eq!(code, 2, "{err}");
+        let blend = r#"{"family":"blend","x":{"family":"ggx","alpha":0.3},"y":{"family":"beckmann","alpha":0.2}}"#;
+        let (code, _, err) = run_args(&["chi2", "--model", blend]);
+        assert_eq!(code, 2);
+        assert!(err.contains("no normal sampler"), "{err}");
+        let (code, out, _) = run_args(&[
+            "chi2",
+            "--model",
+            r#"{"family":"ggx","alpha":0.3}"#,
+            "--samples",
+            "1",
+            "--resolution",
+            "1",
+        ]);
+        assert_eq!(code, 1, "{out}");
+        assert!(out.contains("verdict FAIL") && out.contains("bin"), "{out}");
+        let (code, _, _) = run_args(&["chi2", "--model", "not json"]);
+        assert_eq!(code, 2);
+        let (code, _, _) = run_args(&[
+            "chi2",
+            "--model",
+            r#"{"family":"ggx","alpha":0.3}"#,
+            "--resolution",
+            "0",
+        ]);
+        assert_eq!(code, 2);
     }
 }

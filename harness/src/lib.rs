@@ -3,5 +3,7 @@
 //!
 //! The binary `mfh` is a thin layer over [`cli::run`].
 
+pub mod chi2_command;
 pub mod cli;
 pub mod eval;
+pub mod oracle;

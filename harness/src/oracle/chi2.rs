@@ -1,0 +1,627 @@
+//! Chi-square goodness-of-fit test of a normal sampler against its pdf over the (φ, cos θ)
+//! grid of the upper hemisphere (DESIGN.md, "Checks and records").
+//!
+//! Procedure:
+//!
+//! 1. **Observed counts.** `samples` normals are drawn with `u` from a PCG64 stream per fixed
+//!    chunk of [`CHUNK`] sample indices, seeded from (seed, chunk index) through SplitMix64, and
+//!    binned into the [`HemisphereGrid`] of the given resolution (R z-rows × 2R φ-columns) in
+//!    parallel (rayon). Counts are integers summed per chunk, so they are identical whatever
+//!    the thread count or scheduling.
+//! 2. **Expected counts.** The pdf is integrated over every cell in (φ, z = cos θ) (dω = dφ dz)
+//!    by adaptive G7/K15 product cubature ([`crate::oracle::cubature`]) with a per-cell error
+//!    bound; the total mass and the summed error bound are reported.
+//! 3. **Sanity failures first** (no p-value): a sample outside the domain (non-finite, non-unit,
+//!    below the horizon), a total pdf mass off from 1 by more than [`MASS_TOLERANCE`], a
+//!    non-finite or negative cell mass, a sample in a cell of zero expected count.
+//! 4. **Pooling.** Cells with expected count < [`MIN_EXPECTED`] are pooled into one bin; if that
+//!    bin's expected count is itself < [`MIN_EXPECTED`], it is merged into the regular bin of
+//!    least expected count (so a remainder of, say, 0.01 expected cannot dominate the
+//!    statistic). dof = bins − 1.
+//! 5. **p-value** Q(dof/2, χ²/2), the upper regularized incomplete gamma function (accurate in
+//!    the far tail, unlike 1 − CDF); the test rejects when p < α.
+
+use crate::oracle::cubature::{integrate_rectangle, Tolerance};
+use crate::oracle::domain::{DomainError, HemisphereGrid};
+use mfh_reference::geometry::Vec3;
+use mfh_reference::NormalSampler;
+use rand_core::{RngCore, SeedableRng};
+use rand_pcg::Pcg64;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Samples per random stream: the unit of work and of seeding.
+pub const CHUNK: u64 = 1 << 16;
+/// Cells with fewer expected samples than this are pooled.
+pub const MIN_EXPECTED: f64 = 5.0;
+/// How far the integrated pdf mass over the hemisphere may be from 1.
+pub const MASS_TOLERANCE: f64 = 1e-3;
+/// The default seed of the test (overridable everywhere a seed is taken).
+pub const DEFAULT_SEED: u64 = 0x6d66_6800_0000_0001;
+/// Per-cell relative tolerance of the expected-mass cubature.
+pub const CELL_RELATIVE_TOLERANCE: f64 = 1e-9;
+/// Per-cell absolute tolerance of the expected-mass cubature.
+pub const CELL_ABSOLUTE_TOLERANCE: f64 = 1e-14;
+
+/// The parameters of one chi-square test.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Chi2Config {
+    /// R: the grid has R z-rows and 2R φ-columns.
+    pub resolution: usize,
+    /// The number of samples drawn.
+    pub samples: u64,
+    /// The seed of the random streams.
+    pub seed: u64,
+    /// The significance level: the test fails when p < `alpha`.
+    pub alpha: f64,
+}
+
+impl Default for Chi2Config {
+    fn default() -> Self {
+        Self {
+            resolution: 32,
+            samples: 1_000_000,
+            seed: DEFAULT_SEED,
+            alpha: 1e-4,
+        }
+    }
+}
+
+/// The Šidák-corrected level for each of `k` independent tests so that the family-wise level
+/// is `alpha`: 1 − (1 − α)^{1/k} (computed as −expm1(ln(1 − α)/k), exact for small α).
+pub fn sidak_alpha(alpha: f64, k: usize) -> f64 {
+    if k <= 1 {
+        return alpha;
+    }
+    -((-alpha).ln_1p() / k as f64).exp_m1()
+}
+
+/// The outcome of a test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// Consistent with the pdf at level α.
+    Pass,
+    /// A sanity failure, or p < α.
+    Fail,
+}
+
+/// Why a test failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Failure {
+    /// A sample lies outside the upper hemisphere; `index` is the first such sample.
+    #[error("{count} samples outside the domain; the first, sample {index}: {error}")]
+    OutsideDomain {
+        /// Index of the first offending sample (in the seeded sequence).
+        index: u64,
+        /// What is wrong with it.
+        error: DomainError,
+        /// How many samples were outside.
+        count: u64,
+    },
+    /// The pdf does not integrate to 1 over the hemisphere.
+    #[error("pdf mass {mass} (± {error_bound:.1e}) differs from 1 by more than {tolerance}")]
+    MassOff {
+        /// The integrated mass.
+        mass: f64,
+        /// Its error bound.
+        error_bound: f64,
+        /// The allowed difference.
+        tolerance: f64,
+    },
+    /// The pdf integrates to a negative or non-finite mass over a cell.
+    #[error("pdf mass over cell {cell} is {mass}")]
+    InvalidMass {
+        /// The cell (row-major, row 0 at the horizon).
+        cell: usize,
+        /// Its mass.
+        mass: f64,
+    },
+    /// Samples landed in a cell where the pdf is zero.
+    #[error("{observed} samples in cell {cell}, where the pdf is zero")]
+    ZeroPdfCell {
+        /// The first such cell.
+        cell: usize,
+        /// The samples in it.
+        observed: u64,
+    },
+    /// Fewer than two bins after pooling: nothing to test.
+    #[error("only {bins} bin(s) after pooling; more samples or a finer grid are needed")]
+    TooFewBins {
+        /// Bins after pooling.
+        bins: usize,
+    },
+    /// The distribution of samples differs from the pdf.
+    #[error("p-value {p_value:.3e} below α = {alpha:.3e}")]
+    Rejected {
+        /// The p-value.
+        p_value: f64,
+        /// The level.
+        alpha: f64,
+    },
+}
+
+/// Observed counts per cell, with the samples that fell outside the domain.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observed {
+    /// Counts per cell (row-major, row 0 at the horizon).
+    pub counts: Vec<u64>,
+    /// Samples outside the domain.
+    pub outside: u64,
+    /// The first sample outside the domain (lowest index) and why.
+    pub first_outside: Option<(u64, DomainError)>,
+}
+
+impl Observed {
+    fn zero(cells: usize) -> Self {
+        Self {
+            counts: vec![0; cells],
+            outside: 0,
+            first_outside: None,
+        }
+    }
+
+    fn merge(mut self, other: Self) -> Self {
+        for (a, b) in self.counts.iter_mut().zip(&other.counts) {
+            *a += b;
+        }
+        self.outside += other.outside;
+        self.first_outside = match (self.first_outside, other.first_outside) {
+            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
+            (a, b) => a.or(b),
+        };
+        self
+    }
+}
+
+/// The expected probability mass per cell.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Expected {
+    /// Mass per cell (row-major, row 0 at the horizon).
+    pub mass: Vec<f64>,
+    /// The total mass (the pdf's integral over the hemisphere).
+    pub total: f64,
+    /// The sum of the per-cell error bounds of the cubature.
+    pub error_bound: f64,
+    /// Pdf evaluations spent.
+    pub evaluations: u64,
+}
+
+/// SplitMix64's finalizer: a bijective mix of 64 bits.
+#[inline]
+pub fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// The random stream of chunk `chunk` under `seed`.
+pub fn stream(seed: u64, chunk: u64) -> Pcg64 {
+    Pcg64::seed_from_u64(splitmix64(splitmix64(seed) ^ chunk))
+}
+
+/// A uniform number in [0, 1) with 53 random bits.
+#[inline]
+fn uniform(rng: &mut Pcg64) -> f64 {
+    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// Draws `samples` normals with `sample` and bins them into `grid`, in parallel, with a result
+/// independent of the thread count.
+pub fn observe<S>(sample: &S, grid: HemisphereGrid, samples: u64, seed: u64) -> Observed
+where
+    S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
+{
+    let chunks = samples.div_ceil(CHUNK);
+    (0..chunks)
+        .into_par_iter()
+        .fold(
+            || Observed::zero(grid.cells()),
+            |mut acc, chunk| {
+                let mut rng = stream(seed, chunk);
+                let start = chunk * CHUNK;
+                let end = (start + CHUNK).min(samples);
+                for index in start..end {
+                    let u = [uniform(&mut rng), uniform(&mut rng)];
+                    match grid.cell_of(sample(u)) {
+                        Ok(cell) => acc.counts[cell] += 1,
+                        Err(error) => {
+                            acc.outside += 1;
+                            if acc.first_outside.is_none_or(|(i, _)| index < i) {
+                                acc.first_outside = Some((index, error));
+                            }
+                        }
+                    }
+                }
+                acc
+            },
+        )
+        .reduce(|| Observed::zero(grid.cells()), Observed::merge)
+}
+
+/// Integrates `pdf` (a density with respect to solid angle) over every cell of `grid`.
+pub fn expected_mass<P>(pdf: &P, grid: HemisphereGrid) -> Expected
+where
+    P: Fn(Vec3) -> f64 + Sync + ?Sized,
+{
+    let tolerance = Tolerance {
+        absolute: CELL_ABSOLUTE_TOLERANCE,
+        relative: CELL_RELATIVE_TOLERANCE,
+    };
+    let estimates: Vec<_> = (0..grid.cells())
+        .into_par_iter()
+        .map(|i| {
+            let cell = grid.cell(i);
+            let f = |phi: f64, z: f64| pdf(HemisphereGrid::direction(phi, z));
+            integrate_rectangle(&f, cell.phi, cell.z, tolerance)
+        })
+        .collect();
+    Expected {
+        mass: estimates.iter().map(|e| e.value).collect(),
+        total: estimates.iter().map(|e| e.value).sum(),
+        error_bound: estimates.iter().map(|e| e.error).sum(),
+        evaluations: estimates.iter().map(|e| e.evaluations).sum(),
+    }
+}
+
+/// The result of a chi-square test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Chi2Result {
+    /// The grid resolution R (R z-rows × 2R φ-columns).
+    pub resolution: usize,
+    /// The χ² statistic (NaN after a sanity failure).
+    pub statistic: f64,
+    /// Degrees of freedom: bins − 1 (0 after a sanity failure).
+    pub dof: usize,
+    /// Q(dof/2, χ²/2) (0 after a sanity failure).
+    pub p_value: f64,
+    /// The level the verdict was taken at.
+    pub alpha: f64,
+    /// Cells pooled because their expected count was < [`MIN_EXPECTED`].
+    pub pooled_cells: usize,
+    /// Samples drawn.
+    pub samples: u64,
+    /// The seed of the random streams.
+    pub seed: u64,
+    /// Pass or fail.
+    pub verdict: Verdict,
+    /// Why it failed, if it did.
+    pub reason: Option<Failure>,
+    /// The integrated pdf mass over the hemisphere.
+    pub expected_mass: f64,
+    /// The error bound of the expected counts (mass bound × samples).
+    pub expected_error_bound: f64,
+    /// Wall time of sampling and binning, seconds.
+    pub sampling_seconds: f64,
+    /// Wall time of the expected-count integration, seconds.
+    pub integration_seconds: f64,
+    /// Observed counts per cell (row-major, row 0 at the horizon).
+    pub observed: Vec<u64>,
+    /// Expected counts per cell (mass × samples).
+    pub expected: Vec<f64>,
+}
+
+impl Chi2Result {
+    /// Samples per second of sampling and binning.
+    pub fn samples_per_second(&self) -> f64 {
+        self.samples as f64 / self.sampling_seconds
+    }
+}
+
+/// Tests the sampler `sample` against the density `pdf` (with respect to solid angle).
+/// `config.resolution` of 0 is treated as 1.
+pub fn chi2_test<S, P>(sample: &S, pdf: &P, config: &Chi2Config) -> Chi2Result
+where
+    S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
+    P: Fn(Vec3) -> f64 + Sync + ?Sized,
+{
+    let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
+    let t = Instant::now();
+    let observed = observe(sample, grid, config.samples, config.seed);
+    let sampling_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let expected = expected_mass(pdf, grid);
+    let integration_seconds = t.elapsed().as_secs_f64();
+    let n = config.samples as f64;
+    let mut result = Chi2Result {
+        resolution: grid.rows(),
+        statistic: f64::NAN,
+        dof: 0,
+        p_value: 0.0,
+        alpha: config.alpha,
+        pooled_cells: 0,
+        samples: config.samples,
+        seed: config.seed,
+        verdict: Verdict::Fail,
+        reason: None,
+        expected_mass: expected.total,
+        expected_error_bound: expected.error_bound * n,
+        sampling_seconds,
+        integration_seconds,
+        expected: expected.mass.iter().map(|m| m * n).collect(),
+        observed: observed.counts,
+    };
+    result.reason = sanity(&result, &expected, observed.outside, observed.first_outside);
+    if result.reason.is_some() {
+        return result;
+    }
+    let (statistic, bins, pooled) = pooled_statistic(&result.observed, &result.expected);
+    result.pooled_cells = pooled;
+    if bins < 2 {
+        result.reason = Some(Failure::TooFewBins { bins });
+        return result;
+    }
+    result.statistic = statistic;
+    result.dof = bins - 1;
+    result.p_value =
+        statrs::function::gamma::checked_gamma_ur(0.5 * result.dof as f64, 0.5 * statistic)
+            .unwrap_or(f64::NAN);
+    if result.p_value >= config.alpha {
+        result.verdict = Verdict::Pass;
+    } else {
+        result.reason = Some(Failure::Rejected {
+            p_value: result.p_value,
+            alpha: config.alpha,
+        });
+    }
+    result
+}
+
+/// Tests a model's `sample_wm` against its own `pdf_wm`.
+pub fn chi2_test_sampler(sampler: &dyn NormalSampler, config: &Chi2Config) -> Chi2Result {
+    chi2_test(&|u| sampler.sample_wm(u), &|m| sampler.pdf_wm(m), config)
+}
+
+/// The sanity failures, in order: samples outside the domain, invalid or off mass, samples in
+/// zero-pdf cells.
+fn sanity(
+    result: &Chi2Result,
+    expected: &Expected,
+    outside: u64,
+    first_outside: Option<(u64, DomainError)>,
+) -> Option<Failure> {
+    if let Some((index, error)) = first_outside {
+        return Some(Failure::OutsideDomain {
+            index,
+            error,
+            count: outside,
+        });
+    }
+    if let Some((cell, &mass)) = expected
+        .mass
+        .iter()
+        .enumerate()
+        .find(|(_, m)| !(m.is_finite() && **m >= 0.0))
+    {
+        return Some(Failure::InvalidMass { cell, mass });
+    }
+    if !((expected.total - 1.0).abs() <= MASS_TOLERANCE) {
+        return Some(Failure::MassOff {
+            mass: expected.total,
+            error_bound: expected.error_bound,
+            tolerance: MASS_TOLERANCE,
+        });
+    }
+    result
+        .observed
+        .iter()
+        .zip(&expected.mass)
+        .enumerate()
+        .find(|(_, (&o, &m))| m == 0.0 && o > 0)
+        .map(|(cell, (&observed, _))| Failure::ZeroPdfCell { cell, observed })
+}
+
+/// Σ (O − E)² / E over the pooled bins; returns (statistic, bins, pooled cells).
+fn pooled_statistic(observed: &[u64], expected: &[f64]) -> (f64, usize, usize) {
+    let mut bins: Vec<(f64, f64)> = Vec::with_capacity(expected.len());
+    let (mut pool_o, mut pool_e, mut pooled) = (0.0, 0.0, 0);
+    for (&o, &e) in observed.iter().zip(expected) {
+        if e < MIN_EXPECTED {
+            pool_o += o as f64;
+            pool_e += e;
+            pooled += 1;
+        } else {
+            bins.push((o as f64, e));
+        }
+    }
+    if pool_e >= MIN_EXPECTED || (bins.is_empty() && pool_e > 0.0) {
+        bins.push((pool_o, pool_e));
+    } else if pool_e > 0.0 {
+        let smallest = bins
+            .iter_mut()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("bins is not empty");
+        smallest.0 += pool_o;
+        smallest.1 += pool_e;
+    }
+    let statistic = bins.iter().map(|(o, e)| (o - e) * (o - e) / e).sum();
+    (statistic, bins.len(), pooled)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mfh_reference::{Model, ModelSpec};
+
+    fn model(json: &str) -> Box<dyn Model> {
+        serde_json::from_str::<ModelSpec>(json)
+            .unwrap()
+            .build()
+            .unwrap()
+    }
+
+    fn config() -> Chi2Config {
+        Chi2Config {
+            resolution: 16,
+            samples: 1_000_000,
+            seed: 7,
+            alpha: 1e-4,
+        }
+    }
+
+    fn assert_passes(json: &str) -> Chi2Result {
+        let m = model(json);
+        let r = chi2_test_sampler(m.as_sampler().unwrap(), &config());
+        eprintln!(
+            "{json}: χ² = {:.1}, dof = {}, p = {:.4}, pooled = {}, mass = {} ± {:.1e} counts, \
+             {:.3e} samples/s, integration {:.3} s",
+            r.statistic,
+            r.dof,
+            r.p_value,
+            r.pooled_cells,
+            r.expected_mass,
+            r.expected_error_bound,
+            r.samples_per_second(),
+            r.integration_seconds
+        );
+        assert_eq!(r.verdict, Verdict::Pass, "{:?}", r.reason);
+        assert!(r.p_value > 1e-4);
+        assert!((r.expected_mass - 1.0).abs() < 1e-6);
+        assert!(r.expected_error_bound < 1e-2);
+        assert_eq!(r.observed.iter().sum::<u64>(), r.samples);
+        r
+    }
+
+    #[test]
+    fn chi2_ggx_passes() {
+        assert_passes(r#"{"family":"ggx","alpha":0.3}"#);
+    }
+
+    #[test]
+    fn chi2_beckmann_passes() {
+        assert_passes(r#"{"family":"beckmann","alpha":0.3}"#);
+    }
+
+    #[test]
+    fn chi2_std_anisotropic_passes() {
+        assert_passes(r#"{"family":"std","gamma":2.5,"alpha_x":0.1,"alpha_y":0.4}"#);
+    }
+
+    #[test]
+    fn chi2_wrong_roughness_fails() {
+        let sampler = model(r#"{"family":"ggx","alpha":0.3}"#);
+        let pdf = model(r#"{"family":"ggx","alpha":0.33}"#);
+        let (s, p) = (sampler.as_sampler().unwrap(), pdf.as_sampler().unwrap());
+        let r = chi2_test(&|u| s.sample_wm(u), &|m| p.pdf_wm(m), &config());
+        assert_eq!(r.verdict, Verdict::Fail);
+        assert!(r.p_value < 1e-12, "{r:?}");
+        assert!(matches!(r.reason, Some(Failure::Rejected { .. })));
+    }
+
+    #[test]
+    fn chi2_printed_half_azimuth_sampler_fails() {
+        let m = mfh_reference::ndf::Student::new(
+            mfh_reference::ndf::student::Member::Std,
+            2.5,
+            0.1,
+            0.4,
+        )
+        .unwrap();
+        let r = chi2_test(
+            &|u| m.sample_wm_printed(u),
+            &|w| m.pdf_wm(w),
+            &Chi2Config {
+                samples: 200_000,
+                ..config()
+            },
+        );
+        assert_eq!(r.verdict, Verdict::Fail);
+        assert_eq!(r.p_value, 0.0);
+        assert!(matches!(r.reason, Some(Failure::Rejected { .. })));
+    }
+
+    #[test]
+    fn chi2_below_horizon_is_a_sanity_failure() {
+        let m = model(r#"{"family":"ggx","alpha":0.3}"#);
+        let s = m.as_sampler().unwrap();
+        let sample = |u: [f64; 2]| {
+            let w = s.sample_wm(u);
+            if u[0] < 0.01 {
+                [w[0], w[1], -w[2]]
+            } else {
+                w
+            }
+        };
+        let r = chi2_test(&sample, &|w| s.pdf_wm(w), &config());
+        assert_eq!(r.verdict, Verdict::Fail);
+        match r.reason {
+            Some(Failure::OutsideDomain {
+                error: DomainError::BelowHorizon(_),
+                count,
+                ..
+            }) => assert!((5_000..15_000).contains(&count), "{count}"),
+            other => panic!("{other:?}"),
+        }
+        let nan = chi2_test(&|_| [f64::NAN; 3], &|w| s.pdf_wm(w), &config());
+        assert!(matches!(
+            nan.reason,
+            Some(Failure::OutsideDomain {
+                index: 0,
+                error: DomainError::NotFinite(_),
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn chi2_mass_and_zero_pdf_sanity_failures() {
+        let m = model(r#"{"family":"ggx","alpha":0.3}"#);
+        let s = m.as_sampler().unwrap();
+        let cfg = Chi2Config {
+            samples: 10_000,
+            ..config()
+        };
+        let half = chi2_test(&|u| s.sample_wm(u), &|w| 0.5 * s.pdf_wm(w), &cfg);
+        assert!(
+            matches!(half.reason, Some(Failure::MassOff { .. })),
+            "{:?}",
+            half.reason
+        );
+        // A pdf that is zero for m_x < 0, renormalized: the sampler still puts samples there.
+        let right = chi2_test(
+            &|u| s.sample_wm(u),
+            &|w| if w[0] > 0.0 { 2.0 * s.pdf_wm(w) } else { 0.0 },
+            &cfg,
+        );
+        assert!(
+            matches!(right.reason, Some(Failure::ZeroPdfCell { .. })),
+            "{:?}",
+            right.reason
+        );
+    }
+
+    #[test]
+    fn chi2_counts_do_not_depend_on_thread_count() {
+        let m = model(r#"{"family":"std","gamma":2.5,"alpha_x":0.1,"alpha_y":0.4}"#);
+        let s = m.as_sampler().unwrap();
+        let grid = HemisphereGrid::new(8).unwrap();
+        let run = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| observe(&|u| s.sample_wm(u), grid, 5 * CHUNK + 123, 99))
+        };
+        let one = run(1);
+        let two = run(2);
+        assert_eq!(one, two);
+        assert_eq!(one.counts.iter().sum::<u64>(), 5 * CHUNK + 123);
+        assert_ne!(
+            one,
+            observe(&|u| s.sample_wm(u), grid, 5 * CHUNK + 123, 100)
+        );
+    }
+
+    #[test]
+    fn chi2_sidak_and_pooling() {
+        assert_eq!(sidak_alpha(0.01, 1), 0.01);
+        let a = sidak_alpha(0.01, 10);
+        assert!((1.0 - (1.0 - a).powi(10) - 0.01).abs() < 1e-15);
+        // Two regular bins and a pooled remainder of 3 expected merged into the smaller bin.
+        let (stat, bins, pooled) = pooled_statistic(&[10, 20, 1, 2], &[10.0, 20.0, 1.0, 2.0]);
+        assert_eq!((stat, bins, pooled), (0.0, 2, 2));
+        let (stat, bins, pooled) = pooled_statistic(&[10, 20, 3, 3], &[10.0, 20.0, 3.0, 3.0]);
+        assert_eq!((stat, bins, pooled), (0.0, 3, 2));
+    }
+}
