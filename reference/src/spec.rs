@@ -110,6 +110,13 @@ pub enum ModelSpec {
         /// The covariance Σ = `[[σx², cxy], [cxy, σy²]]`, symmetric positive definite.
         cov: [[f64; 2]; 2],
     },
+    /// Generalized-Trowbridge-Reitz (Burley 2012; Smith G1 of seed 004), isotropic.
+    Gtr {
+        /// Shape 0 ≤ γ ≤ 10.
+        gamma: f64,
+        /// Roughness 1e-4 ≤ α ≤ 1.
+        alpha: f64,
+    },
 }
 
 /// Resolves `alpha` or (`alpha_x`, `alpha_y`) into validated per-axis roughness.
@@ -146,6 +153,7 @@ impl ModelSpec {
             ModelSpec::PiecewiseLinear { .. } => "piecewise_linear",
             ModelSpec::Blend { .. } => "blend",
             ModelSpec::GaussianSlopes { .. } => "gaussian_slopes",
+            ModelSpec::Gtr { .. } => "gtr",
         }
     }
 
@@ -212,6 +220,7 @@ impl ModelSpec {
             ModelSpec::GaussianSlopes { mean, cov } => {
                 Box::new(crate::slopes::GaussianSlopes::new(mean, cov)?)
             }
+            ModelSpec::Gtr { gamma, alpha } => Box::new(crate::ndf::Gtr::new(gamma, alpha)?),
         })
     }
 }
@@ -302,6 +311,32 @@ mod tests {
         assert!(matches!(
             s.build().map(|_| ()).unwrap_err(),
             ParamError::NotIsotropic { .. }
+        ));
+    }
+
+    #[test]
+    fn gtr_spec_round_trips() {
+        let s = parse(r#"{"family":"gtr","gamma":1.5,"alpha":0.3}"#).unwrap();
+        assert_eq!(
+            s,
+            ModelSpec::Gtr {
+                gamma: 1.5,
+                alpha: 0.3
+            }
+        );
+        assert_eq!(s.family(), "gtr");
+        let m = s.build().unwrap();
+        assert_eq!(m.family(), "gtr");
+        assert_eq!(m.spec(), s);
+        let text = serde_json::to_string(&s).unwrap();
+        assert_eq!(text, r#"{"family":"gtr","gamma":1.5,"alpha":0.3}"#);
+        assert_eq!(parse(&text).unwrap(), s);
+        assert!(parse(r#"{"family":"gtr","gamma":1.5}"#).is_err());
+        assert!(parse(r#"{"family":"gtr","gamma":1.5,"alpha":0.3,"alpha_x":0.3}"#).is_err());
+        let bad = parse(r#"{"family":"gtr","gamma":11,"alpha":0.3}"#).unwrap();
+        assert!(matches!(
+            bad.build().map(|_| ()).unwrap_err(),
+            ParamError::GammaOutOfRange { .. }
         ));
     }
 

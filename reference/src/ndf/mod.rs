@@ -3,6 +3,8 @@
 pub mod beckmann;
 pub mod blend;
 pub mod ggx;
+pub mod gtr;
+pub mod gtr_lambda;
 pub mod piecewise;
 pub mod piecewise_lambda;
 pub mod piecewise_quadrature;
@@ -17,5 +19,6 @@ mod student_errata;
 pub use beckmann::Beckmann;
 pub use blend::Blend;
 pub use ggx::Ggx;
+pub use gtr::Gtr;
 pub use piecewise::{PiecewiseLinear, Profile};
 pub use student::Student;
