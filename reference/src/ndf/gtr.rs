@@ -8,8 +8,8 @@ use crate::model::{
     SlopeDistribution, Smith,
 };
 use crate::ndf::gtr_lambda as routes;
+use crate::ndf::piecewise_quadrature;
 use crate::spec::ModelSpec;
-use crate::special::gauss_kronrod;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// The largest γ accepted (seed 004 §6: "values greater than 10 are impractical").
@@ -224,7 +224,8 @@ impl SlopeDistribution for Gtr {
     /// J     = ∫_0^{π/2} sin²u (sin²u + κ cos²u)^{γ−2} du = (π/4) ₂F₁(2−γ, ½; 2; 1 − κ)
     /// ```
     ///
-    /// J by adaptive Gauss–Kronrod (estimated relative error ≤ 1e-14), J = π/4 at γ = 2 or
+    /// J by the adaptive G7/K15 rule of `ndf::piecewise_quadrature` (estimated relative error
+    /// ≤ 1e-14), J = π/4 at γ = 2 or
     /// α = 1; P2 = cπ/(2|q|³) beyond |q| = 1e100.
     fn p2(&self, q: f64, _phi: f64) -> f64 {
         let q = q.abs();
@@ -257,7 +258,7 @@ impl SlopeDistribution for Gtr {
                     .filter(|&u| u < 1.4),
             );
             points.push(FRAC_PI_2);
-            gauss_kronrod::integrate(&f, &points, 1e-14, 0.0, 500).value
+            piecewise_quadrature::integrate(&f, &points, 1e-14, 0.0).value
         };
         2.0 * self.c * a.sqrt() * kappa.powf(-self.gamma) * j / b / b
     }
@@ -796,6 +797,18 @@ mod tests {
             let clamped = gtr(g, 0.3).g1_route(w, "spline").unwrap();
             assert_eq!(clamped, gtr(4.0, 0.3).g1_route(w, "spline").unwrap());
         }
+        // ERRATA-004.md E3: "ca. 0.1 %" holds as a mean over the document's plot domain, not as a
+        // maximum (an expected failure of the claim read as a bound).
+        assert!(
+            plot.mean_abs < 1e-3,
+            "the mean claim fails: {:e}",
+            plot.mean_abs
+        );
+        assert!(
+            plot.max_abs > 1e-2,
+            "the claim held as a maximum: {:e}",
+            plot.max_abs
+        );
         // What was measured (with margin), recorded in ERRATA-004.md.
         assert!(plot.max_abs < SPLINE_PLOT_MAX_ABS && plot.mean_abs < SPLINE_PLOT_MEAN_ABS);
         assert!(wide.max_abs < SPLINE_WIDE_MAX_ABS && wide.mean_abs < SPLINE_WIDE_MEAN_ABS);
