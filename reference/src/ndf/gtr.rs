@@ -553,7 +553,7 @@ mod tests {
 
     #[test]
     fn erratum_p2_gamma4_printed_q2_read_literally_fails() {
-        // ERRATA-004.md §1: §3.5 prints "4α²q2"; read literally (4α²·q·2) P2⁴ is not even in q
+        // ERRATA.md §1: §3.5 prints "4α²q2"; read literally (4α²·q·2) P2⁴ is not even in q
         // and misses ∫ P22 dp by percents. The corrected term 4α²q² agrees to 1e-11 (above).
         let a = 0.3;
         let m = gtr(4.0, a);
@@ -622,7 +622,7 @@ mod tests {
     #[allow(clippy::excessive_precision)] // the reference values with all computed digits
     fn exact_lambda_matches_high_precision_values() {
         // mpmath 1.3 (mp.dps = 25): the double integral of eq 48* over P22 of eq 1**
-        // (reference/ERRATA-004.md, "High-precision values", has the script).
+        // (reference/ERRATA.md, "High-precision values", has the script).
         let cases = [
             (0.5, 0.3, 0.2, 1.523_149_694_360_503_730_298),
             (2.5, 0.3, 0.2, 0.236_628_915_841_348_448_958_2),
@@ -797,7 +797,7 @@ mod tests {
             let clamped = gtr(g, 0.3).g1_route(w, "spline").unwrap();
             assert_eq!(clamped, gtr(4.0, 0.3).g1_route(w, "spline").unwrap());
         }
-        // ERRATA-004.md E3: "ca. 0.1 %" holds as a mean over the document's plot domain, not as a
+        // ERRATA.md E3: "ca. 0.1 %" holds as a mean over the document's plot domain, not as a
         // maximum (an expected failure of the claim read as a bound).
         assert!(
             plot.mean_abs < 1e-3,
@@ -809,7 +809,7 @@ mod tests {
             "the claim held as a maximum: {:e}",
             plot.max_abs
         );
-        // What was measured (with margin), recorded in ERRATA-004.md.
+        // What was measured (with margin), recorded in ERRATA.md.
         assert!(plot.max_abs < SPLINE_PLOT_MAX_ABS && plot.mean_abs < SPLINE_PLOT_MEAN_ABS);
         assert!(wide.max_abs < SPLINE_WIDE_MAX_ABS && wide.mean_abs < SPLINE_WIDE_MEAN_ABS);
         assert!(clamp.max_abs < SPLINE_CLAMP_MAX_ABS);
@@ -824,7 +824,7 @@ mod tests {
 
     #[test]
     fn erratum_section_4_convergence_claim_is_false_as_printed() {
-        // ERRATA-004.md §2: §4 says "All height fields converge to G1⁰ when μ → 1 and α → 0".
+        // ERRATA.md §2: §4 says "All height fields converge to G1⁰ when μ → 1 and α → 0".
         // At μ = 1 and α → 0, G1^γ → 1 for γ ≥ 1 (slowly: Λ¹ ~ 1/|log α²|), while G1⁰(1) =
         // 2/(1 + √2) ≈ 0.83 does not depend on α.
         let w = from_spherical(std::f64::consts::FRAC_PI_4, 0.0); // μ = 1

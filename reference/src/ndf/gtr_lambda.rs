@@ -398,7 +398,7 @@ pub fn g1_implementation(k: u8, alpha: f64, mu: f64) -> f64 {
 /// numerical Monte Carlo solution"; §5: "the mean difference was 0.001" in G1), and for γ > 4 it
 /// is G1 of γ = 4 (§6: |G1⁴ − G1¹⁰| "up to 0.3" in a plot magnified 10×). The document does not
 /// say which spline: the natural cubic spline through the five knots is this reading. Measured
-/// against the exact route (ERRATA-004.md E3): on the document's plot domain (α ∈ [0.1, 0.5],
+/// against the exact route (ERRATA.md E3): on the document's plot domain (α ∈ [0.1, 0.5],
 /// μ ∈ (0, 5]) mean |ΔG1| = 4.6e-4 but max |ΔG1| = 2.9e-2 (6 % relative, γ = 0.5, α = 0.1);
 /// over α ∈ [0.01, 0.99] max |ΔG1| = 0.17; for γ ∈ (4, 10] (the clamp) max |ΔG1| = 0.28.
 /// Exact at γ ∈ {0, 1, 2, 3, 4}.
