@@ -10,6 +10,7 @@ pub mod geometry;
 pub mod model;
 pub mod ndf;
 pub mod spec;
+pub mod sg;
 pub mod special;
 #[cfg(test)]
 mod test_support;
