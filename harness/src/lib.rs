@@ -5,3 +5,4 @@
 
 pub mod cli;
 pub mod eval;
+pub mod eval_sg;

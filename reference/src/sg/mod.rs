@@ -123,37 +123,55 @@ pub(crate) mod oracle {
 
     /// ∫ f(θ, φ) sin θ dφ dθ over θ ∈ [0, θmax], φ over a whole turn, with the polar angle
     /// measured from +z (`crate::geometry::from_spherical`), cut around a peak at
-    /// (θp, φp) of angular width w; relative accuracy ≈ `rel`.
+    /// (θp, φp) of angular width w; relative accuracy ≈ `rel`. With `mirror`, f is taken to be
+    /// even about φp and only half a turn is integrated. The inner (φ) integrals are single
+    /// double-exponential rules (the rule inside `test_support::integrate`) on pieces cut around
+    /// the peak, where f is analytic and resolved; the outer one is adaptive.
     pub fn directions(
         f: &dyn Fn(f64, f64) -> f64,
         theta_max: f64,
         (theta_peak, phi_peak): (f64, f64),
         w: f64,
         rel: f64,
+        mirror: bool,
     ) -> f64 {
         use std::f64::consts::PI;
         let theta_cuts = cuts(theta_peak.min(theta_max), w, 0.0, theta_max);
-        let inner = |theta: f64, rel: f64, abs: f64| {
+        let inner = |theta: f64, abs: f64| {
             let s = theta.sin();
             if s == 0.0 {
                 return 0.0;
             }
             let pw = (w / s).min(1.0);
-            let phi_cuts = cuts(phi_peak, pw, phi_peak - PI, phi_peak + PI);
-            s * phi_cuts
-                .windows(2)
-                .map(|c| integrate(&|phi| f(theta, phi), c[0], c[1], rel, abs / s).0)
-                .sum::<f64>()
+            let (lo, factor) = if mirror { (phi_peak, 2.0) } else { (phi_peak - PI, 1.0) };
+            let phi_cuts = cuts(phi_peak, pw, lo, phi_peak + PI);
+            let each = abs / (s * factor * phi_cuts.len() as f64);
+            factor
+                * s
+                * phi_cuts
+                    .windows(2)
+                    .map(|c| {
+                        quadrature::double_exponential::integrate(
+                            |phi| f(theta, phi),
+                            c[0],
+                            c[1],
+                            each,
+                        )
+                        .integral
+                    })
+                    .sum::<f64>()
         };
         let outer = |rel: f64, abs: f64| -> f64 {
             let inner_abs = abs / (2.0 * PI * theta_max) * 0.1;
             theta_cuts
                 .windows(2)
-                .map(|c| integrate(&|t| inner(t, rel, inner_abs), c[0], c[1], rel, abs).0)
+                .map(|c| integrate(&|t| inner(t, inner_abs), c[0], c[1], rel, abs).0)
                 .sum()
         };
-        let magnitude = outer(1e-6, 1e-300).abs();
-        outer(rel, (rel * magnitude * 1e-3).max(1e-300))
+        // A coarse first pass, against a guess from the peak's height, fixes the magnitude.
+        let peak = f(theta_peak.min(theta_max), phi_peak).abs().max(1e-300);
+        let rough = outer(1e-6, peak * w * w * 1e-9).abs();
+        outer(rel, (rel * rough * 1e-2).max(1e-300))
     }
 }
 

@@ -121,6 +121,32 @@ fn gk15(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> Piece {
     Piece { a, b, value, error }
 }
 
+/// The nodes and weights of the 15-point Kronrod rule on [a, b] (for fixed-grid sweeps).
+#[cfg(test)]
+pub(crate) fn kronrod_rule(a: f64, b: f64) -> Vec<(f64, f64)> {
+    let c = 0.5 * (a + b);
+    let h = 0.5 * (b - a);
+    let mut v = vec![(c, WGK[7] * h)];
+    for j in 0..7 {
+        v.push((c - h * XGK[j], WGK[j] * h));
+        v.push((c + h * XGK[j], WGK[j] * h));
+    }
+    v
+}
+
+/// The nodes and weights of the 7-point Gauss rule on [a, b] (for fixed-grid sweeps).
+#[cfg(test)]
+pub(crate) fn gauss_rule(a: f64, b: f64) -> Vec<(f64, f64)> {
+    let c = 0.5 * (a + b);
+    let h = 0.5 * (b - a);
+    let mut v = vec![(c, WG[3] * h)];
+    for j in 0..3 {
+        v.push((c - h * XGK[2 * j + 1], WG[j] * h));
+        v.push((c + h * XGK[2 * j + 1], WG[j] * h));
+    }
+    v
+}
+
 /// The most pieces one 1-D integral may be cut into.
 const MAX_PIECES: usize = 4000;
 
