@@ -122,8 +122,7 @@ fn answer(quantity: &str, q: &Map<String, Value>, route: Option<&str>) -> Result
             let s = match (axis_given, q.contains_key("v")) {
                 (true, true) => {
                     return Err(EvalError::Argument(
-                        "give the SG's axis either as \"sg\".\"axis\" or as \"v\", not both"
-                            .into(),
+                        "give the SG's axis either as \"sg\".\"axis\" or as \"v\", not both".into(),
                     ))
                 }
                 (false, true) => {
@@ -285,7 +284,9 @@ mod tests {
     fn sg_quantities_match_the_library() {
         let a = Sg::new([0.0, 0.0, 1.0], 10.0, 2.0).unwrap();
         let b = Sg::new([0.0, 0.6, 0.8], 3.0, 1.0).unwrap();
-        let v = value(&format!(r#"{{"quantity":"sg_eval","a":{A},"v":[0,0.6,0.8]}}"#));
+        let v = value(&format!(
+            r#"{{"quantity":"sg_eval","a":{A},"v":[0,0.6,0.8]}}"#
+        ));
         assert_eq!(v.as_f64().unwrap(), a.eval([0.0, 0.6, 0.8]));
         let v = value(&format!(r#"{{"quantity":"sg_inner","a":{A},"b":{B}}}"#));
         assert_eq!(v.as_f64().unwrap(), a.inner(&b));
@@ -298,7 +299,9 @@ mod tests {
         assert_eq!(p["axis"].as_array().unwrap().len(), 3);
         let i = value(&format!(r#"{{"quantity":"sg_integral","a":{A}}}"#));
         assert_eq!(i.as_f64().unwrap(), a.integral());
-        let c = value(&format!(r#"{{"quantity":"sg_integral","a":{A},"cap":0.5}}"#));
+        let c = value(&format!(
+            r#"{{"quantity":"sg_integral","a":{A},"cap":0.5}}"#
+        ));
         assert_eq!(c.as_f64().unwrap(), a.cap_integral(0.5).unwrap());
         let printed = value(&format!(
             r#"{{"quantity":"sg_integral","a":{A},"cap":0.5,"route":"cap_product"}}"#
@@ -316,7 +319,9 @@ mod tests {
             1.5,
         )
         .unwrap();
-        let v = value(&format!(r#"{{"quantity":"asg_eval","asg":{ASG},"v":[0,0.6,0.8]}}"#));
+        let v = value(&format!(
+            r#"{{"quantity":"asg_eval","asg":{ASG},"v":[0,0.6,0.8]}}"#
+        ));
         assert_eq!(v.as_f64().unwrap(), g.eval([0.0, 0.6, 0.8]));
         let d = value(&format!(r#"{{"quantity":"asg_integral","asg":{ASG}}}"#));
         assert_eq!(d.as_f64().unwrap(), g.integral().unwrap());

@@ -9,8 +9,8 @@ pub mod error;
 pub mod geometry;
 pub mod model;
 pub mod ndf;
-pub mod spec;
 pub mod sg;
+pub mod spec;
 pub mod special;
 #[cfg(test)]
 mod test_support;

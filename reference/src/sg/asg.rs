@@ -69,7 +69,11 @@ impl Asg {
         let z = unit_axis("z", z)?;
         for (name, d) in [("x·y", dot(x, y)), ("x·z", dot(x, z)), ("y·z", dot(y, z))] {
             if !(d.abs() <= UNIT_TOLERANCE) {
-                return Err(param(name, "0: the frame must be orthonormal (within 1e-9)", d));
+                return Err(param(
+                    name,
+                    "0: the frame must be orthonormal (within 1e-9)",
+                    d,
+                ));
             }
         }
         for (name, b) in [("lambda", bandwidths[0]), ("mu", bandwidths[1])] {
@@ -121,9 +125,7 @@ impl Asg {
             return 0.0;
         }
         let (a, b) = (dot(v, self.x), dot(v, self.y));
-        self.amplitude
-            * s
-            * (-self.bandwidths[0] * a * a - self.bandwidths[1] * b * b).exp()
+        self.amplitude * s * (-self.bandwidths[0] * a * a - self.bandwidths[1] * b * b).exp()
     }
 
     /// The document's approximation of the integral over the sphere (seed 003, §3.2.1, Xu et
@@ -136,9 +138,10 @@ impl Asg {
     /// The document prints "=", but this is an approximation (ERRATA-003.md, E3): the exact
     /// integral is c ∫₀^{2π} (1 − e^{−k(φ)})/(2k(φ)) dφ, k = λ cos²φ + μ sin²φ, and the form
     /// replaces 1/k by (1/λ)(1 + (ν/μ) e^{−(ν/μ) cos²φ}), exact at φ = π/2 only. It is exact
-    /// for λ = μ. Measured (test `integral_error_measured`, bandwidths 1e-3 … 1e4): max
-    /// relative error 4.3 % for μ ≥ 1, 1.3 % for μ ≥ 5; it diverges as μ → 0 with λ > μ (×40
-    /// at λ = 0.01, μ = 1e-3). Domain: λ, μ > 0 (an error otherwise).
+    /// for λ = μ. The document states no error; measured (test `integral_error_measured`,
+    /// bandwidths 1e-3 … 1e4): max relative error 4.24 % for μ ≥ 1 (at λ = 2, μ = 1), 1.03e-4
+    /// for μ ≥ 5; it diverges as μ → 0 with λ > μ (error ×41 at λ = 0.01, μ = 1e-3). Domain:
+    /// λ, μ > 0 (an error otherwise).
     pub fn integral(&self) -> Result<f64, QueryError> {
         let [a, b] = self.bandwidths;
         let (l, m) = if a >= b { (a, b) } else { (b, a) };
@@ -231,10 +234,11 @@ impl Asg {
     /// [e₁ − e₀, e₂ − e₀], amplitude c₁c₂ S(z₃; z₁, z₂) e^{−e₀} (vᵀA₃v = e₀ + (e₁ − e₀)(v·u₁)² +
     /// (e₂ − e₀)(v·u₂)² on the unit sphere). The approximation freezes the ratio
     /// S(v; z₁) S(v; z₂) / S(v; z₃) at v = z₃; the document states no error. Measured (test
-    /// `product_error_measured`): max |approx − exact| relative to the exact product's peak
-    /// ≤ 0.43 over bandwidths 1 … 1e3 and axes up to 0.5 rad apart (it falls as the bandwidths
-    /// grow: ≤ 0.03 for bandwidths ≥ 100). An error if the product vanishes identically
-    /// (z₃ on or behind the horizon of z₁ or z₂).
+    /// `product_is_the_document_form_and_its_error_is_measured`, bandwidths (b, 0.3b) ×
+    /// (0.5b, 2b), axes up to 0.5 rad apart): max |approx − exact| relative to the exact
+    /// product's peak 0.19 at b = 1, 0.040 at b = 10, 8.0e-3 at b = 100, 2.1e-3 at b = 1000.
+    /// An error if the product vanishes identically (z₃ on or behind the horizon of z₁ or
+    /// z₂).
     pub fn product(&self, other: &Asg) -> Result<Asg, QueryError> {
         let (a1, a2) = (self.matrix(), other.matrix());
         let mut a3 = [[0.0; 3]; 3];
@@ -284,9 +288,11 @@ impl Asg {
     /// An approximation: the smooth term is frozen at p, ‖v − p‖² is linearized about z, and
     /// the remaining Gaussian integral is taken as π/√((λ+ν)(μ+ν)), which is its value over the
     /// hemisphere v·z ≥ 0 (the document writes ∫ over S², which is twice that: ERRATA-003.md,
-    /// E4). The document claims a relative L2 error below 0.2 % for λ, μ > 3 and below 2.8 %
-    /// for λ, μ > 1; measured, see ERRATA-003.md, E5 and test
-    /// `convolution_l2_error_against_claims`. Domain: (λ + ν)(μ + ν) > 0.
+    /// E4). The document claims an L2 error below 0.2 % for λ, μ > 3 and below 2.8 % for
+    /// λ, μ > 1. Measured as the relative L2 error over the SG axis p ∈ S², the claims fail
+    /// unless the SG is sharp; the error falls roughly as 1/ν, and only slowly with λ, μ:
+    /// 4.6 % at λ = μ = 3, ν = 10; 0.53 % at ν = 100; 39 % at λ = μ = 1.5, ν = 1 (ERRATA-003.md,
+    /// E5; tests `convolution_l2_error_claim_*`). Domain: (λ + ν)(μ + ν) > 0.
     pub fn convolve_sg(&self, sg: &Sg) -> Result<f64, QueryError> {
         let [l, m] = self.bandwidths;
         let nu = 0.5 * sg.sharpness();
@@ -301,10 +307,18 @@ impl Asg {
             return Ok(0.0);
         }
         let (px, py) = (dot(p, self.x), dot(p, self.y));
-        let ratio = |a: f64| if a + nu == 0.0 { 0.0 } else { a * nu / (a + nu) };
+        let ratio = |a: f64| {
+            if a + nu == 0.0 {
+                0.0
+            } else {
+                a * nu / (a + nu)
+            }
+        };
         let exponent = -ratio(l) * px * px - ratio(m) * py * py;
-        Ok(sg.amplitude() * self.amplitude * s * exponent.exp() * PI
-            / ((l + nu) * (m + nu)).sqrt())
+        Ok(
+            sg.amplitude() * self.amplitude * s * exponent.exp() * PI
+                / ((l + nu) * (m + nu)).sqrt(),
+        )
     }
 
     /// The convolution ∫ G(v) G_sg(v) dv by adaptive quadrature over the hemisphere v·z ≥ 0
@@ -341,7 +355,11 @@ impl Asg {
         let [l, m] = self.bandwidths;
         let ls = sg.sharpness();
         let p = sg.axis();
-        let b = [ls * dot(p, self.x), ls * dot(p, self.y), ls * dot(p, self.z)];
+        let b = [
+            ls * dot(p, self.x),
+            ls * dot(p, self.y),
+            ls * dot(p, self.z),
+        ];
         let a = [l, m, 0.0];
         if !(ls > 0.0) {
             return self.z;
@@ -405,10 +423,10 @@ fn symmetric_eigen(mut a: [[f64; 3]; 3]) -> ([f64; 3], [Vec3; 3]) {
                 row[p] = c * kp - s * kq;
                 row[q] = s * kp + c * kq;
             }
+            let (row_p, row_q) = (a[p], a[q]);
             for k in 0..3 {
-                let (pk, qk) = (a[p][k], a[q][k]);
-                a[p][k] = c * pk - s * qk;
-                a[q][k] = s * pk + c * qk;
+                a[p][k] = c * row_p[k] - s * row_q[k];
+                a[q][k] = s * row_p[k] + c * row_q[k];
             }
             for row in v.iter_mut() {
                 let (kp, kq) = (row[p], row[q]);
@@ -428,8 +446,8 @@ fn symmetric_eigen(mut a: [[f64; 3]; 3]) -> ([f64; 3], [Vec3; 3]) {
 mod tests {
     use super::*;
     use crate::geometry::from_spherical;
-    use crate::sg::{cross, frame_around};
     use crate::sg::oracle::{cuts, directions, integrate_cut};
+    use crate::sg::{cross, frame_around};
     use crate::test_support::rel_err;
 
     const BANDWIDTHS: [f64; 13] = [
@@ -491,7 +509,11 @@ mod tests {
         for a in [-3.0f64, 0.0, 1e-3, 1.0, 10.0, 1e3, 1e5] {
             let cut = cuts(FRAC_PI_2, 1.0 / (1.0 + a.abs()).sqrt(), 0.0, FRAC_PI_2);
             let q = 4.0 * integrate_cut(&|p: f64| (-a * p.cos().powi(2)).exp(), &cut, 1e-13);
-            assert!(rel_err(f_function(a), q) < 1e-13, "a = {a}: {} vs {q}", f_function(a));
+            assert!(
+                rel_err(f_function(a), q) < 1e-13,
+                "a = {a}: {} vs {q}",
+                f_function(a)
+            );
         }
     }
 
@@ -548,8 +570,8 @@ mod tests {
              (λ, μ ≥ 5)",
             worst[0], worst_at[0], worst[1], worst_at[1], worst[2], worst_at[2]
         );
-        assert!(worst[0] < 0.043 && worst[0] > 0.03, "{worst:?}");
-        assert!(worst[1] < 0.013, "{worst:?}");
+        assert!(worst[0] < 0.0425 && worst[0] > 0.0423, "{worst:?}");
+        assert!(worst[1] < 1.04e-4, "{worst:?}");
         assert!(worst[2] < 0.0068 && worst[2] > 0.0067, "{worst:?}");
         assert!(worst_small > 10.0);
         // ERRATA-003.md, E3: printed as an equality; it is not one for λ ≠ μ.
@@ -560,8 +582,12 @@ mod tests {
     #[test]
     fn product_is_the_document_form_and_its_error_is_measured() {
         let mut report = Vec::new();
-        let mut worst_all = 0.0f64;
-        for b in [1.0, 10.0, 100.0, 1e3] {
+        for (b, bound) in [
+            (1.0, 0.193),
+            (10.0, 0.0397),
+            (100.0, 8.0e-3),
+            (1e3, 2.08e-3),
+        ] {
             let mut worst = 0.0f64;
             for beta in [0.0, 0.1, 0.5] {
                 let g1 = asg_at([0.0, 0.0, 1.0], 0.0, b, 0.3 * b, 1.2);
@@ -591,11 +617,10 @@ mod tests {
                 }
                 worst = worst.max(err / peak);
             }
-            worst_all = worst_all.max(worst);
             report.push(format!("bandwidth {b}: {worst:.3e}"));
+            assert!(worst < bound && worst > 0.9 * bound, "{b}: {worst}");
         }
         eprintln!("ASG product (seed 003 §3.2.2), max |approx − exact| / peak: {report:?}");
-        assert!(worst_all < 0.43, "{worst_all}");
     }
 
     #[test]
@@ -614,7 +639,11 @@ mod tests {
             let sphere = integrate_cut(&f, &cut, 1e-13);
             let hemisphere = integrate_cut(&f, &cuts(0.0, w, 0.0, FRAC_PI_2), 1e-13);
             let printed = PI / a;
-            assert!((sphere / printed - 2.0).abs() < 2.0 / a, "A = {a}: {}", sphere / printed);
+            assert!(
+                (sphere / printed - 2.0).abs() < 2.0 / a,
+                "A = {a}: {}",
+                sphere / printed
+            );
             assert!((hemisphere / printed - 1.0).abs() < 1.0 / a);
         }
     }
@@ -712,10 +741,22 @@ mod tests {
             return;
         }
         let pieces = [0.0, 0.25 * PI, FRAC_PI_2, 0.75 * PI, PI];
-        for (l, m) in [(1.0, 1.0), (3.0, 1.0), (3.0, 3.0), (10.0, 3.0), (10.0, 10.0), (30.0, 30.0)] {
+        for (l, m) in [
+            (1.0, 1.0),
+            (3.0, 1.0),
+            (3.0, 3.0),
+            (10.0, 3.0),
+            (10.0, 10.0),
+            (30.0, 30.0),
+        ] {
             let row: Vec<String> = [0.3, 1.0, 3.0, 10.0, 30.0, 100.0]
                 .iter()
-                .map(|&nu| format!("ν = {nu}: {:.2e}", convolution_l2_error(l, m, nu, &pieces, true)))
+                .map(|&nu| {
+                    format!(
+                        "ν = {nu}: {:.2e}",
+                        convolution_l2_error(l, m, nu, &pieces, true)
+                    )
+                })
                 .collect();
             eprintln!("λ = {l}, μ = {m}: {}", row.join(", "));
         }

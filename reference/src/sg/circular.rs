@@ -193,10 +193,10 @@ impl CircularGaussian {
     /// ```
     ///
     /// The document prints `∫ g^c = ∫ g` as an equality; it is an approximation
-    /// (ERRATA-003.md, E7). Its relative error is σ²/16 to leading order (g^c = g e^{x⁴/(12σ²)
-    /// + …}); measured on [−π/2, π/2] with μ ∈ [−1.4, 1.4]: ≤ 1.15 σ²/16 for σ ≤ 1 (6.3e-4 at
-    /// σ = 0.1, 1.7e-2 at σ = 0.5, 7.0e-2 at σ = 1; test `interval_integral_erf_error_measured`).
-    /// Requires a ≤ b.
+    /// (ERRATA-003.md, E7). Its relative error is σ²/16 to leading order, since
+    /// g^c = g e^{x⁴/(12σ²) + …}; measured on [−π/2, π/2] with μ ∈ [−1.4, 1.4]: ≤ 1.15 σ²/16 for
+    /// σ ≤ 1 (6.3e-4 at σ = 0.1, 1.7e-2 at σ = 0.5, 7.0e-2 at σ = 1; test
+    /// `interval_integral_erf_error_measured`). Requires a ≤ b.
     pub fn integral_interval(&self, a: f64, b: f64) -> f64 {
         use statrs::function::erf::erf;
         let s = self.bandwidth;
@@ -321,7 +321,11 @@ mod tests {
             let g = CircularGaussian::new(0.7, sigma).unwrap();
             let cut = cuts(0.7, sigma, 0.7 - PI, 0.7 + PI);
             let q = integrate_cut(&|x| g.eval(x), &cut, 1e-13);
-            assert!(rel_err(g.integral_period(), q) < 1e-13, "σ = {sigma}: {} vs {q}", g.integral_period());
+            assert!(
+                rel_err(g.integral_period(), q) < 1e-13,
+                "σ = {sigma}: {} vs {q}",
+                g.integral_period()
+            );
             let mine = g.integral_interval_exact(-2.0, -2.0 + 2.0 * PI);
             assert!(rel_err(mine, q) < 1e-12, "σ = {sigma}: {mine} vs {q}");
         }
@@ -344,7 +348,10 @@ mod tests {
             }
             report.push(format!("σ = {sigma}: {worst:.2e}"));
             // g^c = g · e^{x⁴/(12σ²) + …}: the relative error is σ²/16 to leading order.
-            assert!(worst < 1.15 * sigma * sigma / 16.0, "σ = {sigma}: {worst:.3e}");
+            assert!(
+                worst < 1.15 * sigma * sigma / 16.0,
+                "σ = {sigma}: {worst:.3e}"
+            );
         }
         eprintln!("∫ g^c ≈ erf form (seed 003 §4.3), max rel err: {report:?}");
         // The printed "=" is not an equality (ERRATA-003.md, E7).
@@ -364,7 +371,10 @@ mod tests {
                 let w = fiber_direction(theta, phi);
                 let sg = (2.0 / (sigma * sigma) * (dot(w, xi) - 1.0)).exp();
                 let (l, az) = decompose_sg(theta, phi, tp, pp, sigma).unwrap();
-                assert!((l * az - sg).abs() <= 1e-13 * sg.max(1e-300), "{theta} {phi}");
+                assert!(
+                    (l * az - sg).abs() <= 1e-13 * sg.max(1e-300),
+                    "{theta} {phi}"
+                );
             }
         }
         assert!(decompose_sg(0.5 * PI, 0.0, 0.1, 0.0, 0.3).is_err());

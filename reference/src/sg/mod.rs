@@ -3,8 +3,8 @@
 //! (SG shading), Xu et al. 2013 (ASG) and Iwasaki et al. 2012/2014 (circular Gaussians).
 //!
 //! Every approximation the document gives has a function for the document's route and an
-//! `_exact` function that computes the same quantity by adaptive quadrature
-//! ([`quadrature`], inside this crate so that `mfh eval` can answer `"route": "exact"`).
+//! `_exact` function that computes the same quantity by adaptive quadrature (the private
+//! module `quadrature`, inside this crate so that `mfh eval` can answer `"route": "exact"`).
 //! Where the printed document is wrong, `reference/ERRATA-003.md` says so and names the unit
 //! test that shows it.
 
@@ -143,7 +143,11 @@ pub(crate) mod oracle {
                 return 0.0;
             }
             let pw = (w / s).min(1.0);
-            let (lo, factor) = if mirror { (phi_peak, 2.0) } else { (phi_peak - PI, 1.0) };
+            let (lo, factor) = if mirror {
+                (phi_peak, 2.0)
+            } else {
+                (phi_peak - PI, 1.0)
+            };
             let phi_cuts = cuts(phi_peak, pw, lo, phi_peak + PI);
             let each = abs / (s * factor * phi_cuts.len() as f64);
             factor

@@ -308,7 +308,20 @@ mod tests {
         let f = |x: f64| (-(x - 0.3f64).powi(2) / (w * w)).exp();
         // (A peak exactly at a breakpoint is invisible to the rule's nodes unless pieces of
         // its own width surround it: that is what `integrate_directions` does.)
-        let e = integrate(&f, &[0.0, 0.3 - 1e-3, 0.3 - 1e-4, 0.3, 0.3 + 1e-4, 0.3 + 1e-3, 1.0], 1e-13, 0.0);
+        let e = integrate(
+            &f,
+            &[
+                0.0,
+                0.3 - 1e-3,
+                0.3 - 1e-4,
+                0.3,
+                0.3 + 1e-4,
+                0.3 + 1e-3,
+                1.0,
+            ],
+            1e-13,
+            0.0,
+        );
         assert!(rel_err(e.value, w * PI.sqrt()) < 1e-12, "{e:?}");
         // A kink.
         let e = integrate(&|x: f64| (x - 0.123).abs(), &[0.0, 1.0], 1e-13, 0.0);
