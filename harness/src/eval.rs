@@ -114,6 +114,13 @@ pub fn evaluate(line: &str) -> Result<Value, EvalError> {
     let obj = query
         .as_object()
         .ok_or_else(|| EvalError::Parse("a query must be a JSON object".into()))?;
+    // Spherical-Gaussian quantities (seed 003) take no "model": see eval_sg.
+    if let Some(quantity) = obj.get("quantity").and_then(Value::as_str) {
+        let route = obj.get("route").and_then(Value::as_str);
+        if let Some(answer) = crate::eval_sg::evaluate(quantity, obj, route) {
+            return answer;
+        }
+    }
     let spec_value = obj
         .get("model")
         .ok_or_else(|| EvalError::Argument("missing \"model\"".into()))?;

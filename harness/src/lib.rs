@@ -6,4 +6,5 @@
 pub mod chi2_command;
 pub mod cli;
 pub mod eval;
+pub mod eval_sg;
 pub mod oracle;
