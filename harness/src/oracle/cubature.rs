@@ -1,35 +1,7 @@
 //! Adaptive cubature over rectangles with an error bound: the tensor product of the
 //! Gauss–Kronrod G7/K15 pair, bisected into quadrants until the estimate meets the tolerance.
 
-/// K15 abscissae on [−1, 1] (non-negative half; QUADPACK `qk15`), largest first.
-const XGK: [f64; 8] = [
-    0.991_455_371_120_812_6,
-    0.949_107_912_342_758_5,
-    0.864_864_423_359_769_1,
-    0.741_531_185_599_394_4,
-    0.586_087_235_467_691_1,
-    0.405_845_151_377_397_2,
-    0.207_784_955_007_898_5,
-    0.0,
-];
-/// K15 weights matching [`XGK`].
-const WGK: [f64; 8] = [
-    0.022_935_322_010_529_225,
-    0.063_092_092_629_978_55,
-    0.104_790_010_322_250_18,
-    0.140_653_259_715_525_92,
-    0.169_004_726_639_267_9,
-    0.190_350_578_064_785_4,
-    0.204_432_940_075_298_9,
-    0.209_482_141_084_727_83,
-];
-/// G7 weights of the abscissae `XGK[1], XGK[3], XGK[5], XGK[7]`.
-const WG: [f64; 4] = [
-    0.129_484_966_168_869_7,
-    0.279_705_391_489_276_7,
-    0.381_830_050_505_118_9,
-    0.417_959_183_673_469_4,
-];
+use mfh_reference::special::gauss_kronrod::{WG, WGK, XGK};
 
 /// The deepest quadrant bisection; past it the estimate is accepted with its error.
 pub const MAX_DEPTH: u32 = 10;

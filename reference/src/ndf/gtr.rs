@@ -8,8 +8,8 @@ use crate::model::{
     SlopeDistribution, Smith,
 };
 use crate::ndf::gtr_lambda as routes;
-use crate::ndf::piecewise_quadrature;
 use crate::spec::ModelSpec;
+use crate::special::gauss_kronrod;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// The largest γ accepted (seed 004 §6: "values greater than 10 are impractical").
@@ -224,7 +224,7 @@ impl SlopeDistribution for Gtr {
     /// J     = ∫_0^{π/2} sin²u (sin²u + κ cos²u)^{γ−2} du = (π/4) ₂F₁(2−γ, ½; 2; 1 − κ)
     /// ```
     ///
-    /// J by the adaptive G7/K15 rule of `ndf::piecewise_quadrature` (estimated relative error
+    /// J by the adaptive G7/K15 rule of `special::gauss_kronrod` (estimated relative error
     /// ≤ 1e-14), J = π/4 at γ = 2 or
     /// α = 1; P2 = cπ/(2|q|³) beyond |q| = 1e100.
     fn p2(&self, q: f64, _phi: f64) -> f64 {
@@ -258,7 +258,7 @@ impl SlopeDistribution for Gtr {
                     .filter(|&u| u < 1.4),
             );
             points.push(FRAC_PI_2);
-            piecewise_quadrature::integrate(&f, &points, 1e-14, 0.0).value
+            gauss_kronrod::integrate(&f, &points, 1e-14, 0.0).value
         };
         2.0 * self.c * a.sqrt() * kappa.powf(-self.gamma) * j / b / b
     }

@@ -8,7 +8,7 @@
 
 use crate::error::QueryError;
 use crate::ndf::gtr::normalization_constant;
-use crate::ndf::piecewise_quadrature;
+use crate::special::gauss_kronrod;
 use std::f64::consts::PI;
 
 /// The named routes with a one-line description; the first is the default.
@@ -121,7 +121,7 @@ const MU_LARGE: f64 = 1e9;
 ///
 /// (c the normalization constant of D). This is evaluated with ψ = gd(s) (r = μ cosh s, so that
 /// cos ψ = sech s is exact near the horizon and the scales r ≈ α and r ≈ 1 are evenly spaced in
-/// s) by the adaptive G7/K15 rule of `ndf::piecewise_quadrature` (hand-written: the crate may
+/// s) by the adaptive G7/K15 rule of `special::gauss_kronrod` (hand-written: the crate may
 /// not use the dev-only `quadrature`, which is the tests' independent oracle) on
 /// s ∈ [0, asech(1e-17 min(μ, 1))]
 /// plus the analytic tail 2c σ_min/μ², asking for an estimated relative error of 1e-14.
@@ -174,7 +174,7 @@ pub fn lambda_exact_with(gamma: f64, alpha: f64, c: f64, mu: f64) -> f64 {
     points.retain(|s| (0.0..=s_max).contains(s));
     points.sort_by(f64::total_cmp);
     let points = subdivide(&points, 4.0);
-    piecewise_quadrature::integrate(&integrand, &points, 1e-14, 0.0).value + tail
+    gauss_kronrod::integrate(&integrand, &points, 1e-14, 0.0).value + tail
 }
 
 /// sin ψ − ψ cos ψ given sin ψ and cos ψ; by its series below ψ = 0.25, where the difference

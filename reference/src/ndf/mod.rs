@@ -7,7 +7,6 @@ pub mod gtr;
 pub mod gtr_lambda;
 pub mod piecewise;
 pub mod piecewise_lambda;
-pub mod piecewise_quadrature;
 pub mod student;
 pub mod student_lambda;
 

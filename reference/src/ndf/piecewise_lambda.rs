@@ -7,7 +7,7 @@
 
 use crate::geometry::Vec3;
 use crate::ndf::piecewise::{segment_cos_sin, segment_sin2, PiecewiseLinear};
-use crate::ndf::piecewise_quadrature::integrate;
+use crate::special::gauss_kronrod::integrate;
 use std::f64::consts::{FRAC_PI_2, TAU};
 
 /// Relative accuracy requested from the adaptive quadrature of the "exact" route.
@@ -86,7 +86,7 @@ pub(crate) fn k2(g: f64) -> f64 {
 /// The azimuthal integral over the back-facing arc |φ_m − φ_o − π| < γ is closed (K₀, K₂ above;
 /// the sin 2(φ_m − φ_o) part is odd and vanishes). The θ integral is taken in u = √δ (the
 /// integrand behaves as δ^{3/2} at E) with the profile breakpoints `breaks` as interval ends,
-/// by `piecewise_quadrature` to relative accuracy `rel`. `dxy(θ)` = (k_x D_x(θ), k_y D_y(θ)).
+/// by `special::gauss_kronrod` to relative accuracy `rel`. `dxy(θ)` = (k_x D_x(θ), k_y D_y(θ)).
 /// Domain: θ_o ∈ [0, π/2] (0 at θ_o = 0, +∞ at π/2).
 pub(crate) fn lambda_exact(
     theta_o: f64,

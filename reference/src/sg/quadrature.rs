@@ -11,41 +11,13 @@
 //! globally adaptive: it bisects the piece with the largest error estimate until the sum of
 //! the estimates is below `max(rel·|I|, abs)`.
 
+use crate::special::gauss_kronrod::{WG, WGK, XGK};
+
 use super::{add, scale};
 use crate::geometry::{dot, Vec3};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 use std::f64::consts::PI;
-
-/// Kronrod abscissae on [−1, 1] (the odd-indexed ones are the Gauss points; the last is 0).
-const XGK: [f64; 8] = [
-    0.991_455_371_120_812_6,
-    0.949_107_912_342_758_5,
-    0.864_864_423_359_769_1,
-    0.741_531_185_599_394_4,
-    0.586_087_235_467_691_1,
-    0.405_845_151_377_397_2,
-    0.207_784_955_007_898_5,
-    0.0,
-];
-/// Kronrod weights.
-const WGK: [f64; 8] = [
-    0.022_935_322_010_529_225,
-    0.063_092_092_629_978_55,
-    0.104_790_010_322_250_18,
-    0.140_653_259_715_525_92,
-    0.169_004_726_639_267_9,
-    0.190_350_578_064_785_4,
-    0.204_432_940_075_298_9,
-    0.209_482_141_084_727_83,
-];
-/// Gauss weights (the last is the centre's).
-const WG: [f64; 4] = [
-    0.129_484_966_168_869_7,
-    0.279_705_391_489_276_7,
-    0.381_830_050_505_118_9,
-    0.417_959_183_673_469_4,
-];
 
 /// An integral's value and an estimate of its absolute error.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,5 +2,6 @@
 //! closed forms need; everything else comes from statrs and libm.
 
 pub mod gamma_ratio;
+pub mod gauss_kronrod;
 pub mod hyp2f1;
 pub mod student_tail;

@@ -1,4 +1,5 @@
-//! Globally adaptive Gauss–Kronrod (G7/K15) quadrature over a list of break points.
+//! Globally adaptive Gauss–Kronrod (G7/K15) quadrature over a list of break points, and the
+//! G7/K15 nodes and weights every quadrature of the project shares.
 //!
 //! Why this lives in the reference crate: the "exact" and "slope_space" Smith Λ routes of the
 //! piecewise-linear and blended NDFs (seed 000, eq 10–13 and 30–32) have no closed form, so the
@@ -13,7 +14,7 @@
 
 /// Kronrod abscissae on [−1, 1] (non-negative half, descending); the odd-indexed ones are the
 /// Gauss points (QUADPACK `qk15`).
-const XGK: [f64; 8] = [
+pub const XGK: [f64; 8] = [
     0.991_455_371_120_812_6,
     0.949_107_912_342_758_5,
     0.864_864_423_359_769_1,
@@ -25,7 +26,7 @@ const XGK: [f64; 8] = [
 ];
 
 /// Kronrod weights, matching `XGK`.
-const WGK: [f64; 8] = [
+pub const WGK: [f64; 8] = [
     0.022_935_322_010_529_22,
     0.063_092_092_629_978_55,
     0.104_790_010_322_250_2,
@@ -37,7 +38,7 @@ const WGK: [f64; 8] = [
 ];
 
 /// Gauss weights of the 7-point rule at `XGK[1]`, `XGK[3]`, `XGK[5]`, `XGK[7]`.
-const WG: [f64; 4] = [
+pub const WG: [f64; 4] = [
     0.129_484_966_168_869_7,
     0.279_705_391_489_276_7,
     0.381_830_050_505_118_9,
