@@ -7,7 +7,7 @@
 //! so that branch-dependent costs (series versus continued fraction, the regimes of the stable
 //! Λ) are averaged; one slow input weighs in at 1/64 of its cost (the piecewise-linear `exact`
 //! and `domain_split_adaptive` routes spend ~0.1 s at θ = 1e-6, 10–60 µs elsewhere). The
-//! piecewise-linear `slope_space` route (nested quadrature: 1–100 ms per Λ, minutes at
+//! piecewise-linear `slope_space` route (nested quadrature: 1–100 ms per Λ, > 15 min at
 //! θ = 1e-5) is swept over 8 of the directions only. The throughput is the number of inputs:
 //! criterion's `time` is per sweep, its `thrpt` in evaluations per second. Names read
 //! `quantity/family/parameters[/route]`, e.g. `lambda/std/gamma=2.5/stable`.
@@ -192,7 +192,7 @@ fn bench_routed<M: Ndf + Smith + NormalSampler>(
     g.finish();
 
     if routes.contains(&SLOW_ROUTE) {
-        // Nested adaptive quadrature: 1–100 ms per Λ, and minutes at θ = 1e-5. Eight of the
+        // Nested adaptive quadrature: 1–100 ms per Λ, > 15 min at θ = 1e-5. Eight of the
         // swept directions (θ from 0.09 to 1.37), ten flat samples.
         let dirs = directions();
         let few: Vec<Vec3> = (0..8).map(|k| dirs[3 + 7 * k]).collect();
