@@ -365,24 +365,34 @@ fn direction(q: &Map<String, Value>, key: &str) -> Result<Vec3, EvalError> {
     }
 }
 
+/// Test helpers shared by the unit tests of every `eval` module.
 #[cfg(test)]
-mod tests {
-    use super::*;
+pub(crate) mod testing {
+    use super::answer_line;
+    use serde_json::Value;
 
-    fn value(line: &str) -> Value {
+    /// The value of an answer line; panics on an error line.
+    pub(crate) fn value(line: &str) -> Value {
         let a = answer_line(line);
         a.get("value")
             .cloned()
             .unwrap_or_else(|| panic!("expected a value for {line}, got {a}"))
     }
 
-    fn error_kind(line: &str) -> String {
+    /// The error kind of an answer line; panics on a value line.
+    pub(crate) fn error_kind(line: &str) -> String {
         let a = answer_line(line);
         a["error"]["kind"]
             .as_str()
             .unwrap_or_else(|| panic!("expected an error for {line}, got {a}"))
             .to_string()
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::testing::{error_kind, value};
+    use super::*;
 
     #[test]
     fn std_lambda_matches_library() {

@@ -257,24 +257,8 @@ fn asg(q: &Map<String, Value>) -> Result<Asg, EvalError> {
 
 #[cfg(test)]
 mod tests {
-    use crate::eval::answer_line;
+    use crate::eval::testing::{error_kind, value};
     use mfh_reference::sg::{Asg, Sg};
-    use serde_json::Value;
-
-    fn value(line: &str) -> Value {
-        let a = answer_line(line);
-        a.get("value")
-            .cloned()
-            .unwrap_or_else(|| panic!("expected a value for {line}, got {a}"))
-    }
-
-    fn error_kind(line: &str) -> String {
-        let a = answer_line(line);
-        a["error"]["kind"]
-            .as_str()
-            .unwrap_or_else(|| panic!("expected an error for {line}, got {a}"))
-            .to_string()
-    }
 
     const A: &str = r#"{"axis":[0,0,1],"sharpness":10,"amplitude":2}"#;
     const B: &str = r#"{"axis":[0,0.6,0.8],"sharpness":3}"#;
