@@ -58,6 +58,10 @@ impl Profile {
     }
 }
 
+/// The smallest θ ≠ 0 the `slope_space` Λ route accepts (its nested quadrature costs 0.3 s at
+/// θ = 1e-4 and did not finish in 15 minutes at 1e-5).
+pub const SLOPE_SPACE_MIN_THETA: f64 = 1e-3;
+
 /// The piecewise-linear NDF of seed 000 with one profile (isotropic) or two (the anisotropic
 /// blend of eq 1).
 ///
@@ -594,6 +598,19 @@ impl Smith for PiecewiseLinear {
                 routes::domain_split(self, t, c2, Remaining::Adaptive).lambda
             }),
             "slope_space" => {
+                // Nested adaptive quadrature: 0.3 s per Λ at θ = 1e-4 and no answer within
+                // 15 minutes at θ = 1e-5 (measured), so near the normal it refuses rather than
+                // hang; θ = 0 itself (Λ = 0) is exact.
+                let theta = (w[0].hypot(w[1])).atan2(w[2].abs());
+                if theta > 0.0 && theta < SLOPE_SPACE_MIN_THETA {
+                    return Err(QueryError::Route {
+                        route: route.to_string(),
+                        reason: format!(
+                            "slope_space needs θ ≥ {SLOPE_SPACE_MIN_THETA} or θ = 0 (got {theta:e}): \
+                             its nested quadrature does not finish near the normal; use \"exact\""
+                        ),
+                    });
+                }
                 routes::both_hemispheres(w, |t, c2| routes::lambda_slope_space(self, t, c2))
             }
             _ => {
@@ -956,6 +973,19 @@ pub(crate) mod tests {
             }
         }
         eprintln!("64-point profiles: Λ exact max rel err against the integral of D: {worst:.2e}");
+    }
+
+    #[test]
+    fn slope_space_refuses_near_normal_incidence_instead_of_hanging() {
+        let (_, m) = small_models().into_iter().next().unwrap();
+        for &t in &[1e-5, 1e-4] {
+            let e = m.lambda_route(from_spherical(t, 0.0), "slope_space");
+            assert!(matches!(e, Err(QueryError::Route { .. })), "θ={t}: {e:?}");
+        }
+        assert_eq!(m.lambda_route([0.0, 0.0, 1.0], "slope_space").unwrap(), 0.0);
+        assert!(m
+            .lambda_route(from_spherical(1e-3, 0.0), "slope_space")
+            .is_ok());
     }
 
     #[test]
