@@ -63,20 +63,6 @@ pub fn student_lambda(c: f64, x: f64) -> f64 {
     n * w_power / x * numerator / denominator
 }
 
-/// Seed 001 eq 21 in standardized form, term by term as printed (A − ½ + N x ₂F₁): kept to
-/// show the cancellation the stable form avoids.
-pub fn student_lambda_eq21(c: f64, x: f64) -> f64 {
-    if x == 0.0 {
-        return f64::INFINITY;
-    }
-    if x == f64::INFINITY {
-        return 0.0;
-    }
-    let n = student_norm(c);
-    let a = n * ((1.5 - c) * (x * x).ln_1p()).exp() / ((2.0 * c - 3.0) * x);
-    a + n * x * super::hyp2f1::hyp2f1_lambda(c, -x * x) - 0.5
-}
-
 /// Below this, Beckmann Λ is the direct difference; above, the continued fraction.
 const BECKMANN_SWITCH: f64 = 1.5;
 
@@ -170,11 +156,16 @@ mod tests {
         // At C = 3, a = 30 the two terms of eq 21 agree to ~6 digits: eq 21 loses them.
         let (c, x) = (3.0, 30.0 / 2f64.sqrt());
         let stable = student_lambda(c, x);
-        let printed = student_lambda_eq21(c, x);
+        let printed = crate::ndf::student_lambda::lambda_2f1(c, x);
         assert!(rel_err(printed, stable) > 1e-12, "{printed} vs {stable}");
         // …but agrees where Λ is not small.
         let x = 0.5;
-        assert!(rel_err(student_lambda_eq21(c, x), student_lambda(c, x)) < 1e-14);
+        assert!(
+            rel_err(
+                crate::ndf::student_lambda::lambda_2f1(c, x),
+                student_lambda(c, x)
+            ) < 1e-14
+        );
     }
 
     #[test]
