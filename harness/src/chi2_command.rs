@@ -161,7 +161,7 @@ fn finite_or_null(x: f64) -> Value {
 
 /// Writes the observed and expected counts as JSON tables (rows of cos θ, row 0 at the
 /// horizon; columns of φ from 0).
-fn write_tables(dir: &Path, result: &Chi2Result) -> std::io::Result<()> {
+pub fn write_tables(dir: &Path, result: &Chi2Result) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     let columns = 2 * result.resolution;
     let layout = format!(

@@ -3,8 +3,11 @@
 //!
 //! The binary `mfh` is a thin layer over [`cli::run`].
 
+pub mod check;
 pub mod chi2_command;
 pub mod cli;
 pub mod eval;
 pub mod eval_sg;
 pub mod oracle;
+pub mod record;
+pub mod tolerance;

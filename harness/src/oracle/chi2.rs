@@ -260,7 +260,7 @@ where
     Expected {
         mass: estimates.iter().map(|e| e.value).collect(),
         total: estimates.iter().map(|e| e.value).sum(),
-        error_bound: estimates.iter().map(|e| e.error).sum(),
+        error_bound: estimates.iter().map(|e| e.error_bound).sum(),
         evaluations: estimates.iter().map(|e| e.evaluations).sum(),
     }
 }

@@ -6,17 +6,7 @@ use mfh_reference::special::gauss_kronrod::{WG, WGK, XGK};
 /// The deepest quadrant bisection; past it the estimate is accepted with its error.
 pub const MAX_DEPTH: u32 = 10;
 
-/// An integral estimate with its error bound.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Estimate {
-    /// The K15 × K15 value.
-    pub value: f64,
-    /// |K15×K15 − G7×G7| summed over the accepted sub-rectangles: a bound on the error of the
-    /// value for smooth integrands (the G7 product rule is itself exact to degree 13).
-    pub error: f64,
-    /// Integrand evaluations spent.
-    pub evaluations: u64,
-}
+pub use super::Estimate;
 
 /// The 15 nodes and K15 / G7 weights on [a, b] (G7 weight 0 at the Kronrod-only nodes).
 fn rule(a: f64, b: f64) -> ([f64; 15], [f64; 15], [f64; 15]) {
@@ -83,7 +73,7 @@ pub fn integrate_rectangle(
         let (value, error) = whole.unwrap_or_else(|| product_rule(f, x, y));
         let mut out = Estimate {
             value,
-            error,
+            error_bound: error,
             evaluations: if whole.is_some() { 0 } else { 225 },
         };
         if !(error > tolerance) || depth >= MAX_DEPTH {
@@ -98,7 +88,7 @@ pub fn integrate_rectangle(
             for ys in [[y[0], ym], [ym, y[1]]] {
                 let part = go(f, xs, ys, 0.25 * tolerance, depth + 1, None);
                 sum.value += part.value;
-                sum.error += part.error;
+                sum.error_bound += part.error_bound;
                 sum.evaluations += part.evaluations;
             }
         }
@@ -139,7 +129,7 @@ mod tests {
         let fine = integrate_rectangle(&f, [-1.0, 1.0], [-1.0, 1.0], abs(1e-12));
         assert!(e.evaluations > 225);
         assert!(
-            (e.value - fine.value).abs() <= e.error.max(1e-9),
+            (e.value - fine.value).abs() <= e.error_bound.max(1e-9),
             "{e:?} {fine:?}"
         );
         let g = |x: f64, y: f64| (x + 2.0 * y).exp();

@@ -4,3 +4,17 @@
 pub mod chi2;
 pub mod cubature;
 pub mod domain;
+pub mod monte_carlo;
+pub mod quadrature;
+
+/// An integral (or other numerical) estimate with a bound on its error.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct Estimate {
+    /// The value.
+    pub value: f64,
+    /// A bound on |value − truth| (for quadrature: the summed local error estimates, which
+    /// bound the error for integrands smooth on each piece).
+    pub error_bound: f64,
+    /// Integrand evaluations spent.
+    pub evaluations: u64,
+}

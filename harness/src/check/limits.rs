@@ -1,0 +1,102 @@
+//! Limits: the Student-t family tends to Beckmann as γ → ∞ (seed 001 §4), at the measured rate
+//! O(1/γ), for D and Λ.
+
+use super::{applied, covers, timed, Planned};
+use crate::record::{relative_error, CheckRecord, Measured, Verdict};
+use crate::tolerance::LIMIT_RATE;
+use mfh_reference::geometry::from_spherical;
+use mfh_reference::ModelSpec;
+use serde_json::json;
+
+const GAMMAS: [f64; 4] = [1e2, 1e4, 1e6, 1e8];
+
+/// Least-squares slope of ln e against ln γ.
+fn fitted_exponent(gammas: &[f64], errors: &[f64]) -> f64 {
+    let xs: Vec<f64> = gammas.iter().map(|g| g.ln()).collect();
+    let ys: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
+    let n = xs.len() as f64;
+    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
+    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
+    sxy / sxx
+}
+
+/// Plans the γ → ∞ checks for an STD material of roughness `alpha`.
+pub fn plan(alpha: f64, why: &str) -> Vec<Planned> {
+    ["d", "lambda"]
+        .into_iter()
+        .map(|quantity| {
+            let case =
+                json!({"quantity": quantity, "alpha": alpha, "theta": 0.5, "gammas": GAMMAS});
+            let case_run = case.clone();
+            Planned {
+                check: "limits.std_to_beckmann".into(),
+                model: json!({"family": "std", "gamma": "→∞", "alpha": alpha}),
+                case,
+                why: format!("{why}: STD must reach Beckmann as γ → ∞ at rate 1/γ"),
+                covers: vec![covers("std", quantity, "default")],
+                statistical: false,
+                run: Box::new(move |_| {
+                    timed(|| {
+                        let mut r = CheckRecord::new(
+                            "limits.std_to_beckmann",
+                            json!({"family": "std", "gamma": "→∞", "alpha": alpha}),
+                            case_run.clone(),
+                            "seed 001 §4 (γ → ∞: STD → Beckmann), Table 1 (γ = ∞ row)",
+                        );
+                        r.covers = vec![covers("std", quantity, "default")];
+                        let w = from_spherical(0.5, 0.0);
+                        let eval = |spec: ModelSpec| -> Option<f64> {
+                            let m = spec.build().ok()?;
+                            Some(if quantity == "d" {
+                                m.d(w)
+                            } else {
+                                m.as_smith()?.lambda(w)
+                            })
+                        };
+                        let std = |g: f64| ModelSpec::Std {
+                            gamma: g,
+                            alpha: Some(alpha),
+                            alpha_x: None,
+                            alpha_y: None,
+                        };
+                        let (Some(limit), Some(at_inf)) = (
+                            eval(ModelSpec::Beckmann {
+                                alpha: Some(alpha),
+                                alpha_x: None,
+                                alpha_y: None,
+                            }),
+                            eval(std(f64::INFINITY)),
+                        ) else {
+                            r.verdict = Verdict::Error {
+                                message: "cannot build the models".into(),
+                            };
+                            return r;
+                        };
+                        let errors: Vec<f64> = GAMMAS
+                            .iter()
+                            .map(|&g| eval(std(g)).map_or(f64::NAN, |v| relative_error(v, limit)))
+                            .collect();
+                        let exponent = fitted_exponent(&GAMMAS, &errors);
+                        r.value = Some(exponent);
+                        r.measured = Some(Measured::Rate {
+                            exponent,
+                            expected: -1.0,
+                        });
+                        r.tolerance = Some(applied(&LIMIT_RATE));
+                        r.case = json!({"quantity": quantity, "alpha": alpha, "theta": 0.5,
+                                        "gammas": GAMMAS, "relative_errors": errors,
+                                        "gamma_inf_equals_beckmann": at_inf == limit});
+                        r.verdict = if (exponent + 1.0).abs() <= LIMIT_RATE.value && at_inf == limit
+                        {
+                            Verdict::Pass
+                        } else {
+                            Verdict::Fail
+                        };
+                        r
+                    })
+                }),
+            }
+        })
+        .collect()
+}

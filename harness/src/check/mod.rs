@@ -1,0 +1,183 @@
+//! Checks: one property family per file, each planning cases for a model and turning each case
+//! into a [`CheckRecord`] against an oracle (DESIGN.md, "Checks and records"). A check never
+//! panics and never asserts; only the audit's verdicts decide.
+
+pub mod limits;
+pub mod moments;
+pub mod normalization;
+pub mod sampling;
+pub mod smith;
+pub mod stability;
+
+use crate::oracle::Estimate;
+use crate::record::{
+    relative_error, AppliedTolerance, CheckRecord, Measured, OracleValue, Verdict,
+};
+use crate::tolerance::Tolerance;
+use serde::Serialize;
+use serde_json::Value;
+use std::path::PathBuf;
+
+/// How hard an audit looks: the size of the case grids and of the statistical samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum Profile {
+    /// A few cases per property, 2·10⁵ samples per sampler: ≤ 60 s on 2 cores.
+    Quick,
+    /// More incidence angles and 2·10⁶ samples per sampler: ≤ 10 minutes.
+    Standard,
+    /// Dense grids and 2·10⁷ samples per sampler.
+    Thorough,
+}
+
+impl Profile {
+    /// Incidence angles θ (radians) at which direction-dependent properties are checked,
+    /// including the hard cases (near normal and near grazing incidence), capped at `theta_max`.
+    pub fn thetas(self, theta_max: f64) -> Vec<f64> {
+        let all: &[f64] = match self {
+            Profile::Quick => &[1e-3, 0.5, 1.2, 1.5],
+            Profile::Standard => &[1e-6, 1e-3, 0.2, 0.5, 0.9, 1.2, 1.4, 1.55],
+            Profile::Thorough => &[
+                1e-8, 1e-6, 1e-4, 1e-2, 0.1, 0.3, 0.5, 0.7, 0.9, 1.1, 1.2, 1.3, 1.4, 1.5, 1.55,
+                1.57,
+            ],
+        };
+        all.iter().copied().filter(|t| *t <= theta_max).collect()
+    }
+
+    /// Samples per chi-square test.
+    pub fn chi2_samples(self) -> u64 {
+        match self {
+            Profile::Quick => 200_000,
+            Profile::Standard => 2_000_000,
+            Profile::Thorough => 20_000_000,
+        }
+    }
+
+    /// The name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Profile::Quick => "quick",
+            Profile::Standard => "standard",
+            Profile::Thorough => "thorough",
+        }
+    }
+}
+
+/// What a running check may use: its seed and where to write artefacts.
+#[derive(Debug, Clone)]
+pub struct RunContext {
+    /// The seed of this check's random stream (derived from the audit seed and the check's id
+    /// and case, so that order and thread count do not matter).
+    pub seed: u64,
+    /// The folder for artefacts (heat maps, tables), if any.
+    pub out: Option<PathBuf>,
+}
+
+/// The function that runs a planned check.
+pub type Runner = Box<dyn Fn(&RunContext) -> CheckRecord + Send + Sync>;
+
+/// One planned check: what it is, why the planner chose it, and how to run it.
+pub struct Planned {
+    /// The check id, `family.property`.
+    pub check: String,
+    /// The model spec (JSON), or null.
+    pub model: Value,
+    /// The case.
+    pub case: Value,
+    /// Why the planner planned it (the scene effect that calls for it).
+    pub why: String,
+    /// The closed forms it exercises (`family/quantity/route`).
+    pub covers: Vec<String>,
+    /// Whether its verdict is statistical (it takes a share of the audit's α).
+    pub statistical: bool,
+    /// Runs it.
+    pub run: Runner,
+}
+
+impl std::fmt::Debug for Planned {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Planned")
+            .field("check", &self.check)
+            .field("model", &self.model)
+            .field("case", &self.case)
+            .field("why", &self.why)
+            .finish()
+    }
+}
+
+/// Fills `record` with the comparison of `value` against the oracle's estimate: relative error
+/// (absolute where the oracle is 0), pass when it is within `tolerance` plus the oracle's own
+/// relative error bound.
+pub fn compare(record: &mut CheckRecord, value: f64, oracle: Estimate, tolerance: &Tolerance) {
+    record.value = Some(value);
+    record.oracle = Some(OracleValue {
+        value: oracle.value,
+        uncertainty: oracle.error_bound,
+        kind: "error_bound",
+    });
+    record.cost.evaluations += oracle.evaluations;
+    let error = relative_error(value, oracle.value);
+    let allowed = tolerance.value + relative_error(oracle.value + oracle.error_bound, oracle.value);
+    record.measured = Some(if oracle.value == 0.0 {
+        Measured::Absolute { error }
+    } else {
+        Measured::Relative { error }
+    });
+    record.tolerance = Some(applied(tolerance));
+    record.verdict = if !value.is_finite() || !oracle.value.is_finite() {
+        Verdict::Fail
+    } else if error <= allowed {
+        Verdict::Pass
+    } else {
+        Verdict::Fail
+    };
+}
+
+/// Fills `record` with the comparison of two evaluations that must agree (no oracle error).
+pub fn compare_exact(record: &mut CheckRecord, value: f64, expected: f64, tolerance: &Tolerance) {
+    compare(
+        record,
+        value,
+        Estimate {
+            value: expected,
+            error_bound: 0.0,
+            evaluations: 0,
+        },
+        tolerance,
+    );
+}
+
+/// The record form of a tolerance.
+pub fn applied(tolerance: &Tolerance) -> AppliedTolerance {
+    AppliedTolerance {
+        name: tolerance.name,
+        value: tolerance.value,
+        reason: tolerance.reason,
+    }
+}
+
+/// Turns a failing verdict into an expected failure when the tolerance table lists one for
+/// (check, family, route).
+pub fn apply_expected(record: &mut CheckRecord, family: &str, route: &str) {
+    if record.verdict == Verdict::Fail {
+        if let Some(e) = crate::tolerance::expected_failure(&record.check, family, route) {
+            record.verdict = Verdict::ExpectedFailure {
+                reason: format!("[{}] {}", e.erratum, e.reason),
+            };
+        }
+    }
+}
+
+/// Times `f` into `record.cost.wall_seconds` and returns the record.
+pub fn timed(f: impl FnOnce() -> CheckRecord) -> CheckRecord {
+    let t = std::time::Instant::now();
+    let mut r = f();
+    r.cost.wall_seconds += t.elapsed().as_secs_f64();
+    r
+}
+
+/// The closed-form id `family/quantity/route` used by coverage.
+pub fn covers(family: &str, quantity: &str, route: &str) -> String {
+    format!("{family}/{quantity}/{route}")
+}

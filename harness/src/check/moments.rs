@@ -1,0 +1,112 @@
+//! Slope moments: ν₂ₖ, variance and excess kurtosis against integrals of P2, the marginal
+//! P2 = ∫P22 dp, and the normalization ∫P2 dq = 1 (seed 001 eq 4, 6–7, 15; seed 002 eq 2–10).
+
+use super::normalization::lobe_width;
+use super::{compare, covers, timed, Planned};
+use crate::oracle::quadrature::{integrate_line, Accuracy};
+use crate::oracle::Estimate;
+use crate::record::{CheckRecord, Verdict};
+use crate::tolerance::MOMENT;
+use mfh_reference::Model;
+use serde_json::{json, Value};
+use std::sync::Arc;
+
+const SOURCE: &str = "seed 001 eq 4, 6–7, 15 (ν₂ₖ = ∫ q^{2k} P2(q) dq); seed 002 eq 2–10";
+
+/// The quantities checked, with the closed form each covers.
+const QUANTITIES: &[(&str, &str)] = &[
+    ("p2_normalization", "p2"),
+    ("p22_marginal", "p22"),
+    ("nu2", "slope_moment"),
+    ("nu4", "slope_moment"),
+    ("variance", "slope_moment"),
+    ("excess_kurtosis", "slope_moment"),
+];
+
+/// Plans the moment checks of one slope-space model.
+pub fn plan(model: Arc<dyn Model>, why: &str) -> Vec<Planned> {
+    if model.as_slopes().is_none() {
+        return Vec::new();
+    }
+    let spec = serde_json::to_value(model.spec()).unwrap_or(Value::Null);
+    let family = model.family();
+    let phi = 0.7;
+    QUANTITIES
+        .iter()
+        .map(|&(quantity, closed)| {
+            let (m, spec_run) = (model.clone(), spec.clone());
+            let case = json!({"quantity": quantity, "phi": phi});
+            let case_run = case.clone();
+            Planned {
+                check: "moments.slopes".into(),
+                model: spec.clone(),
+                case,
+                why: format!("{why}: slope-space quantity {quantity}"),
+                covers: vec![covers(family, closed, "default")],
+                statistical: false,
+                run: Box::new(move |_| {
+                    timed(|| {
+                        let mut r =
+                            CheckRecord::new("moments.slopes", spec_run.clone(), case_run.clone(), SOURCE);
+                        r.covers = vec![covers(family, closed, "default")];
+                        let slopes = m.as_slopes().expect("planned for slope models");
+                        let scale = lobe_width(&spec_run).tan().max(1e-6);
+                        let acc = Accuracy::relative(1e-12);
+                        let raw = |k: i32| {
+                            integrate_line(&|q| q.powi(k) * slopes.p2(q, phi), 0.0, scale, acc)
+                        };
+                        let finite = |k: u32| slopes.slope_moment(k, phi);
+                        let (value, oracle): (Option<f64>, Estimate) = match quantity {
+                            "p2_normalization" => {
+                                let e = raw(0);
+                                (Some(e.value), Estimate { value: 1.0, error_bound: e.error_bound, evaluations: e.evaluations })
+                            }
+                            "p22_marginal" => {
+                                // P2 along x (φ = 0) at q = scale/2 is ∫ P22(q, p) dp.
+                                let q = 0.5 * scale;
+                                let e = integrate_line(&|p| slopes.p22(q, p), 0.0, scale, acc);
+                                (Some(slopes.p2(q, 0.0)), e)
+                            }
+                            "nu2" => (finite(1), raw(2)),
+                            "nu4" => (finite(2), raw(4)),
+                            "variance" | "excess_kurtosis" => {
+                                let (m1, m2) = (raw(1), raw(2));
+                                let mean = m1.value;
+                                let central = |k: i32| {
+                                    integrate_line(&|q| (q - mean).powi(k) * slopes.p2(q, phi), mean, scale, acc)
+                                };
+                                let var = central(2);
+                                if quantity == "variance" {
+                                    (slopes.variance(phi), Estimate { value: var.value, error_bound: var.error_bound + m2.error_bound, evaluations: var.evaluations + m1.evaluations + m2.evaluations })
+                                } else {
+                                    let c4 = central(4);
+                                    let v = c4.value / (var.value * var.value) - 3.0;
+                                    let bound = (c4.error_bound / c4.value.abs() + 2.0 * var.error_bound / var.value.abs()) * (v + 3.0).abs();
+                                    (slopes.excess_kurtosis(), Estimate { value: v, error_bound: bound, evaluations: c4.evaluations + var.evaluations })
+                                }
+                            }
+                            _ => (None, Estimate::default()),
+                        };
+                        match value {
+                            Some(v) => compare(&mut r, v, oracle, &MOMENT),
+                            None => {
+                                // Undefined moments must belong to a divergent integral: the
+                                // oracle's estimate must not settle (or be infinite).
+                                let settled = oracle.value.is_finite()
+                                    && oracle.error_bound <= 1e-6 * oracle.value.abs();
+                                r.oracle = Some(crate::record::OracleValue { value: oracle.value, uncertainty: oracle.error_bound, kind: "error_bound" });
+                                r.verdict = if settled {
+                                    Verdict::Fail
+                                } else {
+                                    Verdict::Pass
+                                };
+                                r.case = json!({"quantity": quantity, "phi": phi, "closed_form": "undefined (diverges)"});
+                            }
+                        }
+                        r
+                    })
+                }),
+            }
+        })
+        .collect()
+}

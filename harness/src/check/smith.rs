@@ -1,0 +1,307 @@
+//! Smith masking: every Λ route against the oracle (∫(q − μ)P2 dq for slope-space models,
+//! ∫⟨−w·m⟩⁺D(m)dm otherwise), the weak white furnace ∫G1(w,m)⟨w·m⟩⁺D(m)dm = cos θ, and the
+//! identities Λ(−w) = −1 − Λ(w), 0 ≤ G1 ≤ 1, G2 ≤ min G1.
+
+use super::normalization::lobe_width;
+use super::{apply_expected, compare, compare_exact, covers, timed, Planned, Profile};
+use crate::oracle::quadrature::{integrate_hemisphere, integrate_upper, Accuracy, Cuts};
+use crate::oracle::Estimate;
+use crate::record::{CheckRecord, Measured, Verdict};
+use crate::tolerance::{CLOSED_FORM, IDENTITY, NUMERICAL_ROUTE};
+use mfh_reference::geometry::{dot, from_spherical};
+use mfh_reference::{Masking, Model, Vec3};
+use serde_json::{json, Value};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::sync::Arc;
+
+const SOURCE_LAMBDA: &str =
+    "seed 001 eq 5 (Λ = (1/μ)∫_μ^∞ (q − μ) P2(q) dq), eq 16–21; seed 004 §2; seed 000 eq 10–13";
+
+/// Whether a family's default Λ is itself a numerical integral.
+fn numerical_default(family: &str) -> bool {
+    matches!(family, "gtr" | "piecewise_linear" | "blend")
+}
+
+/// The terminator of w on the hemisphere of normals: for azimuth φ_m, the polar angle where
+/// w·m = 0 (none when it lies below the horizon).
+fn terminator(w: Vec3) -> impl Fn(f64) -> Vec<f64> {
+    let (st, ct) = ((w[0] * w[0] + w[1] * w[1]).sqrt(), w[2]);
+    let phi_w = w[1].atan2(w[0]);
+    move |phi: f64| {
+        let c = (phi - phi_w).cos();
+        if c < 0.0 && st > 0.0 {
+            vec![(ct / (-c * st)).atan()]
+        } else {
+            vec![]
+        }
+    }
+}
+
+/// The azimuths where the terminator's polar angle has kinks: φ_w ± π/2 and φ_w + π, in [0, 2π).
+fn terminator_azimuths(w: Vec3) -> Vec<f64> {
+    let phi_w = w[1].atan2(w[0]);
+    [0.5 * PI, PI, 1.5 * PI]
+        .iter()
+        .map(|d| (phi_w + d).rem_euclid(TAU))
+        .collect()
+}
+
+/// The oracle of Λ(w): (1/μ)∫_μ^∞ (q − μ) P2(q) dq along the azimuth of w for slope-space
+/// models; otherwise ∫⟨−w·m⟩⁺ D(m) dm / cos θ (the back-facing projected area, which equals
+/// Λ cos θ without the cancellation of ∫⟨w·m⟩⁺D dm − cos θ).
+pub fn lambda_oracle(model: &dyn Model, spec: &Value, w: Vec3) -> Estimate {
+    let (sin_t, cos_t) = ((w[0] * w[0] + w[1] * w[1]).sqrt(), w[2]);
+    if cos_t >= 1.0 || sin_t == 0.0 {
+        return Estimate::default();
+    }
+    let accuracy = Accuracy::relative(1e-12);
+    if let Some(slopes) = model.as_slopes() {
+        let mu = cos_t / sin_t;
+        let phi = w[1].atan2(w[0]);
+        let scale = lobe_width(spec).tan().max(1e-6);
+        let e = integrate_upper(&|q| (q - mu) * slopes.p2(q, phi), mu, scale, accuracy);
+        return Estimate {
+            value: e.value / mu,
+            error_bound: e.error_bound / mu,
+            evaluations: e.evaluations,
+        };
+    }
+    let theta_cut = terminator(w);
+    let phis = terminator_azimuths(w);
+    let e = integrate_hemisphere(
+        &|m| {
+            let c = -dot(w, m);
+            if c > 0.0 {
+                c * model.d(m)
+            } else {
+                0.0
+            }
+        },
+        lobe_width(spec),
+        Some(Cuts {
+            theta: &theta_cut,
+            phi: &phis,
+        }),
+        accuracy,
+    );
+    Estimate {
+        value: e.value / cos_t,
+        error_bound: e.error_bound / cos_t,
+        evaluations: e.evaluations,
+    }
+}
+
+/// Directions (θ, φ) at which direction-dependent checks run: the profile's θ grid, along x
+/// and, for anisotropic models, along a second azimuth.
+pub fn directions(spec: &Value, profile: Profile, theta_max: f64) -> Vec<(f64, f64)> {
+    let anisotropic = spec.get("alpha_x").is_some()
+        || spec.get("y").is_some()
+        || spec.get("cov").is_some()
+        || spec.get("mean").is_some();
+    let phis: &[f64] = if anisotropic { &[0.0, 2.2] } else { &[0.0] };
+    let mut out = Vec::new();
+    for t in profile.thetas(theta_max) {
+        for p in phis {
+            out.push((t, *p));
+        }
+    }
+    out
+}
+
+/// Plans the Smith checks of one model.
+pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) -> Vec<Planned> {
+    let Some(smith) = model.as_smith() else {
+        return Vec::new();
+    };
+    let spec = serde_json::to_value(model.spec()).unwrap_or(Value::Null);
+    let family = model.family();
+    let mut out = Vec::new();
+    for route in smith.lambda_routes() {
+        for (theta, phi) in directions(&spec, profile, theta_max) {
+            let case = json!({"route": route, "theta": theta, "phi": phi});
+            let (m, spec_run, case_run) = (model.clone(), spec.clone(), case.clone());
+            out.push(Planned {
+                check: "smith.lambda_route".into(),
+                model: spec.clone(),
+                case,
+                why: format!("{why}: Λ by route `{route}`"),
+                covers: vec![covers(family, "lambda", route)],
+                statistical: false,
+                run: Box::new(move |_| {
+                    timed(|| {
+                        let mut r = CheckRecord::new(
+                            "smith.lambda_route",
+                            spec_run.clone(),
+                            case_run.clone(),
+                            SOURCE_LAMBDA,
+                        );
+                        r.covers = vec![covers(family, "lambda", route)];
+                        let w = from_spherical(theta, phi);
+                        let smith = m.as_smith().expect("planned for Smith models");
+                        let value = match smith.lambda_route(w, route) {
+                            Ok(v) => v,
+                            Err(e) => {
+                                r.verdict = Verdict::Skipped {
+                                    reason: format!("route does not apply: {e}"),
+                                };
+                                return r;
+                            }
+                        };
+                        let oracle = lambda_oracle(m.as_ref(), &spec_run, w);
+                        let tol =
+                            if numerical_default(family) && matches!(route, "default" | "exact") {
+                                &NUMERICAL_ROUTE
+                            } else {
+                                &CLOSED_FORM
+                            };
+                        compare(&mut r, value, oracle, tol);
+                        apply_expected(&mut r, family, route);
+                        r
+                    })
+                }),
+            });
+        }
+    }
+    // The weak white furnace at two incidences.
+    for theta in [0.6, 1.3].into_iter().filter(|t| *t <= theta_max) {
+        let case = json!({"theta": theta, "phi": 0.4});
+        let (m, spec_run, case_run) = (model.clone(), spec.clone(), case.clone());
+        out.push(Planned {
+            check: "smith.white_furnace".into(),
+            model: spec.clone(),
+            case,
+            why: format!("{why}: G1 must conserve the projected area"),
+            covers: vec![covers(family, "g1", "default")],
+            statistical: false,
+            run: Box::new(move |_| {
+                timed(|| {
+                    let mut r = CheckRecord::new(
+                        "smith.white_furnace",
+                        spec_run.clone(),
+                        case_run.clone(),
+                        "seed 001 eq 16 with the projected-area constraint ∫G1⟨w·m⟩⁺D dm = cos θ \
+                         (Heitz 2014, eq 17)",
+                    );
+                    r.covers = vec![covers(family, "g1", "default")];
+                    let w = from_spherical(theta, 0.4);
+                    let smith = m.as_smith().expect("planned for Smith models");
+                    let theta_cut = terminator(w);
+                    let phis = terminator_azimuths(w);
+                    let e = integrate_hemisphere(
+                        &|mm| {
+                            let c = dot(w, mm);
+                            if c > 0.0 {
+                                smith.g1(w, mm) * c * m.d(mm)
+                            } else {
+                                0.0
+                            }
+                        },
+                        lobe_width(&spec_run),
+                        Some(Cuts {
+                            theta: &theta_cut,
+                            phi: &phis,
+                        }),
+                        Accuracy::relative(1e-11),
+                    );
+                    let tol = if numerical_default(family) {
+                        &NUMERICAL_ROUTE
+                    } else {
+                        &CLOSED_FORM
+                    };
+                    // The closed form enters through G1; the integral is the value under test.
+                    compare(&mut r, e.value, Estimate { value: w[2], ..e }, tol);
+                    if let Some(o) = r.oracle.as_mut() {
+                        o.uncertainty = 0.0;
+                    }
+                    let allowed = tol.value + e.error_bound / w[2];
+                    if let Some(Measured::Relative { error }) = r.measured {
+                        r.verdict = if error <= allowed {
+                            Verdict::Pass
+                        } else {
+                            Verdict::Fail
+                        };
+                    }
+                    r
+                })
+            }),
+        });
+    }
+    // Identities over a grid of directions.
+    let (m, spec_run) = (model.clone(), spec.clone());
+    let covered = vec![
+        covers(family, "g1", "default"),
+        covers(family, "g2", "uncorrelated"),
+        covers(family, "g2", "height_correlated"),
+    ];
+    let covered_run = covered.clone();
+    out.push(Planned {
+        check: "smith.identities".into(),
+        model: spec.clone(),
+        case: json!({"grid": "θ ∈ {0, …, π/2} × φ ∈ {0, 1, 2.5, 4}"}),
+        why: format!("{why}: Λ(−w) = −1 − Λ(w), 0 ≤ G1 ≤ 1, G2 ≤ min G1, Λ(n) = 0, G1(π/2) = 0"),
+        covers: covered,
+        statistical: false,
+        run: Box::new(move |_| {
+            timed(|| {
+                let mut r = CheckRecord::new(
+                    "smith.identities",
+                    spec_run.clone(),
+                    json!({"grid": "θ ∈ {0, …, π/2} × φ ∈ {0, 1, 2.5, 4}"}),
+                    "Heitz 2014 §5.2 (Λ(−w) = −1 − Λ(w)); seed 001 eq 16, 22, 23",
+                );
+                r.covers = covered_run.clone();
+                let smith = m.as_smith().expect("planned for Smith models");
+                let mut worst = 0.0f64;
+                let mut what = String::new();
+                let mut note = |v: f64, label: String| {
+                    if !(v <= worst) {
+                        worst = if v.is_nan() { f64::INFINITY } else { v };
+                        what = label;
+                    }
+                };
+                let thetas = [0.0, 1e-6, 0.3, 0.8, 1.2, 1.5, FRAC_PI_2 - 1e-6];
+                let phis = [0.0, 1.0, 2.5, 4.0];
+                let n = [0.0, 0.0, 1.0];
+                let l0 = smith.lambda(n);
+                note(l0.abs(), format!("Λ(n) = {l0}"));
+                let g_grazing = smith.g1(from_spherical(FRAC_PI_2, 0.3), n);
+                note(g_grazing.abs(), format!("G1(π/2) = {g_grazing}"));
+                for &t in &thetas {
+                    for &p in &phis {
+                        let w = from_spherical(t, p);
+                        let l = smith.lambda(w);
+                        let lm = smith.lambda([-w[0], -w[1], -w[2]]);
+                        let d = (lm + 1.0 + l).abs() / (1.0 + l);
+                        note(d, format!("Λ(−w) + 1 + Λ(w) at θ = {t}, φ = {p}"));
+                        note(-l, format!("Λ < 0 at θ = {t}, φ = {p}"));
+                        let g = smith.g1(w, n);
+                        note((g - 1.0).max(0.0).max(-g), format!("G1 = {g} at θ = {t}"));
+                        for &t2 in &thetas[..4] {
+                            let wi = from_spherical(t2, p + 1.0);
+                            let gi = smith.g1(wi, n);
+                            for masking in [Masking::Uncorrelated, Masking::HeightCorrelated] {
+                                let g2 = smith.g2(w, wi, n, masking);
+                                note(
+                                    (g2 - g.min(gi)).max(0.0).max(-g2),
+                                    format!("G2 {masking:?} = {g2} > min G1 = {}", g.min(gi)),
+                                );
+                            }
+                        }
+                    }
+                }
+                compare_exact(&mut r, worst, 0.0, &IDENTITY);
+                r.measured = Some(Measured::Absolute { error: worst });
+                r.verdict = if worst <= IDENTITY.value {
+                    Verdict::Pass
+                } else {
+                    Verdict::Fail
+                };
+                if r.verdict == Verdict::Fail {
+                    r.case = json!({"worst": what});
+                }
+                r
+            })
+        }),
+    });
+    out
+}

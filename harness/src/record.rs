@@ -1,0 +1,201 @@
+//! CheckRecord: what one check of one property of one model at one case found, and the schema
+//! version of the records (DESIGN.md, "Checks and records").
+
+use serde::Serialize;
+use serde_json::Value;
+
+/// The version of the record schema written into `report.json`; bump it when a field changes
+/// meaning or disappears (adding a field keeps the version).
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// The outcome of a check.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "verdict", rename_all = "snake_case")]
+pub enum Verdict {
+    /// The property holds within the tolerance.
+    Pass,
+    /// The property does not hold.
+    Fail,
+    /// The property does not hold, as expected: a printed formula with an erratum, or a route
+    /// outside its domain of accuracy. `reason` says which.
+    ExpectedFailure {
+        /// Why the failure is expected (an erratum id and what it is).
+        reason: String,
+    },
+    /// The check did not run.
+    Skipped {
+        /// Why.
+        reason: String,
+    },
+    /// The check could not be carried out (the model rejected the case, the oracle failed).
+    Error {
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl Verdict {
+    /// The short name used in summaries: pass, fail, expected_failure, skipped, error.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Verdict::Pass => "pass",
+            Verdict::Fail => "fail",
+            Verdict::ExpectedFailure { .. } => "expected_failure",
+            Verdict::Skipped { .. } => "skipped",
+            Verdict::Error { .. } => "error",
+        }
+    }
+
+    /// Whether this verdict makes an audit fail (fail or error).
+    pub fn is_failure(&self) -> bool {
+        matches!(self, Verdict::Fail | Verdict::Error { .. })
+    }
+}
+
+/// The oracle's value with its own uncertainty.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct OracleValue {
+    /// The value.
+    pub value: f64,
+    /// The bound on the oracle's error (quadrature) or its standard error (Monte Carlo).
+    pub uncertainty: f64,
+    /// What the uncertainty is: `error_bound` or `standard_error`.
+    pub kind: &'static str,
+}
+
+/// The measured discrepancy.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Measured {
+    /// |value − oracle|.
+    Absolute {
+        /// The error.
+        error: f64,
+    },
+    /// |value − oracle| / |oracle|.
+    Relative {
+        /// The error.
+        error: f64,
+    },
+    /// A statistical test.
+    PValue {
+        /// The p-value.
+        p: f64,
+        /// The test statistic.
+        statistic: f64,
+        /// Degrees of freedom (0 where the test has none, e.g. Kolmogorov–Smirnov).
+        dof: usize,
+        /// The level the verdict was taken at (after the Šidák correction).
+        alpha: f64,
+    },
+    /// An estimated rate (e.g. the exponent of a convergence law).
+    Rate {
+        /// The measured exponent.
+        exponent: f64,
+        /// The expected exponent.
+        expected: f64,
+    },
+}
+
+impl Measured {
+    /// The error as one number for "worst error" summaries (p-values and rates excluded).
+    pub fn error(&self) -> Option<f64> {
+        match *self {
+            Measured::Absolute { error } | Measured::Relative { error } => Some(error),
+            Measured::Rate { exponent, expected } => Some((exponent - expected).abs()),
+            Measured::PValue { .. } => None,
+        }
+    }
+}
+
+/// The tolerance a check applied, with its reason (from [`crate::tolerance`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AppliedTolerance {
+    /// The tolerance's name in the table.
+    pub name: &'static str,
+    /// The allowed error (relative or absolute as `measured` says; for p-values, α).
+    pub value: f64,
+    /// Why this tolerance.
+    pub reason: &'static str,
+}
+
+/// What a check cost.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct Cost {
+    /// Wall time, seconds.
+    pub wall_seconds: f64,
+    /// Function evaluations of the oracle.
+    pub evaluations: u64,
+    /// Random samples drawn.
+    pub samples: u64,
+}
+
+/// One check of one property of one model at one case.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CheckRecord {
+    /// The check id, `family.property` (e.g. `smith.lambda_integral`).
+    pub check: String,
+    /// The model spec (JSON), or null for checks of non-NDF objects (SG, ASG).
+    pub model: Value,
+    /// The case: the point and parameters (θ, route, γ, …).
+    pub case: Value,
+    /// The value under test.
+    pub value: Option<f64>,
+    /// The oracle's value and its uncertainty.
+    pub oracle: Option<OracleValue>,
+    /// The measured discrepancy.
+    pub measured: Option<Measured>,
+    /// The tolerance applied.
+    pub tolerance: Option<AppliedTolerance>,
+    /// The verdict.
+    #[serde(flatten)]
+    pub verdict: Verdict,
+    /// The cost.
+    pub cost: Cost,
+    /// The seed of the check's random stream (statistical checks).
+    pub seed: Option<u64>,
+    /// The source: document and equation.
+    pub source: String,
+    /// The closed forms this record exercises (`family/quantity/route`), for the coverage registry.
+    pub covers: Vec<String>,
+    /// Paths of artefacts written for this record (heat maps, tables).
+    pub artefacts: Vec<String>,
+}
+
+impl CheckRecord {
+    /// A record with the identity fields set and everything else empty (verdict: error, until
+    /// the check decides).
+    pub fn new(check: &str, model: Value, case: Value, source: &str) -> Self {
+        Self {
+            check: check.to_string(),
+            model,
+            case,
+            value: None,
+            oracle: None,
+            measured: None,
+            tolerance: None,
+            verdict: Verdict::Error {
+                message: "the check did not reach a verdict".to_string(),
+            },
+            cost: Cost::default(),
+            seed: None,
+            source: source.to_string(),
+            covers: Vec::new(),
+            artefacts: Vec::new(),
+        }
+    }
+
+    /// Whether the record is a statistical test (its verdict depends on the audit's α).
+    pub fn is_statistical(&self) -> bool {
+        matches!(self.measured, Some(Measured::PValue { .. }))
+    }
+}
+
+/// The relative difference |a − b| / |b| (absolute where b = 0).
+pub fn relative_error(a: f64, b: f64) -> f64 {
+    if b == 0.0 {
+        a.abs()
+    } else {
+        ((a - b) / b).abs()
+    }
+}
