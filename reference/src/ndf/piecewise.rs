@@ -58,10 +58,6 @@ impl Profile {
     }
 }
 
-/// The smallest θ ≠ 0 the `slope_space` Λ route accepts (its nested quadrature costs 0.3 s at
-/// θ = 1e-4 and did not finish in 15 minutes at 1e-5).
-pub const SLOPE_SPACE_MIN_THETA: f64 = 1e-3;
-
 /// The piecewise-linear NDF of seed 000 with one profile (isotropic) or two (the anisotropic
 /// blend of eq 1).
 ///
@@ -221,6 +217,29 @@ impl PiecewiseLinear {
         let vx = lerp(self.gx[i], self.gx[i + 1], t);
         let vy = lerp(self.gy[i], self.gy[i + 1], t);
         0.5 * (self.kx * vx * (1.0 + cos2phi) + self.ky * vy * (1.0 - cos2phi))
+    }
+
+    /// (D_x, D_y) (normalized profiles) at θ = π/2 − ε, given the co-angle ε ∈ [0, π/2]: the
+    /// segment's fraction is taken from its upper end, (ε − (π/2 − θᵢ₊₁))/(θᵢ₊₁ − θᵢ), so the
+    /// values keep their relative accuracy where a profile vanishes at the horizon (from θ,
+    /// whose absolute resolution next to π/2 is ~2e-16, D(π/2 − 1e-6) carries a relative error
+    /// ~1e-10 there, which the nested quadrature of the `slope_space` route cannot converge on).
+    pub(super) fn d_xy_co(&self, eps: f64) -> (f64, f64) {
+        if !(0.0..=FRAC_PI_2).contains(&eps) {
+            return if eps.is_nan() {
+                (f64::NAN, f64::NAN)
+            } else {
+                (0.0, 0.0)
+            };
+        }
+        let (i, _) = self.locate(FRAC_PI_2 - eps);
+        let (a, b) = (self.grid[i], self.grid[i + 1]);
+        // π/2 − θᵢ₊₁ is exact (Sterbenz) for θᵢ₊₁ ≥ π/4, and 0 at the last breakpoint.
+        let s = ((eps - (FRAC_PI_2 - b)) / (b - a)).clamp(0.0, 1.0);
+        (
+            lerp(self.gx[i + 1], self.gx[i], s),
+            lerp(self.gy[i + 1], self.gy[i], s),
+        )
     }
 
     /// The segment index i (θ ∈ [θᵢ, θᵢ₊₁]) and the fraction within it.
@@ -598,19 +617,6 @@ impl Smith for PiecewiseLinear {
                 routes::domain_split(self, t, c2, Remaining::Adaptive).lambda
             }),
             "slope_space" => {
-                // Nested adaptive quadrature: 0.3 s per Λ at θ = 1e-4 and no answer within
-                // 15 minutes at θ = 1e-5 (measured), so near the normal it refuses rather than
-                // hang; θ = 0 itself (Λ = 0) is exact.
-                let theta = (w[0].hypot(w[1])).atan2(w[2].abs());
-                if theta > 0.0 && theta < SLOPE_SPACE_MIN_THETA {
-                    return Err(QueryError::Route {
-                        route: route.to_string(),
-                        reason: format!(
-                            "slope_space needs θ ≥ {SLOPE_SPACE_MIN_THETA} or θ = 0 (got {theta:e}): \
-                             its nested quadrature does not finish near the normal; use \"exact\""
-                        ),
-                    });
-                }
                 routes::both_hemispheres(w, |t, c2| routes::lambda_slope_space(self, t, c2))
             }
             _ => {
@@ -812,6 +818,60 @@ pub(crate) mod tests {
         integrate_theta(&inner, &cuts, 1e-13) / theta_o.cos()
     }
 
+    /// D(π/2 − ε, φ) of a piecewise-linear model: on the last segment by eq 4's linear
+    /// interpolation between D at its two breakpoints (exact θ values, `d_theta`), so that
+    /// D keeps its relative accuracy where it vanishes at the horizon; elsewhere `d` at the
+    /// direction (whose θ is then accurate enough).
+    pub(crate) fn d_co(m: &PiecewiseLinear, eps: f64, phi: f64) -> f64 {
+        let g = m.breakpoints();
+        let h = FRAC_PI_2 - g[g.len() - 2];
+        if eps < h {
+            // (`d` at θ = π/2 itself is 0: m_z ≤ 0 there.)
+            let c2 = (2.0 * phi).cos();
+            let top = m.d_theta(FRAC_PI_2, c2);
+            let below = m.d_theta(g[g.len() - 2], c2);
+            top + (below - top) * (eps / h)
+        } else {
+            m.d(from_spherical(FRAC_PI_2 - eps, phi))
+        }
+    }
+
+    /// Λ(o) as the back-facing projected area (seed 000 eq 10, as `lambda_integral`), in
+    /// the co-angle δ = θ_m − (π/2 − θ_o) ∈ [0, θ_o]: cos θ_m = sin(θ_o − δ) and
+    /// sin θ_m = cos(θ_o − δ) keep their relative accuracy near the horizon, where θ_m
+    /// itself (next to π/2) resolves cos θ_m to ~1e-16 absolute only (`lambda_integral`
+    /// is ~3e-9 off at θ_o = 1e-6 for that reason). `d(ε, φ)` is D at θ = π/2 − ε
+    /// (`d_co` for the piecewise-linear model).
+    pub(crate) fn lambda_integral_coangle(
+        d: &dyn Fn(f64, f64) -> f64,
+        theta_o: f64,
+        phi_o: f64,
+        breaks: &[f64],
+    ) -> f64 {
+        let (so, co) = theta_o.sin_cos();
+        let inner = |delta: f64| {
+            let (cm, sm) = (theta_o - delta).sin_cos(); // cos θ_m, sin θ_m
+            let t = co * cm / (so * sm);
+            if !(t < 1.0) {
+                return 0.0;
+            }
+            let g = t.acos();
+            let f = |psi: f64| {
+                (-(so * sm * psi.cos() + co * cm)).max(0.0) * d(theta_o - delta, phi_o + psi) * sm
+            };
+            de(&f, PI - g, PI + g, 1e-14)
+        };
+        let mut cuts = vec![0.0];
+        cuts.extend(
+            breaks
+                .iter()
+                .map(|&b| b - (FRAC_PI_2 - theta_o))
+                .filter(|&x| x > 0.0 && x < theta_o),
+        );
+        cuts.push(theta_o);
+        integrate_theta(&inner, &cuts, 1e-13) / co
+    }
+
     #[test]
     fn segment_integrals_match_quadrature_and_printed_eq5() {
         let mut worst: f64 = 0.0;
@@ -976,16 +1036,63 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn slope_space_refuses_near_normal_incidence_instead_of_hanging() {
-        let (_, m) = small_models().into_iter().next().unwrap();
-        for &t in &[1e-5, 1e-4] {
-            let e = m.lambda_route(from_spherical(t, 0.0), "slope_space");
-            assert!(matches!(e, Err(QueryError::Route { .. })), "θ={t}: {e:?}");
+    fn slope_space_and_exact_converge_near_normal_incidence() {
+        // The slope_space route used to run for > 15 minutes at θ = 1e-5 (it refused θ < 1e-3):
+        // for profiles that vanish at the horizon, D(θ) from θ ≈ π/2 carried a relative error
+        // ~2e-16/(π/2 − θ) that its nested quadrature could not converge on. With D taken from
+        // the co-angle (`d_xy_co`) both quadrature routes agree with the co-angle oracle.
+        let start = Instant::now();
+        let mut worst: f64 = 0.0;
+        for (label, m) in small_models().into_iter().chain(big_models()) {
+            for &t in &[1e-6, 1e-5, 1e-4] {
+                for &phi in &[0.0, 0.7, FRAC_PI_2] {
+                    let w = from_spherical(t, phi);
+                    let want =
+                        lambda_integral_coangle(&|e, p| d_co(&m, e, p), t, phi, m.breakpoints());
+                    for route in ["exact", "slope_space"] {
+                        let got = m.lambda_route(w, route).unwrap();
+                        let e = rel_err(got, want);
+                        assert!(
+                            e < 1e-11,
+                            "{label} {route} θ={t} φ={phi}: {got:e} vs {want:e}"
+                        );
+                        worst = worst.max(e);
+                    }
+                }
+            }
         }
+        let elapsed = start.elapsed();
+        eprintln!("Λ at θ ≤ 1e-4: max rel err {worst:.1e} ({elapsed:?})");
+        assert!(elapsed.as_secs() < 60, "{elapsed:?}");
+        let (_, m) = small_models().into_iter().next().unwrap();
         assert_eq!(m.lambda_route([0.0, 0.0, 1.0], "slope_space").unwrap(), 0.0);
-        assert!(m
-            .lambda_route(from_spherical(1e-3, 0.0), "slope_space")
-            .is_ok());
+    }
+
+    #[test]
+    fn co_angle_profile_values_keep_their_relative_accuracy_at_the_horizon() {
+        // flat_profile ends 0.5, 1.0, 0.0 on equal segments: D_iso(π/2 − ε) = ε · 1/h / c_iso.
+        let m = pl(flat_profile(), None);
+        let h = FRAC_PI_2 / 7.0;
+        let slope = m.d_x(FRAC_PI_2 - h) / h;
+        for eps in [1e-12, 1e-9, 1e-6, 1e-3] {
+            let (dx, dy) = m.d_xy_co(eps);
+            assert!(rel_err(dx, slope * eps) < 1e-13, "ε={eps}: {dx:e}");
+            assert_eq!(dx, dy);
+        }
+        // Elsewhere d_xy_co is d_x, d_y at θ = π/2 − ε.
+        let a = pl(
+            random_profile(2, 7, false),
+            Some(random_profile(3, 11, false)),
+        );
+        for t in [0.0, 0.1, 0.77, 1.2, 1.5] {
+            let (dx, dy) = a.d_xy_co(FRAC_PI_2 - t);
+            assert!(
+                rel_err(dx, a.d_x(t)) < 1e-13 && rel_err(dy, a.d_y(t)) < 1e-13,
+                "θ={t}"
+            );
+        }
+        assert_eq!(a.d_xy_co(-1e-3), (0.0, 0.0));
+        assert!(a.d_xy_co(f64::NAN).0.is_nan());
     }
 
     #[test]
@@ -1513,43 +1620,6 @@ pub(crate) mod tests {
                 .sum()
         }
 
-        /// Λ(o) as the back-facing projected area (seed 000 eq 10, as `lambda_integral`), in
-        /// the co-angle δ = θ_m − (π/2 − θ_o) ∈ [0, θ_o]: cos θ_m = sin(θ_o − δ) and
-        /// sin θ_m = cos(θ_o − δ) keep their relative accuracy near the horizon, where θ_m
-        /// itself (next to π/2) resolves cos θ_m to ~1e-16 absolute only (`lambda_integral`
-        /// is ~3e-9 off at θ_o = 1e-6 for that reason).
-        fn lambda_integral_coangle(
-            d: &dyn Fn(Vec3) -> f64,
-            theta_o: f64,
-            phi_o: f64,
-            breaks: &[f64],
-        ) -> f64 {
-            let (so, co) = theta_o.sin_cos();
-            let inner = |delta: f64| {
-                let (cm, sm) = (theta_o - delta).sin_cos(); // cos θ_m, sin θ_m
-                let t = co * cm / (so * sm);
-                if !(t < 1.0) {
-                    return 0.0;
-                }
-                let g = t.acos();
-                let f = |psi: f64| {
-                    let phi = phi_o + psi;
-                    let m = [sm * phi.cos(), sm * phi.sin(), cm];
-                    (-(so * sm * psi.cos() + co * cm)).max(0.0) * d(m) * sm
-                };
-                de(&f, PI - g, PI + g, 1e-14)
-            };
-            let mut cuts = vec![0.0];
-            cuts.extend(
-                breaks
-                    .iter()
-                    .map(|&b| b - (FRAC_PI_2 - theta_o))
-                    .filter(|&x| x > 0.0 && x < theta_o),
-            );
-            cuts.push(theta_o);
-            integrate_theta(&inner, &cuts, 1e-13) / co
-        }
-
         fn cell(e: Option<f64>) -> String {
             match e {
                 Some(e) => format!("{e:.1e}"),
@@ -1619,8 +1689,12 @@ pub(crate) mod tests {
                 for &theta in &THETAS {
                     for &phi in &PHIS {
                         let w = from_spherical(theta, phi);
-                        let want =
-                            lambda_integral_coangle(&|v| m.d(v), theta, phi, m.breakpoints());
+                        let want = lambda_integral_coangle(
+                            &|e, p| d_co(m, e, p),
+                            theta,
+                            phi,
+                            m.breakpoints(),
+                        );
                         for (k, route) in routes.iter().enumerate() {
                             match m.lambda_route(w, route) {
                                 Ok(l) => {
@@ -1651,7 +1725,13 @@ pub(crate) mod tests {
             for &theta in &THETAS {
                 for &phi in &PHIS {
                     let w = from_spherical(theta, phi);
-                    let want = lambda_integral_coangle(&|v| blend.d(v), theta, phi, &cuts);
+                    let want = lambda_integral_coangle(
+                        // cos θ = sin ε, sin θ = cos ε: exact in the co-angle.
+                        &|e, p| blend.d([e.cos() * p.cos(), e.cos() * p.sin(), e.sin()]),
+                        theta,
+                        phi,
+                        &cuts,
+                    );
                     let l = blend.lambda(w);
                     put(&mut t[5][j], rel_err(l, want));
                     put(&mut t[9][j], rel_err(1.0 / (1.0 + l), 1.0 / (1.0 + want)));
@@ -1673,15 +1753,13 @@ pub(crate) mod tests {
                         .join(" | ")
                 );
             }
-            println!(
-                "({refused} slope_space evaluations refused: θ = 1e-6 < SLOPE_SPACE_MIN_THETA)"
-            );
+            assert_eq!(refused, 0, "slope_space refused {refused} evaluations");
             let worst = |i: usize| t[i].iter().flatten().fold(0.0f64, |a, &b| a.max(b));
             assert!(worst(0) < 1e-12, "normalization {:e}", worst(0));
             for (i, label) in labels.iter().enumerate().take(5).skip(1) {
                 assert!(worst(i) < 1e-11, "{label}: {:e}", worst(i));
             }
-            assert!(worst(5) < 1e-9, "exact Λ {:e}", worst(5));
+            assert!(worst(5) < 1e-12, "exact Λ {:e}", worst(5));
             assert!(worst(8) < 1e-12, "slope_space Λ {:e}", worst(8));
             assert!(worst(9) < 1e-10, "exact G1 {:e}", worst(9));
             assert!(
