@@ -223,22 +223,20 @@ fn bench_piecewise(c: &mut Criterion) {
     );
     g.finish();
 
-    // G1 = 1/(1 + Λ) by each route; the quadrature routes on the 60 interior directions only
-    // (the 4 end directions cost up to ~0.1 s each, see closed_forms.rs), slope_space on 8.
+    // G1 = 1/(1 + Λ) by each route over all 64 directions (ends included: since the
+    // co-angle fix, `exact` and `slope_space` cost ~0.1 ms at θ = 1e-6 too).
     let dirs = directions();
-    let interior: Vec<Vec3> = dirs[..N - 4].to_vec();
-    let mut g = slow_group(c, "g1/piecewise_linear", interior.len());
-    for route in ["exact", "domain_split", "domain_split_adaptive"] {
-        over(&mut g, &format!("{params}/{route}"), &interior, |w| {
+    let mut g = slow_group(c, "g1/piecewise_linear", N);
+    for route in [
+        "exact",
+        "domain_split",
+        "domain_split_adaptive",
+        "slope_space",
+    ] {
+        over(&mut g, &format!("{params}/{route}"), &dirs, |w| {
             1.0 / (1.0 + m.lambda_route(w, route).expect("listed route"))
         });
     }
-    g.finish();
-    let few: Vec<Vec3> = (0..8).map(|k| dirs[3 + 7 * k]).collect();
-    let mut g = slow_group(c, "g1/piecewise_linear", few.len());
-    over(&mut g, &format!("{params}/slope_space"), &few, |w| {
-        1.0 / (1.0 + m.lambda_route(w, "slope_space").expect("listed route"))
-    });
     g.finish();
 
     let blend = Blend::new(
@@ -246,8 +244,8 @@ fn bench_piecewise(c: &mut Criterion) {
         Box::new(Beckmann::new(0.4, 0.4).expect("valid")),
     )
     .expect("valid blend");
-    let mut g = slow_group(c, "g1/blend", interior.len());
-    over(&mut g, "ggx0.2+beckmann0.4/exact", &interior, |w| {
+    let mut g = slow_group(c, "g1/blend", N);
+    over(&mut g, "ggx0.2+beckmann0.4/exact", &dirs, |w| {
         blend.g1(w, [0.0, 0.0, 1.0])
     });
     g.finish();
