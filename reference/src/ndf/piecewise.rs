@@ -220,8 +220,8 @@ impl PiecewiseLinear {
     }
 
     /// (D_x, D_y) (normalized profiles, seed 000 eq 4) at θ = π/2 − ε, given the co-angle
-    /// ε ∈ [0, π/2]: the
-    /// segment's fraction is taken from its upper end, (ε − (π/2 − θᵢ₊₁))/(θᵢ₊₁ − θᵢ), so the
+    /// ε ∈ [0, π/2]: the segment's fraction is taken from its upper end,
+    /// (ε − (π/2 − θᵢ₊₁))/(θᵢ₊₁ − θᵢ), so the
     /// values keep their relative accuracy where a profile vanishes at the horizon (from θ,
     /// whose absolute resolution next to π/2 is ~2e-16, D(π/2 − 1e-6) carries a relative error
     /// ~1e-10 there, which the nested quadrature of the `slope_space` route cannot converge on).
