@@ -100,7 +100,7 @@ fn sg_rows() -> Vec<Row> {
     let mut cosine_exact = Row::new("∫ G max(v·n, 0) (rel)", "`exact`");
     let mut warp = Row::new(
         "lobe warp: f_a(λ_W) vs area of ψ(A) (rel)",
-        "λ_W = λ_D/(4|p·o|) (§2.1)",
+        "λ_W = λ_D/(4\\|p·o\\|) (§2.1)",
     );
     let mut warp_exact = Row::new("lobe warp: area of ψ(A) (rel)", "`warp_support_area_exact`");
     for (j, &k) in K.iter().enumerate() {
@@ -209,11 +209,11 @@ fn asg_rows() -> Vec<Row> {
     let mut large = Row::new("ASG ∫ G (rel)", "§3.2.1 π/√(λμ) (\"λ, μ > 5\")");
     let mut exact = Row::new("ASG ∫ G (rel)", "`exact`");
     let mut product = Row::new(
-        "ASG product, bandwidths (b, 0.3b)×(0.5b, 2b): max|Δ|/peak",
+        "ASG product, bandwidths (b, 0.3b)×(0.5b, 2b): max\\|Δ\\|/peak",
         "§3.2.2",
     );
     let mut conv = Row::new(
-        "ASG [3, 1.5] ∗ SG(λ): max_p |ΔC| / max_p C",
+        "ASG [3, 1.5] ∗ SG(λ): max_p \\|ΔC\\| / max_p C",
         "§3.2.3 approximation (E4, E5)",
     );
     let mut conv_exact = Row::new("ASG [3, 1.5] ∗ SG(λ) (rel)", "`exact`");
