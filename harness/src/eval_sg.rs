@@ -1,6 +1,6 @@
 //! `mfh eval` for spherical Gaussians and anisotropic spherical Gaussians (seed 003): the
-//! quantities `sg_eval`, `sg_inner`, `sg_product`, `sg_integral`, `asg_eval`, `asg_integral`
-//! and `asg_sg_convolution`. These queries carry no `"model"`.
+//! quantities `sg_eval`, `sg_inner`, `sg_product`, `sg_integral`, `sg_warp`, `asg_eval`,
+//! `asg_integral` and `asg_sg_convolution`. These queries carry no `"model"`.
 //!
 //! An SG is `{"axis": [x, y, z], "sharpness": λ, "amplitude": μ}` (amplitude 1 if left out); an
 //! ASG is `{"x": […], "y": […], "z": […], "bandwidths": [λ, μ], "amplitude": c}`. Where the
@@ -14,6 +14,7 @@
 //! | `sg_inner` | `a`, `b` | `default` (stable closed form), `printed` (as printed: overflows past λ₁+λ₂ ≈ 709), `exact` |
 //! | `sg_product` | `a`, `b` | `default` (→ an SG object) |
 //! | `sg_integral` | `a`, optional `cap` (half-angle θ_d ∈ [0, π] of a cap around the axis) | `default`, `exact`; with `cap` also `cap_product` (the integral of §2.2's cap-product lobe, as printed) |
+//! | `sg_warp` | `a` (the lobe in half vectors), `o` (the view direction, unit) | `default` (§2.1: p_W = 2(o·p)p − o, λ_W = λ/(4\|p·o\|), μ_W = μ; → an SG object) |
 //! | `asg_eval` | `asg`, `v` | `default` |
 //! | `asg_integral` | `asg` | `default` (§3.2.1 with F), `large_bandwidth` (π/√(λμ)), `exact` |
 //! | `asg_sg_convolution` | `asg`, `sg` (its axis is p; or give p as `v` and leave the axis out) | `default` (§3.2.3), `exact` |
@@ -24,11 +25,12 @@ use mfh_reference::sg::{Asg, Sg};
 use serde_json::{json, Map, Value};
 
 /// The SG/ASG quantities this module answers.
-pub const QUANTITIES: [&str; 7] = [
+pub const QUANTITIES: [&str; 8] = [
     "sg_eval",
     "sg_inner",
     "sg_product",
     "sg_integral",
+    "sg_warp",
     "asg_eval",
     "asg_integral",
     "asg_sg_convolution",
@@ -72,11 +74,12 @@ fn answer(quantity: &str, q: &Map<String, Value>, route: Option<&str>) -> Result
         "sg_product" => {
             routes(quantity, route, &["default"])?;
             let p = sg(q, "a", true)?.product(&sg(q, "b", true)?);
-            Ok(json!({
-                "axis": p.axis().iter().map(|c| number(*c)).collect::<Vec<_>>(),
-                "sharpness": number(p.sharpness()),
-                "amplitude": number(p.amplitude()),
-            }))
+            Ok(sg_value(&p))
+        }
+        "sg_warp" => {
+            routes(quantity, route, &["default"])?;
+            let w = sg(q, "a", true)?.warp(vector(q, "o")?)?;
+            Ok(sg_value(&w))
         }
         "sg_integral" => {
             let a = sg(q, "a", true)?;
@@ -169,6 +172,15 @@ fn array3(v: &Value, what: &str) -> Result<Vec3, EvalError> {
         .filter(|a| a.len() == 3)
         .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?, a[2].as_f64()?]))
         .ok_or_else(|| EvalError::Argument(format!("{what} must be [x, y, z]")))
+}
+
+/// An SG as the JSON object the queries take (`{"axis", "sharpness", "amplitude"}`).
+fn sg_value(g: &Sg) -> Value {
+    json!({
+        "axis": g.axis().iter().map(|c| number(*c)).collect::<Vec<_>>(),
+        "sharpness": number(g.sharpness()),
+        "amplitude": number(g.amplitude()),
+    })
 }
 
 /// The unit vector `q[key]`.
@@ -291,6 +303,43 @@ mod tests {
             r#"{{"quantity":"sg_integral","a":{A},"cap":0.5,"route":"cap_product"}}"#
         ));
         assert!(printed.as_f64().unwrap() > c.as_f64().unwrap());
+    }
+
+    #[test]
+    fn sg_warp_is_the_library_warp() {
+        // Seed 003 §2.1: the lobe warp from half vectors to light directions for view o.
+        let a = Sg::new([0.0, 0.0, 1.0], 10.0, 2.0).unwrap();
+        let o = [0.6, 0.0, 0.8];
+        let w = value(&format!(
+            r#"{{"quantity":"sg_warp","a":{A},"o":[0.6,0,0.8]}}"#
+        ));
+        let want = a.warp(o).unwrap();
+        assert_eq!(w["sharpness"].as_f64().unwrap(), want.sharpness());
+        assert_eq!(w["amplitude"].as_f64().unwrap(), want.amplitude());
+        // λ_W = λ/(4|p·o|) = 10/3.2, p_W = 2(o·p)p − o = (−0.6, 0, 0.8).
+        assert!((w["sharpness"].as_f64().unwrap() - 3.125).abs() < 1e-15);
+        let axis: Vec<f64> = w["axis"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_f64().unwrap())
+            .collect();
+        assert!((axis[0] + 0.6).abs() < 1e-15 && axis[1] == 0.0 && (axis[2] - 0.8).abs() < 1e-15);
+        // p ⊥ o: λ_W would be infinite; o not unit; an unknown route.
+        assert_eq!(
+            error_kind(&format!(r#"{{"quantity":"sg_warp","a":{A},"o":[1,0,0]}}"#)),
+            "argument"
+        );
+        assert_eq!(
+            error_kind(&format!(r#"{{"quantity":"sg_warp","a":{A},"o":[0,0,2]}}"#)),
+            "argument"
+        );
+        assert_eq!(
+            error_kind(&format!(
+                r#"{{"quantity":"sg_warp","a":{A},"o":[0,0,1],"route":"exact"}}"#
+            )),
+            "route"
+        );
     }
 
     #[test]

@@ -708,6 +708,7 @@ fn spherical_gaussian_quantities_answer_as_the_library_does() {
     let asg_json = json!({"x": ax, "y": ay, "z": az, "bandwidths": [6.0, 15.0], "amplitude": 2.0});
     let (aj, bj) = (sg_json(a_axis, 8.0, 1.5), sg_json(b_axis, 20.0, 0.7));
     let p = a.product(&b);
+    let warped = a.warp(v).unwrap();
     let cases: Vec<(Value, Expect)> = vec![
         (
             json!({"quantity": "sg_eval", "a": aj, "v": v}),
@@ -747,6 +748,13 @@ fn spherical_gaussian_quantities_answer_as_the_library_does() {
         (
             json!({"quantity": "sg_integral", "a": aj, "cap": 0.7, "route": "cap_product"}),
             Ok(num(a.cap_product(0.7).unwrap().integral())),
+        ),
+        (
+            json!({"quantity": "sg_warp", "a": aj, "o": v}),
+            Ok(
+                json!({"axis": warped.axis().map(num), "sharpness": num(warped.sharpness()),
+                      "amplitude": num(warped.amplitude())}),
+            ),
         ),
         (
             json!({"quantity": "asg_eval", "asg": asg_json, "v": v}),

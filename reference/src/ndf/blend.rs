@@ -128,7 +128,7 @@ impl Smith for Blend {
     /// The exact route: `piecewise_lambda::lambda_exact` with the analytic profiles.
     fn lambda(&self, w: Vec3) -> f64 {
         both_hemispheres(w, |t, c2| {
-            lambda_exact(t, c2, &|th| self.dxy(th), &CUTS, EXACT_REL)
+            lambda_exact(t, c2, &|th, _| self.dxy(th), &CUTS, EXACT_REL)
         })
     }
 

@@ -86,12 +86,14 @@ pub(crate) fn k2(g: f64) -> f64 {
 /// The azimuthal integral over the back-facing arc |φ_m − φ_o − π| < γ is closed (K₀, K₂ above;
 /// the sin 2(φ_m − φ_o) part is odd and vanishes). The θ integral is taken in u = √δ (the
 /// integrand behaves as δ^{3/2} at E) with the profile breakpoints `breaks` as interval ends,
-/// by `special::gauss_kronrod` to relative accuracy `rel`. `dxy(θ)` = (k_x D_x(θ), k_y D_y(θ)).
+/// by `special::gauss_kronrod` to relative accuracy `rel`. `dxy(θ, π/2 − θ)` = (k_x D_x(θ),
+/// k_y D_y(θ)); the co-angle π/2 − θ_m = θ_o − δ is passed exactly, for profiles that vanish at
+/// the horizon (see `PiecewiseLinear::d_xy_co`).
 /// Domain: θ_o ∈ [0, π/2] (0 at θ_o = 0, +∞ at π/2).
 pub(crate) fn lambda_exact(
     theta_o: f64,
     cos2phi: f64,
-    dxy: &dyn Fn(f64) -> (f64, f64),
+    dxy: &dyn Fn(f64, f64) -> (f64, f64),
     breaks: &[f64],
     rel: f64,
 ) -> f64 {
@@ -116,7 +118,7 @@ pub(crate) fn lambda_exact(
         let ratio = delta.sin() / (2.0 * theta_o - delta).sin();
         let gamma = 2.0 * ratio.max(0.0).sqrt().atan();
         let s = tm.sin();
-        let (a, b) = dxy(tm);
+        let (a, b) = dxy(tm, theta_o - delta);
         2.0 * u * s * s * ((a + b) * k0(gamma) + cos2phi * (a - b) * k2(gamma))
     };
     0.5 * theta_o.tan() * integrate(&f, &us, rel, 0.0).value
@@ -127,7 +129,10 @@ pub(crate) fn lambda_exact_piecewise(p: &PiecewiseLinear, theta_o: f64, cos2phi:
     lambda_exact(
         theta_o,
         cos2phi,
-        &|t| (p.kx * p.d_x(t), p.ky * p.d_y(t)),
+        &|_, eps| {
+            let (dx, dy) = p.d_xy_co(eps);
+            (p.kx * dx, p.ky * dy)
+        },
         &p.grid,
         EXACT_REL,
     )
@@ -281,11 +286,11 @@ fn p2_co(p: &PiecewiseLinear, q: f64, eq: f64, cos2phi: f64, rel: f64) -> f64 {
     let q2 = q * q;
     let f = |v: f64| {
         let d = v * v;
-        let th = tq + d;
         let (c, s) = (eq - d).sin_cos(); // cos θ, sin θ
         let pp2 = d.sin() / (c * cos_tq) * (s / c + q);
         let pv = pp2.sqrt();
-        let (a, b) = (p.kx * p.d_x(th), p.ky * p.d_y(th));
+        let (dx, dy) = p.d_xy_co(eq - d); // π/2 − θ, exactly
+        let (a, b) = (p.kx * dx, p.ky * dy);
         let val = 4.0 * v * c * c * c / (pv * s)
             * (a * (q2 * cv2 + pp2 * sv2) + b * (q2 * sv2 + pp2 * cv2));
         if val.is_finite() {

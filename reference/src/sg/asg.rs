@@ -351,7 +351,7 @@ impl Asg {
     /// The maximum over the sphere of −λ(v·x)² − μ(v·y)² + λ_s v·p (the exponent of the
     /// ASG × SG integrand without the smooth term), from the secular equation
     /// v_i = b_i / (2(a_i + γ)), |v| = 1, γ > 0 (a = (λ, μ, 0), b = λ_s p in the ASG frame).
-    fn product_peak(&self, sg: &Sg) -> Vec3 {
+    pub(crate) fn product_peak(&self, sg: &Sg) -> Vec3 {
         let [l, m] = self.bandwidths;
         let ls = sg.sharpness();
         let p = sg.axis();
@@ -443,7 +443,7 @@ fn symmetric_eigen(mut a: [[f64; 3]; 3]) -> ([f64; 3], [Vec3; 3]) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::geometry::from_spherical;
     use crate::sg::oracle::{cuts, directions, integrate_cut};
@@ -454,7 +454,7 @@ mod tests {
         1e-3, 0.01, 0.1, 0.5, 1.0, 2.0, 3.0, 5.0, 10.0, 30.0, 100.0, 1e3, 1e4,
     ];
 
-    fn asg_at(z: Vec3, twist: f64, l: f64, m: f64, c: f64) -> Asg {
+    pub(crate) fn asg_at(z: Vec3, twist: f64, l: f64, m: f64, c: f64) -> Asg {
         let f = frame_around(z);
         let (s, co) = twist.sin_cos();
         let x = add(scale(f[0], co), scale(f[1], s));
@@ -465,7 +465,7 @@ mod tests {
     /// The independent oracle for the ASG integral: nested double-exponential quadrature over
     /// (θ, φ) of the ASG (λ ≥ μ) in its own frame, cut around the ridge at φ = π/2, over the
     /// half turn φ ∈ [π/2, 3π/2] (the integrand is even about π/2).
-    fn integral_oracle(l: f64, m: f64) -> f64 {
+    pub(crate) fn integral_oracle(l: f64, m: f64) -> f64 {
         let w = 1.0 / (1.0 + l.max(m)).sqrt();
         let f = |theta: f64, phi: f64| {
             let (st, ct) = theta.sin_cos();

@@ -8,6 +8,8 @@
 //! Where the printed document is wrong, `reference/ERRATA.md` says so and names the unit
 //! test that shows it.
 
+#[cfg(test)]
+mod accuracy;
 pub mod asg;
 pub mod circular;
 pub(crate) mod quadrature;
