@@ -1,9 +1,8 @@
 //! Slope moments: ν₂ₖ, variance and excess kurtosis against integrals of P2, the marginal
 //! P2 = ∫P22 dp, and the normalization ∫P2 dq = 1 (seed 001 eq 4, 6–7, 15; seed 002 eq 2–10).
 
-use super::normalization::lobe_width;
-use super::{compare, covers, timed, Planned};
-use crate::oracle::quadrature::{integrate_line, Accuracy};
+use super::{compare, covers, lobe_width, timed, Planned};
+use crate::oracle::quadrature::{integrate_line, integrate_pieces, Accuracy};
 use crate::oracle::Estimate;
 use crate::record::{CheckRecord, Verdict};
 use crate::tolerance::MOMENT;
@@ -46,8 +45,12 @@ pub fn plan(model: Arc<dyn Model>, why: &str) -> Vec<Planned> {
                 statistical: false,
                 run: Box::new(move |_| {
                     timed(|| {
-                        let mut r =
-                            CheckRecord::new("moments.slopes", spec_run.clone(), case_run.clone(), SOURCE);
+                        let mut r = CheckRecord::new(
+                            "moments.slopes",
+                            spec_run.clone(),
+                            case_run.clone(),
+                            SOURCE,
+                        );
                         r.covers = vec![covers(family, closed, "default")];
                         let slopes = m.as_slopes().expect("planned for slope models");
                         let scale = lobe_width(&spec_run).tan().max(1e-6);
@@ -59,7 +62,14 @@ pub fn plan(model: Arc<dyn Model>, why: &str) -> Vec<Planned> {
                         let (value, oracle): (Option<f64>, Estimate) = match quantity {
                             "p2_normalization" => {
                                 let e = raw(0);
-                                (Some(e.value), Estimate { value: 1.0, error_bound: e.error_bound, evaluations: e.evaluations })
+                                (
+                                    Some(e.value),
+                                    Estimate {
+                                        value: 1.0,
+                                        error_bound: e.error_bound,
+                                        evaluations: e.evaluations,
+                                    },
+                                )
                             }
                             "p22_marginal" => {
                                 // P2 along x (φ = 0) at q = scale/2 is ∫ P22(q, p) dp.
@@ -73,16 +83,39 @@ pub fn plan(model: Arc<dyn Model>, why: &str) -> Vec<Planned> {
                                 let (m1, m2) = (raw(1), raw(2));
                                 let mean = m1.value;
                                 let central = |k: i32| {
-                                    integrate_line(&|q| (q - mean).powi(k) * slopes.p2(q, phi), mean, scale, acc)
+                                    integrate_line(
+                                        &|q| (q - mean).powi(k) * slopes.p2(q, phi),
+                                        mean,
+                                        scale,
+                                        acc,
+                                    )
                                 };
                                 let var = central(2);
                                 if quantity == "variance" {
-                                    (slopes.variance(phi), Estimate { value: var.value, error_bound: var.error_bound + m2.error_bound, evaluations: var.evaluations + m1.evaluations + m2.evaluations })
+                                    (
+                                        slopes.variance(phi),
+                                        Estimate {
+                                            value: var.value,
+                                            error_bound: var.error_bound + m2.error_bound,
+                                            evaluations: var.evaluations
+                                                + m1.evaluations
+                                                + m2.evaluations,
+                                        },
+                                    )
                                 } else {
                                     let c4 = central(4);
                                     let v = c4.value / (var.value * var.value) - 3.0;
-                                    let bound = (c4.error_bound / c4.value.abs() + 2.0 * var.error_bound / var.value.abs()) * (v + 3.0).abs();
-                                    (slopes.excess_kurtosis(), Estimate { value: v, error_bound: bound, evaluations: c4.evaluations + var.evaluations })
+                                    let bound = (c4.error_bound / c4.value.abs()
+                                        + 2.0 * var.error_bound / var.value.abs())
+                                        * (v + 3.0).abs();
+                                    (
+                                        slopes.excess_kurtosis(),
+                                        Estimate {
+                                            value: v,
+                                            error_bound: bound,
+                                            evaluations: c4.evaluations + var.evaluations,
+                                        },
+                                    )
                                 }
                             }
                             _ => (None, Estimate::default()),
@@ -90,17 +123,43 @@ pub fn plan(model: Arc<dyn Model>, why: &str) -> Vec<Planned> {
                         match value {
                             Some(v) => compare(&mut r, v, oracle, &MOMENT),
                             None => {
-                                // Undefined moments must belong to a divergent integral: the
-                                // oracle's estimate must not settle (or be infinite).
-                                let settled = oracle.value.is_finite()
-                                    && oracle.error_bound <= 1e-6 * oracle.value.abs();
-                                r.oracle = Some(crate::record::OracleValue { value: oracle.value, uncertainty: oracle.error_bound, kind: "error_bound" });
-                                r.verdict = if settled {
-                                    Verdict::Fail
-                                } else {
-                                    Verdict::Pass
+                                // An undefined moment must belong to a divergent integral:
+                                // ∫_{−Q}^{Q} q^{2k} P2 must keep growing between Q = 10⁴ s and
+                                // Q = 10⁸ s (a convergent moment changes by its tail only,
+                                // ≪ 1e-3 for the tails of these models).
+                                let k = if quantity == "nu4" { 4 } else { 2 };
+                                let truncated = |top: f64| {
+                                    let mut cuts = vec![0.0];
+                                    let mut c = 1e-3 * scale;
+                                    while c < top {
+                                        cuts.push(c);
+                                        c *= 10.0;
+                                    }
+                                    cuts.push(top);
+                                    integrate_pieces(
+                                        &|q| q.powi(k) * (slopes.p2(q, phi) + slopes.p2(-q, phi)),
+                                        &cuts,
+                                        Accuracy::relative(1e-10),
+                                    )
                                 };
-                                r.case = json!({"quantity": quantity, "phi": phi, "closed_form": "undefined (diverges)"});
+                                let (near, far) = (truncated(1e4 * scale), truncated(1e8 * scale));
+                                let growth = (far.value - near.value) / near.value;
+                                r.value = Some(growth);
+                                r.oracle = Some(crate::record::OracleValue {
+                                    value: far.value,
+                                    uncertainty: far.error_bound,
+                                    kind: "error_bound",
+                                });
+                                r.measured =
+                                    Some(crate::record::Measured::Relative { error: growth });
+                                r.verdict = if growth > 1e-3 {
+                                    Verdict::Pass
+                                } else {
+                                    Verdict::Fail
+                                };
+                                r.case = json!({"quantity": quantity, "phi": phi,
+                                                "closed_form": "undefined (diverges)",
+                                                "growth_from_1e4_to_1e8_scales": growth});
                             }
                         }
                         r

@@ -23,9 +23,10 @@
 
 use crate::oracle::cubature::{integrate_rectangle, Tolerance};
 use crate::oracle::domain::{DomainError, HemisphereGrid};
+use crate::oracle::monte_carlo::uniform;
 use mfh_reference::geometry::Vec3;
 use mfh_reference::NormalSampler;
-use rand_core::{RngCore, SeedableRng};
+use rand_core::SeedableRng;
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -199,12 +200,6 @@ pub fn splitmix64(mut z: u64) -> u64 {
 /// The random stream of chunk `chunk` under `seed`.
 pub fn stream(seed: u64, chunk: u64) -> Pcg64 {
     Pcg64::seed_from_u64(splitmix64(splitmix64(seed) ^ chunk))
-}
-
-/// A uniform number in [0, 1) with 53 random bits.
-#[inline]
-fn uniform(rng: &mut Pcg64) -> f64 {
-    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 /// Draws `samples` normals with `sample` and bins them into `grid`, in parallel, with a result
