@@ -25,6 +25,7 @@
 //! however small Λ is. Near grazing incidence, where Λ is large and the continued fraction
 //! converges slowly, Λ = A − ½ + N x ₂F₁ (Pfaff series) has no harmful cancellation.
 
+use super::beckmann_fit::PIECES;
 use super::hyp2f1::{beta_cf_delta, beta_cf_k_denominator, pfaff_series, student_norm, use_pfaff};
 use std::f64::consts::PI;
 
@@ -63,19 +64,46 @@ pub fn student_lambda(c: f64, x: f64) -> f64 {
     n * w_power / x * numerator / denominator
 }
 
-/// Below this, Beckmann Λ is the direct difference; above, the continued fraction.
-const BECKMANN_SWITCH: f64 = 1.5;
+/// Below this, Beckmann Λ is the direct difference (which cancels by at most a factor 2.2
+/// here); above, the fitted polynomials of `special::beckmann_fit`.
+const BECKMANN_SWITCH: f64 = 0.5;
+
+/// Above this, Beckmann Λ < e^{−a²} underflows to 0.
+const BECKMANN_ZERO: f64 = 28.0;
+
+/// a² = hi + lo exactly (Dekker's product; no FMA needed), for 0 ≤ a ≤ `BECKMANN_ZERO`.
+#[inline]
+fn exact_square(a: f64) -> (f64, f64) {
+    let c = 134_217_729.0 * a; // 2²⁷ + 1: splits a into two 26-bit halves
+    let high = c - (c - a);
+    let low = a - high;
+    let hi = a * a;
+    let lo = ((high * high - hi) + 2.0 * high * low) + low * low;
+    (hi, lo)
+}
+
+/// e^{−a²} with a² taken exactly: e^{−hi}(1 − lo), |lo| ≤ ulp(hi)/2 (e^{−a·a} would carry the
+/// rounding of a·a, a relative error up to a² × 1.1e-16).
+#[inline]
+fn exp_minus_square(a: f64) -> f64 {
+    let (hi, lo) = exact_square(a);
+    (-hi).exp() * (1.0 - lo)
+}
 
 /// Beckmann Smith Λ(a), a = cot θ / α ≥ 0 (seed 001 Table 1, γ = ∞; Walter et al. 2007):
 ///
 /// ```text
-/// Λ(a) = ½ (e^{−a²}/(a√π) − erfc a)
-///      = e^{−a²}/(2√π) · r / (a (a + r)),   r = (1/2)/(a + 1/(a + (3/2)/(a + 2/(a + …))))
+/// Λ(a) = ½ (e^{−a²}/(a√π) − erfc a)                          a < ½
+///      = e^{−a²} F(a) / (4√π a³),  F(a) = 2a² − 2√π a³ erfcx(a)   a ≥ ½
 /// ```
 ///
-/// the second line from the continued fraction erfc a = e^{−a²}/√π · 1/(a + r), which removes
-/// the cancellation for a ≥ 1.5; below, erfc comes from `libm` (statrs' erfc is off by up to
-/// 1e-10 relative on [0.5, 1.5]). Relative error ≤ 3e-15 for a ∈ (0, ∞) where Λ is normal.
+/// The first line with erfc from `libm` (statrs' erfc is off by up to 1e-10 relative on
+/// [0.5, 1.5]); it cancels by at most a factor 2.2 below a = ½. On a ≥ ½ the difference is
+/// never formed: F ∈ [0.22, 1) is read from fitted polynomials (`special::beckmann_fit`,
+/// generated with mpmath; a table because the alternatives are slow: the continued fraction
+/// of erfc needs ~100 steps at a = 1.5, ~25 at a = 4). In both lines e^{−a²} uses a² split
+/// exactly into two doubles. Relative error ≤ 1e-15 for a ∈ (0, ∞) where Λ is normal
+/// (against mpmath, `reference/golden/beckmann.json`: max 6e-16).
 pub fn beckmann_lambda(a: f64) -> f64 {
     if a.is_nan() || a < 0.0 {
         return f64::NAN;
@@ -83,44 +111,31 @@ pub fn beckmann_lambda(a: f64) -> f64 {
     if a == 0.0 {
         return f64::INFINITY;
     }
-    if a == f64::INFINITY {
+    if a > BECKMANN_ZERO {
         return 0.0;
     }
     let sqrt_pi = PI.sqrt();
     if a < BECKMANN_SWITCH {
-        return 0.5 * ((-a * a).exp() / (a * sqrt_pi) - libm::erfc(a));
+        return 0.5 * (exp_minus_square(a) / (a * sqrt_pi) - libm::erfc(a));
     }
-    // r = ½ / R, R = a + 1/(a + (3/2)/(a + …)) by modified Lentz: partial numerators k/2,
-    // k = 2, 3, …, partial denominators a.
-    const TINY: f64 = 1e-300;
-    let mut f = a;
-    let mut cc = f;
-    let mut dd = 0.0;
-    for k in 2..10_000 {
-        let num = k as f64 * 0.5;
-        dd = a + num * dd;
-        if dd.abs() < TINY {
-            dd = TINY;
-        }
-        cc = a + num / cc;
-        if cc.abs() < TINY {
-            cc = TINY;
-        }
-        dd = 1.0 / dd;
-        let delta = cc * dd;
-        f *= delta;
-        if (delta - 1.0).abs() < 1e-16 {
-            break;
-        }
-    }
-    let r = 0.5 / f;
-    (-a * a).exp() / (2.0 * sqrt_pi) * r / (a * (a + r))
+    let (piece, x) = if a < 4.0 {
+        (&PIECES[((a - 0.5) * 2.0) as usize], a)
+    } else {
+        (&PIECES[7], 1.0 / (a * a))
+    };
+    let s = (x - piece.mid) * piece.inv_half;
+    let f = piece
+        .coefficients
+        .iter()
+        .rev()
+        .fold(0.0, |acc, &c| acc * s + c);
+    exp_minus_square(a) * f / (4.0 * sqrt_pi * (a * a * a))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_support::{golden, integrate_tail, rel_err};
+    use crate::test_support::{golden, golden_beckmann, integrate_tail, rel_err};
 
     #[test]
     fn student_lambda_matches_mpmath() {
@@ -171,7 +186,9 @@ mod tests {
     #[test]
     fn beckmann_lambda_against_its_integral() {
         // Λ(a) = (1/a) ∫_a^∞ (q − a) e^{−q²}/√π dq.
-        for &a in &[1e-6, 0.1, 0.7, 1.49, 1.5, 1.51, 2.5, 6.0, 20.0] {
+        for &a in &[
+            1e-6, 0.1, 0.49, 0.5, 0.7, 1.49, 1.5, 1.51, 2.5, 3.99, 4.0, 6.0, 20.0,
+        ] {
             let f = |q: f64| (q - a) * (-q * q).exp() / PI.sqrt();
             let want = integrate_tail(&f, a, 1.0 / (1.0 + a), 1e-14) / a;
             let e = rel_err(beckmann_lambda(a), want);
@@ -181,10 +198,43 @@ mod tests {
                 beckmann_lambda(a)
             );
         }
-        // Continuity across the switch.
-        let below = beckmann_lambda(BECKMANN_SWITCH * (1.0 - 1e-15));
-        let above = beckmann_lambda(BECKMANN_SWITCH);
-        assert!(rel_err(below, above) < 1e-14);
+        // Continuity across the switch and the ends of the pieces (Λ's condition number in a
+        // is 1 … 3 + 2a²: a step of 1e-15 in a moves Λ by about that much).
+        for &a in &[BECKMANN_SWITCH, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0] {
+            let below = beckmann_lambda(a * (1.0 - 1e-15));
+            let above = beckmann_lambda(a);
+            let e = rel_err(below, above);
+            assert!(e < 1e-15 * (5.0 + 2.0 * a * a), "a = {a}: {e:e}");
+        }
+        assert_eq!(beckmann_lambda(BECKMANN_ZERO * (1.0 + 1e-15)), 0.0);
+        assert!(beckmann_lambda(BECKMANN_ZERO) < 1e-300);
+    }
+
+    #[test]
+    fn beckmann_lambda_matches_mpmath() {
+        // a is exact in the golden file: no condition-number allowance (e^{−a²} is computed
+        // from the exact a²).
+        let mut worst = (0.0, 0.0);
+        for row in golden_beckmann() {
+            let a = row["a"].as_f64().unwrap();
+            let want: f64 = row["lambda"].as_str().unwrap().parse().unwrap();
+            if !want.is_normal() {
+                continue;
+            }
+            let e = rel_err(beckmann_lambda(a), want);
+            if e > worst.0 {
+                worst = (e, a);
+            }
+            assert!(
+                e < 1e-15,
+                "a = {a}: {} vs {want} ({e:e})",
+                beckmann_lambda(a)
+            );
+        }
+        eprintln!(
+            "Beckmann Λ: max relative error {:.2e} at a = {}",
+            worst.0, worst.1
+        );
     }
 
     #[test]
