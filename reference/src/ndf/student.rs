@@ -197,7 +197,9 @@ impl Ndf for Student {
 impl Smith for Student {
     fn lambda(&self, w: Vec3) -> f64 {
         let x = self.standardized_cotangent(w);
-        lambda_both_hemispheres(x, |x| routes::lambda_stable(self.c, x))
+        lambda_both_hemispheres(x, |x| {
+            crate::special::student_tail::student_lambda_with_norm(self.c, self.p2_norm, x)
+        })
     }
 
     fn lambda_routes(&self) -> Vec<&'static str> {

@@ -37,8 +37,14 @@ use std::f64::consts::PI;
 /// ill-conditioned in x (condition number 2a²).
 ///
 /// Cost: see the criterion benchmark `closed_forms` (the continued fraction takes 2 × 4–60
-/// steps).
+/// steps; N_C alone costs up to 30 divisions, see `student_lambda_with_norm`).
 pub fn student_lambda(c: f64, x: f64) -> f64 {
+    student_lambda_with_norm(c, student_norm(c), x)
+}
+
+/// `student_lambda` with the constant N_C = Γ(C − ½)/(√π Γ(C − 1)) given (`n` must be
+/// `hyp2f1::student_norm(c)`, which a model computes once): the same value, bit for bit.
+pub fn student_lambda_with_norm(c: f64, n: f64, x: f64) -> f64 {
     if !(c > 1.5) || x.is_nan() || x < 0.0 {
         return f64::NAN;
     }
@@ -50,7 +56,6 @@ pub fn student_lambda(c: f64, x: f64) -> f64 {
     }
     let x2 = x * x;
     let s = x2 / (1.0 + x2);
-    let n = student_norm(c);
     let w_power = ((1.5 - c) * x2.ln_1p()).exp(); // w^{C − 3/2}
     if use_pfaff(c, s) {
         let a = n * w_power / ((2.0 * c - 3.0) * x);
