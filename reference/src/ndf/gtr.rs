@@ -10,7 +10,7 @@ use crate::model::{
 use crate::ndf::gtr_lambda as routes;
 use crate::spec::ModelSpec;
 use crate::special::gauss_kronrod;
-use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// The largest γ accepted (seed 004 §6: "values greater than 10 are impractical").
 pub const GAMMA_MAX: f64 = 10.0;
@@ -198,7 +198,7 @@ impl NormalSampler for Gtr {
     /// cos θ from u₂ (`cos2_sin2`), so that the density is D(m) cos θ_m.
     fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
         let (cos2, sin2) = self.cos2_sin2(u[1]);
-        let (sp, cp) = (TAU * u[0]).sin_cos();
+        let (sp, cp) = crate::geometry::sin_cos_turns(u[0]);
         let (st, ct) = (sin2.max(0.0).sqrt(), cos2.max(0.0).sqrt());
         let n = (sin2 + cos2).sqrt();
         [st * cp / n, st * sp / n, ct / n]
@@ -933,7 +933,7 @@ mod tests {
                 let l = 2.0 * f64::ln(a);
                 for &u in &[[0.1, 1e-6], [0.45, 0.2], [0.8, 0.5], [0.99, 0.999]] {
                     let w = m.sample_wm(u);
-                    let u1 = conformance::azimuth(w) / TAU;
+                    let u1 = conformance::azimuth(w) / std::f64::consts::TAU;
                     let ell = (w[0] * w[0] + w[1] * w[1] + a * a * w[2] * w[2]).ln();
                     let s = 1.0 - g;
                     let u2 = if s == 0.0 {
