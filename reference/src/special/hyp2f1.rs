@@ -100,14 +100,6 @@ pub(crate) fn beta_cf_delta(c: f64, s: f64, w: f64) -> f64 {
             p,
         )
     };
-    let coefficient = |j: usize| -> f64 {
-        let m = (j / 2) as f64;
-        if j % 2 == 0 {
-            m * (beta - m) * w / ((alpha + 2.0 * m - 1.0) * (alpha + 2.0 * m))
-        } else {
-            -(alpha + m) * (alpha + beta + m) * w / ((alpha + 2.0 * m) * (alpha + 2.0 * m + 1.0))
-        }
-    };
     // Forward: continuants of 1 + d₃/(1 + d₄/(1 + …)) from A₋₁ = 1, B₋₁ = 0, A₀ = B₀ = 1; the
     // determinant starts at −1. Rescaled (all by the same power of two, the determinant by its
     // square) if they leave [1e-100, 1e100].
@@ -116,14 +108,30 @@ pub(crate) fn beta_cf_delta(c: f64, s: f64, w: f64) -> f64 {
     let (mut a_prev, mut b_prev, mut a, mut b) = (1.0, 0.0, 1.0, 1.0);
     let mut det: f64 = -1.0;
     let mut needed = None;
-    for j in 3..MAX_TERMS {
-        let d = coefficient(j);
-        let (a_next, b_next) = (a + d * a_prev, b + d * b_prev);
-        det *= -d;
-        (a_prev, b_prev, a, b) = (a, b, a_next, b_next);
-        if det.abs() < 1e-16 * (a_prev * b).abs() {
-            needed = Some(j);
-            break;
+    // Levels in pairs j = 2m+1, 2m+2 (m = 1, 2, …), sharing one division:
+    // d_{2m+1} = −(α+m)(α+β+m)w (α+2m+2) / P,  d_{2m+2} = (m+1)(β−m−1)w (α+2m) / P,
+    // P = (α+2m)(α+2m+1)(α+2m+2).
+    let mut j = 3;
+    'pairs: while j < MAX_TERMS {
+        let m = (j / 2) as f64;
+        let (e0, e1, e2) = (
+            alpha + 2.0 * m,
+            alpha + 2.0 * m + 1.0,
+            alpha + 2.0 * m + 2.0,
+        );
+        let inverse = w / (e0 * e1 * e2);
+        let pair = [
+            -(alpha + m) * (alpha + beta + m) * e2 * inverse,
+            (m + 1.0) * (beta - m - 1.0) * e0 * inverse,
+        ];
+        for (k, d) in pair.into_iter().enumerate() {
+            let (a_next, b_next) = (a + d * a_prev, b + d * b_prev);
+            det *= -d;
+            (a_prev, b_prev, a, b) = (a, b, a_next, b_next);
+            if det.abs() < 1e-16 * (a_prev * b).abs() {
+                needed = Some(j + k);
+                break 'pairs;
+            }
         }
         let size = b.abs();
         if size > BIG {
@@ -133,6 +141,7 @@ pub(crate) fn beta_cf_delta(c: f64, s: f64, w: f64) -> f64 {
             (a_prev, b_prev, a, b) = (a_prev * BIG, b_prev * BIG, a * BIG, b * BIG);
             det *= BIG * BIG;
         }
+        j += 2;
     }
     let Some(needed) = needed else {
         return f64::NAN;
