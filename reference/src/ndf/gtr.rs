@@ -44,6 +44,33 @@ pub struct Gtr {
     a2: f64,
     /// The normalization constant c.
     c: f64,
+    /// The u-independent parts of the sampler's inversion (`cos2_sin2`).
+    inversion: Inversion,
+}
+
+/// The constants of the Burley inversion: L = log α², s = 1 − γ, expm1(sL), expm1(−sL),
+/// expm1(L).
+#[derive(Debug, Clone, PartialEq)]
+struct Inversion {
+    l: f64,
+    s: f64,
+    expm1_sl: f64,
+    expm1_minus_sl: f64,
+    expm1_l: f64,
+}
+
+impl Inversion {
+    fn new(gamma: f64, alpha: f64) -> Self {
+        let l = 2.0 * alpha.ln();
+        let s = 1.0 - gamma;
+        Self {
+            l,
+            s,
+            expm1_sl: (s * l).exp_m1(),
+            expm1_minus_sl: (-s * l).exp_m1(),
+            expm1_l: l.exp_m1(),
+        }
+    }
 }
 
 /// The normalization constant c of D_GTR (seed 004 eq 1**, 4**) in the form
@@ -83,6 +110,7 @@ impl Gtr {
             alpha,
             a2: alpha * alpha,
             c: normalization_constant(gamma, alpha),
+            inversion: Inversion::new(gamma, alpha),
         })
     }
 
@@ -140,23 +168,28 @@ impl Gtr {
     /// L − ℓ = −log1p(u expm1(−sL))/s                                 (→ uL at s = 0)
     /// ```
     ///
-    /// with s = 1 − γ, L = log α²; at α = 1, cos²θ = 1 − u.
+    /// with s = 1 − γ, L = log α²; at α = 1, cos²θ = 1 − u. The u-independent expm1 values
+    /// are computed once (`Inversion`); e^ℓ stays `exp` (1 + expm1(ℓ) cancels for small α).
     fn cos2_sin2(&self, u: f64) -> (f64, f64) {
-        let l = 2.0 * self.alpha.ln();
+        let Inversion {
+            l,
+            s,
+            expm1_sl,
+            expm1_minus_sl,
+            expm1_l,
+        } = self.inversion;
         if l == 0.0 {
             return (1.0 - u, u);
         }
-        let s = 1.0 - self.gamma;
         let (ell, delta) = if s == 0.0 {
             ((1.0 - u) * l, u * l)
         } else {
             (
-                ((1.0 - u) * (s * l).exp_m1()).ln_1p() / s,
-                -(u * (-s * l).exp_m1()).ln_1p() / s,
+                ((1.0 - u) * expm1_sl).ln_1p() / s,
+                -(u * expm1_minus_sl).ln_1p() / s,
             )
         };
-        let e = l.exp_m1();
-        (ell.exp_m1() / e, ell.exp() * delta.exp_m1() / e)
+        (ell.exp_m1() / expm1_l, ell.exp() * delta.exp_m1() / expm1_l)
     }
 }
 
