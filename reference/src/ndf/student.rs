@@ -9,6 +9,7 @@ use crate::model::{
 };
 use crate::ndf::student_lambda as routes;
 use crate::spec::ModelSpec;
+use crate::special::hyp2f1::BetaCfTable;
 use std::f64::consts::PI;
 
 /// The largest finite γ accepted: accuracy of every quantity is established up to here; use
@@ -59,6 +60,8 @@ pub struct Student {
     p2_norm: f64,
     /// How D raises 1 + t to the power −C.
     exponent: Exponent,
+    /// The continued-fraction coefficients of the stable Λ at this C.
+    cf_table: BetaCfTable,
 }
 
 /// The largest n for which D's (1 + t)^(−C) is a product of powers (C = n or n + ½).
@@ -155,6 +158,7 @@ impl Student {
             p22_norm: (c - 1.0) / (PI * sx * sy),
             p2_norm: routes::p2_norm(c),
             exponent: Exponent::of(c),
+            cf_table: BetaCfTable::new(c),
         }
     }
 
@@ -249,7 +253,12 @@ impl Smith for Student {
     fn lambda(&self, w: Vec3) -> f64 {
         let x = self.standardized_cotangent(w);
         lambda_both_hemispheres(x, |x| {
-            crate::special::student_tail::student_lambda_with_norm(self.c, self.p2_norm, x)
+            crate::special::student_tail::student_lambda_tabulated(
+                self.c,
+                self.p2_norm,
+                Some(&self.cf_table),
+                x,
+            )
         })
     }
 

@@ -79,6 +79,46 @@ pub(crate) fn pfaff_series(c: f64, s: f64) -> f64 {
 /// t' = (r q P + p n Q) / (p (q P + n Q)) with d_even = n/q, 1 + d_odd = r/p), rescaling P, Q
 /// by powers of two, which leaves P/Q exact.
 pub(crate) fn beta_cf_delta(c: f64, s: f64, w: f64) -> f64 {
+    beta_cf_delta_tabulated(c, s, w, None)
+}
+
+/// The w-free factors of the continued-fraction coefficients of `beta_cf_delta` for one C:
+/// d_j = κ_j w, tabulated in pairs (κ_{2m+1}, κ_{2m+2}), m = 1 … `TABLE_PAIRS`, so that a model
+/// evaluating Λ many times at one C spends no division per level.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BetaCfTable {
+    pairs: Vec<[f64; 2]>,
+}
+
+/// Pairs of levels tabulated (the fraction rarely needs more than 60 levels for C ≤ 100).
+const TABLE_PAIRS: usize = 64;
+
+impl BetaCfTable {
+    /// The table for C (> 1).
+    pub fn new(c: f64) -> Self {
+        let alpha = c - 1.0;
+        let beta = 0.5;
+        let pairs = (1..=TABLE_PAIRS)
+            .map(|m| {
+                let m = m as f64;
+                let (e0, e1, e2) = (
+                    alpha + 2.0 * m,
+                    alpha + 2.0 * m + 1.0,
+                    alpha + 2.0 * m + 2.0,
+                );
+                [
+                    -(alpha + m) * (alpha + beta + m) / (e0 * e1),
+                    (m + 1.0) * (beta - m - 1.0) / (e1 * e2),
+                ]
+            })
+            .collect();
+        Self { pairs }
+    }
+}
+
+/// `beta_cf_delta` with the coefficients of the first levels read from `table` (which must
+/// be `BetaCfTable::new(c)`), where given.
+pub(crate) fn beta_cf_delta_tabulated(c: f64, s: f64, w: f64, table: Option<&BetaCfTable>) -> f64 {
     /// Up to this C the forward value serves: its errors against mpmath are those of the
     /// backward pass (`reference/golden/student.json`, C ≤ 100, and 280 more points at
     /// C ∈ {1.7, 2.5, 3, 7.5, 20, 50, 100}, a = 0.3 … 25: the same maxima to three digits);
@@ -113,17 +153,22 @@ pub(crate) fn beta_cf_delta(c: f64, s: f64, w: f64) -> f64 {
     // P = (α+2m)(α+2m+1)(α+2m+2).
     let mut j = 3;
     'pairs: while j < MAX_TERMS {
-        let m = (j / 2) as f64;
-        let (e0, e1, e2) = (
-            alpha + 2.0 * m,
-            alpha + 2.0 * m + 1.0,
-            alpha + 2.0 * m + 2.0,
-        );
-        let inverse = w / (e0 * e1 * e2);
-        let pair = [
-            -(alpha + m) * (alpha + beta + m) * e2 * inverse,
-            (m + 1.0) * (beta - m - 1.0) * e0 * inverse,
-        ];
+        let pair = match table.and_then(|t| t.pairs.get(j / 2 - 1)) {
+            Some(&[odd, even]) => [odd * w, even * w],
+            None => {
+                let m = (j / 2) as f64;
+                let (e0, e1, e2) = (
+                    alpha + 2.0 * m,
+                    alpha + 2.0 * m + 1.0,
+                    alpha + 2.0 * m + 2.0,
+                );
+                let inverse = w / (e0 * e1 * e2);
+                [
+                    -(alpha + m) * (alpha + beta + m) * e2 * inverse,
+                    (m + 1.0) * (beta - m - 1.0) * e0 * inverse,
+                ]
+            }
+        };
         for (k, d) in pair.into_iter().enumerate() {
             let (a_next, b_next) = (a + d * a_prev, b + d * b_prev);
             det *= -d;

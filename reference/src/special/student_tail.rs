@@ -26,7 +26,10 @@
 //! converges slowly, Λ = A − ½ + N x ₂F₁ (Pfaff series) has no harmful cancellation.
 
 use super::beckmann_fit::PIECES;
-use super::hyp2f1::{beta_cf_delta, beta_cf_k_denominator, pfaff_series, student_norm, use_pfaff};
+use super::hyp2f1::{
+    beta_cf_delta_tabulated, beta_cf_k_denominator, pfaff_series, student_norm, use_pfaff,
+    BetaCfTable,
+};
 use std::f64::consts::PI;
 
 /// Λ_C(x) of the standardized Student slope distribution, C > 3/2, x ≥ 0 (x = +∞ gives 0,
@@ -45,6 +48,13 @@ pub fn student_lambda(c: f64, x: f64) -> f64 {
 /// `student_lambda` with the constant N_C = Γ(C − ½)/(√π Γ(C − 1)) given (`n` must be
 /// `hyp2f1::student_norm(c)`, which a model computes once): the same value, bit for bit.
 pub fn student_lambda_with_norm(c: f64, n: f64, x: f64) -> f64 {
+    student_lambda_tabulated(c, n, None, x)
+}
+
+/// `student_lambda_with_norm` with the continued fraction's coefficients read from `table`
+/// (`BetaCfTable::new(c)`, which a model builds once): no division per level; the same value
+/// to an ulp or two.
+pub fn student_lambda_tabulated(c: f64, n: f64, table: Option<&BetaCfTable>, x: f64) -> f64 {
     if !(c > 1.5) || x.is_nan() || x < 0.0 {
         return f64::NAN;
     }
@@ -63,7 +73,7 @@ pub fn student_lambda_with_norm(c: f64, n: f64, x: f64) -> f64 {
         return (a + nxf) - 0.5;
     }
     let w = 1.0 / (1.0 + x2);
-    let delta = beta_cf_delta(c, s, w);
+    let delta = beta_cf_delta_tabulated(c, s, w, table);
     let numerator = c - w + c * delta * (1.0 + (2.0 * c - 3.0) * w);
     let denominator = (2.0 * c - 3.0) * (2.0 * c - 2.0) * beta_cf_k_denominator(c, s, w, delta);
     n * w_power / x * numerator / denominator
@@ -178,7 +188,8 @@ mod tests {
 
     #[test]
     fn student_lambda_matches_mpmath() {
-        let mut worst: (f64, f64, f64) = (0.0, 0.0, 0.0);
+        // Untabulated (student_lambda) and with the model's coefficient table.
+        let mut worst = [(0.0, 0.0, 0.0); 2];
         for row in golden("lambda") {
             let c = row["c"].as_f64().unwrap();
             let x = row["x"].as_f64().unwrap();
@@ -186,23 +197,33 @@ mod tests {
             if !want.is_normal() {
                 continue;
             }
-            let got = student_lambda(c, x);
-            // Λ's condition number in x: |d ln Λ / d ln x| ≤ 1 + (2C − 1) s, s = x²/(1+x²)
-            // (≈ 2a² near normal incidence for large C): one ulp of x moves Λ that much.
-            let condition = 1.0 + (2.0 * c - 1.0) * x * x / (1.0 + x * x);
-            let e = rel_err(got, want) / condition;
-            if e > worst.0 {
-                worst = (e, c, x);
+            let table = BetaCfTable::new(c);
+            let tabulated = student_lambda_tabulated(c, student_norm(c), Some(&table), x);
+            for (k, got) in [student_lambda(c, x), tabulated].into_iter().enumerate() {
+                // Λ's condition number in x: |d ln Λ / d ln x| ≤ 1 + (2C − 1) s,
+                // s = x²/(1+x²) (≈ 2a² near normal incidence for large C): one ulp of x
+                // moves Λ that much.
+                let condition = 1.0 + (2.0 * c - 1.0) * x * x / (1.0 + x * x);
+                let e = rel_err(got, want) / condition;
+                if e > worst[k].0 {
+                    worst[k] = (e, c, x);
+                }
+                assert!(
+                    e < 1e-14,
+                    "C = {c}, x = {x}: {got} vs {want} ({e:e} × condition, tabulated: {})",
+                    k == 1
+                );
             }
-            assert!(
-                e < 1e-14,
-                "C = {c}, x = {x}: {got} vs {want} ({e:e} × condition)"
+        }
+        for (k, w) in worst.iter().enumerate() {
+            eprintln!(
+                "Λ_C{} max relative error / condition number {:.2e} at C = {}, x = {}",
+                if k == 1 { " (tabulated)" } else { "" },
+                w.0,
+                w.1,
+                w.2
             );
         }
-        eprintln!(
-            "Λ_C max relative error / condition number {:.2e} at C = {}, x = {}",
-            worst.0, worst.1, worst.2
-        );
     }
 
     #[test]
