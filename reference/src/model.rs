@@ -186,7 +186,7 @@ pub(crate) fn check_alpha(name: &'static str, value: f64) -> Result<f64, crate::
 /// This is the quadrant-correct form of seed 001 eq 11 / 40.
 #[inline]
 pub(crate) fn elliptic_direction(sx: f64, sy: f64, u1: f64) -> (f64, f64) {
-    let (s, c) = (std::f64::consts::TAU * u1).sin_cos();
+    let (s, c) = crate::geometry::sin_cos_turns(u1);
     (sx * c, sy * s)
 }
 

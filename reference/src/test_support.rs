@@ -95,3 +95,11 @@ pub fn golden(table: &str) -> Vec<serde_json::Value> {
         serde_json::from_str(include_str!("../golden/student.json")).expect("golden JSON");
     all[table].as_array().expect("golden table").clone()
 }
+
+/// The rows of `reference/golden/beckmann.json` (Beckmann Λ(a), mpmath, 60 digits; see its
+/// provenance block).
+pub fn golden_beckmann() -> Vec<serde_json::Value> {
+    let all: serde_json::Value =
+        serde_json::from_str(include_str!("../golden/beckmann.json")).expect("golden JSON");
+    all["lambda"].as_array().expect("golden table").clone()
+}

@@ -10,7 +10,7 @@ use crate::model::{
 use crate::ndf::gtr_lambda as routes;
 use crate::spec::ModelSpec;
 use crate::special::gauss_kronrod;
-use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// The largest γ accepted (seed 004 §6: "values greater than 10 are impractical").
 pub const GAMMA_MAX: f64 = 10.0;
@@ -44,6 +44,33 @@ pub struct Gtr {
     a2: f64,
     /// The normalization constant c.
     c: f64,
+    /// The u-independent parts of the sampler's inversion (`cos2_sin2`).
+    inversion: Inversion,
+}
+
+/// The constants of the Burley inversion: L = log α², s = 1 − γ, expm1(sL), expm1(−sL),
+/// expm1(L).
+#[derive(Debug, Clone, PartialEq)]
+struct Inversion {
+    l: f64,
+    s: f64,
+    expm1_sl: f64,
+    expm1_minus_sl: f64,
+    expm1_l: f64,
+}
+
+impl Inversion {
+    fn new(gamma: f64, alpha: f64) -> Self {
+        let l = 2.0 * alpha.ln();
+        let s = 1.0 - gamma;
+        Self {
+            l,
+            s,
+            expm1_sl: (s * l).exp_m1(),
+            expm1_minus_sl: (-s * l).exp_m1(),
+            expm1_l: l.exp_m1(),
+        }
+    }
 }
 
 /// The normalization constant c of D_GTR (seed 004 eq 1**, 4**) in the form
@@ -83,6 +110,7 @@ impl Gtr {
             alpha,
             a2: alpha * alpha,
             c: normalization_constant(gamma, alpha),
+            inversion: Inversion::new(gamma, alpha),
         })
     }
 
@@ -140,23 +168,28 @@ impl Gtr {
     /// L − ℓ = −log1p(u expm1(−sL))/s                                 (→ uL at s = 0)
     /// ```
     ///
-    /// with s = 1 − γ, L = log α²; at α = 1, cos²θ = 1 − u.
+    /// with s = 1 − γ, L = log α²; at α = 1, cos²θ = 1 − u. The u-independent expm1 values
+    /// are computed once (`Inversion`); e^ℓ stays `exp` (1 + expm1(ℓ) cancels for small α).
     fn cos2_sin2(&self, u: f64) -> (f64, f64) {
-        let l = 2.0 * self.alpha.ln();
+        let Inversion {
+            l,
+            s,
+            expm1_sl,
+            expm1_minus_sl,
+            expm1_l,
+        } = self.inversion;
         if l == 0.0 {
             return (1.0 - u, u);
         }
-        let s = 1.0 - self.gamma;
         let (ell, delta) = if s == 0.0 {
             ((1.0 - u) * l, u * l)
         } else {
             (
-                ((1.0 - u) * (s * l).exp_m1()).ln_1p() / s,
-                -(u * (-s * l).exp_m1()).ln_1p() / s,
+                ((1.0 - u) * expm1_sl).ln_1p() / s,
+                -(u * expm1_minus_sl).ln_1p() / s,
             )
         };
-        let e = l.exp_m1();
-        (ell.exp_m1() / e, ell.exp() * delta.exp_m1() / e)
+        (ell.exp_m1() / expm1_l, ell.exp() * delta.exp_m1() / expm1_l)
     }
 }
 
@@ -198,7 +231,7 @@ impl NormalSampler for Gtr {
     /// cos θ from u₂ (`cos2_sin2`), so that the density is D(m) cos θ_m.
     fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
         let (cos2, sin2) = self.cos2_sin2(u[1]);
-        let (sp, cp) = (TAU * u[0]).sin_cos();
+        let (sp, cp) = crate::geometry::sin_cos_turns(u[0]);
         let (st, ct) = (sin2.max(0.0).sqrt(), cos2.max(0.0).sqrt());
         let n = (sin2 + cos2).sqrt();
         [st * cp / n, st * sp / n, ct / n]
@@ -933,7 +966,7 @@ mod tests {
                 let l = 2.0 * f64::ln(a);
                 for &u in &[[0.1, 1e-6], [0.45, 0.2], [0.8, 0.5], [0.99, 0.999]] {
                     let w = m.sample_wm(u);
-                    let u1 = conformance::azimuth(w) / TAU;
+                    let u1 = conformance::azimuth(w) / std::f64::consts::TAU;
                     let ell = (w[0] * w[0] + w[1] * w[1] + a * a * w[2] * w[2]).ln();
                     let s = 1.0 - g;
                     let u2 = if s == 0.0 {
@@ -1048,6 +1081,7 @@ mod tests {
     mod accuracy_table {
         use super::*;
         use crate::test_support::integrate;
+        use std::f64::consts::TAU;
 
         const TABLE_GAMMAS: [f64; 13] = [
             0.0,

@@ -9,6 +9,7 @@ use crate::model::{
 };
 use crate::ndf::student_lambda as routes;
 use crate::spec::ModelSpec;
+use crate::special::hyp2f1::BetaCfTable;
 use std::f64::consts::PI;
 
 /// The largest finite γ accepted: accuracy of every quantity is established up to here; use
@@ -57,6 +58,36 @@ pub struct Student {
     p22_norm: f64,
     /// N_C = Γ(C − ½)/(√π Γ(C − 1)), the constant of the standardized P2.
     p2_norm: f64,
+    /// How D raises 1 + t to the power −C.
+    exponent: Exponent,
+    /// The continued-fraction coefficients of the stable Λ at this C.
+    cf_table: BetaCfTable,
+}
+
+/// The largest n for which D's (1 + t)^(−C) is a product of powers (C = n or n + ½).
+const SMALL_EXPONENT: f64 = 16.0;
+
+/// The form of the exponent C, chosen once at construction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Exponent {
+    /// C = n, an integer ≤ `SMALL_EXPONENT`.
+    Integer(i32),
+    /// C = n + ½, n an integer < `SMALL_EXPONENT`.
+    HalfInteger(i32),
+    /// Any other C.
+    General,
+}
+
+impl Exponent {
+    fn of(c: f64) -> Self {
+        if c <= SMALL_EXPONENT && c.fract() == 0.0 {
+            Self::Integer(c as i32)
+        } else if c <= SMALL_EXPONENT && (c - 0.5).fract() == 0.0 {
+            Self::HalfInteger((c - 0.5) as i32)
+        } else {
+            Self::General
+        }
+    }
 }
 
 impl Student {
@@ -126,6 +157,8 @@ impl Student {
             sy,
             p22_norm: (c - 1.0) / (PI * sx * sy),
             p2_norm: routes::p2_norm(c),
+            exponent: Exponent::of(c),
+            cf_table: BetaCfTable::new(c),
         }
     }
 
@@ -161,6 +194,18 @@ impl Student {
         normal_from_slopes(t * c, t * s)
     }
 
+    /// b^(−C) for b ≥ 1: 1/bⁿ (n = C ≤ `SMALL_EXPONENT`, an integer) or 1/(bⁿ √b) (C = n + ½),
+    /// else `powf`. The integer routes cost a few multiplications instead of a logarithm and
+    /// an exponential; each rounds ≤ log₂ n + 3 times.
+    #[inline]
+    fn power_of(&self, b: f64) -> f64 {
+        match self.exponent {
+            Exponent::Integer(n) => 1.0 / b.powi(n),
+            Exponent::HalfInteger(n) => 1.0 / (b.powi(n) * b.sqrt()),
+            Exponent::General => b.powf(-self.c),
+        }
+    }
+
     /// The squared standardized slope radius of eq 12 / 42: (1 − u)^{1/(1−C)} − 1, evaluated
     /// as expm1(−ln(1 − u)/(C − 1)) so that it keeps its relative accuracy for large C and
     /// small u.
@@ -188,7 +233,17 @@ impl Ndf for Student {
         let z2 = mz * mz;
         // tan²θ (cos²φ/s_x² + sin²φ/s_y²) = (m_x²/s_x² + m_y²/s_y²)/m_z²
         let t = ((m[0] / self.sx).powi(2) + (m[1] / self.sy).powi(2)) / z2;
-        // (1 + t)^(−C) / cos⁴θ in logarithms: exact for large C and t, no overflow of 1/m_z⁴.
+        // (1 + t)^(−C) / cos⁴θ: 1 + t = b + e exactly (TwoSum), (b + e)^(−C) =
+        // b^(−C) (1 − C e/b) to O((C ε)²), b^(−C) by `power_of` (a few ulps); falls back to
+        // logarithms (no overflow of 1/m_z⁴, no subnormal b^(−C)) near the horizon.
+        let b = 1.0 + t;
+        let bb = b - 1.0;
+        let e = (1.0 - (b - bb)) + (t - bb);
+        let power = self.power_of(b) * (1.0 - self.c * (e / b));
+        let z4 = z2 * z2;
+        if power > 1e-280 && z4 > 1e-280 {
+            return self.p22_norm * power / z4;
+        }
         let ln = -self.c * t.ln_1p() - 2.0 * z2.ln();
         self.p22_norm * ln.exp()
     }
@@ -197,7 +252,14 @@ impl Ndf for Student {
 impl Smith for Student {
     fn lambda(&self, w: Vec3) -> f64 {
         let x = self.standardized_cotangent(w);
-        lambda_both_hemispheres(x, |x| routes::lambda_stable(self.c, x))
+        lambda_both_hemispheres(x, |x| {
+            crate::special::student_tail::student_lambda_tabulated(
+                self.c,
+                self.p2_norm,
+                Some(&self.cf_table),
+                x,
+            )
+        })
     }
 
     fn lambda_routes(&self) -> Vec<&'static str> {

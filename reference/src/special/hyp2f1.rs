@@ -62,8 +62,11 @@ pub(crate) fn pfaff_series(c: f64, s: f64) -> f64 {
 /// fraction for I_w(C − 1, ½) after its first step. Computing δ rather than τ keeps the
 /// O(1/C²) correction that Λ depends on.
 ///
-/// Two passes: modified Lentz forward finds how many terms the fraction needs, then the
-/// fraction is evaluated backward (stable) with half as many again. In the backward pass
+/// Forward, the continuants Aₙ = Aₙ₋₁ + dₙAₙ₋₂ (and Bₙ) of t₃ = 1 + d₃/(1 + d₄/(1 + …)) run
+/// until |fₙ/fₙ₋₁ − 1| < 1e-16, i.e. |Π dₖ| < 1e-16 |Aₙ₋₁ Bₙ| (the determinant
+/// AₙBₙ₋₁ − Aₙ₋₁Bₙ = (−1)ⁿ Π dₖ): the stopping rule of modified Lentz without its two chained
+/// divisions per step. Up to C = `FORWARD_MAX`, δ = d₂ Bₙ/Aₙ. Above, where the forward value
+/// loses digits, a second pass backward (stable), with half as many terms again, in which
 /// every odd level 1 + d_{2m+1}/t uses 1 + d_{2m+1} written without cancellation,
 ///
 /// ```text
@@ -71,61 +74,145 @@ pub(crate) fn pfaff_series(c: f64, s: f64) -> f64 {
 /// ```
 ///
 /// (s = 1 − w given separately): for large C and w → 1 the plain 1 + d_{2m+1} loses
-/// log₁₀ C digits.
+/// log₁₀ C digits. The backward pass carries t as a fraction P/Q with every denominator
+/// multiplied out, so it divides once at the end (an even and an odd level at a time:
+/// t' = (r q P + p n Q) / (p (q P + n Q)) with d_even = n/q, 1 + d_odd = r/p), rescaling P, Q
+/// by powers of two, which leaves P/Q exact.
 pub(crate) fn beta_cf_delta(c: f64, s: f64, w: f64) -> f64 {
+    beta_cf_delta_tabulated(c, s, w, None)
+}
+
+/// The w-free factors of the continued-fraction coefficients of `beta_cf_delta` for one C:
+/// d_j = κ_j w, tabulated in pairs (κ_{2m+1}, κ_{2m+2}), m = 1 … `TABLE_PAIRS`, so that a model
+/// evaluating Λ many times at one C spends no division per level.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BetaCfTable {
+    pairs: Vec<[f64; 2]>,
+}
+
+/// Pairs of levels tabulated (the fraction rarely needs more than 60 levels for C ≤ 100).
+const TABLE_PAIRS: usize = 64;
+
+impl BetaCfTable {
+    /// The table for C (> 1).
+    pub fn new(c: f64) -> Self {
+        let alpha = c - 1.0;
+        let beta = 0.5;
+        let pairs = (1..=TABLE_PAIRS)
+            .map(|m| {
+                let m = m as f64;
+                let (e0, e1, e2) = (
+                    alpha + 2.0 * m,
+                    alpha + 2.0 * m + 1.0,
+                    alpha + 2.0 * m + 2.0,
+                );
+                [
+                    -(alpha + m) * (alpha + beta + m) / (e0 * e1),
+                    (m + 1.0) * (beta - m - 1.0) / (e1 * e2),
+                ]
+            })
+            .collect();
+        Self { pairs }
+    }
+}
+
+/// `beta_cf_delta` with the coefficients of the first levels read from `table` (which must
+/// be `BetaCfTable::new(c)`), where given.
+pub(crate) fn beta_cf_delta_tabulated(c: f64, s: f64, w: f64, table: Option<&BetaCfTable>) -> f64 {
+    /// Up to this C the forward value serves: its errors against mpmath are those of the
+    /// backward pass (`reference/golden/student.json`, C ≤ 100, and 280 more points at
+    /// C ∈ {1.7, 2.5, 3, 7.5, 20, 50, 100}, a = 0.3 … 25: the same maxima to three digits);
+    /// at C = 10⁴ it loses up to 4e-14 (1 + d_{2m+1} cancels).
+    const FORWARD_MAX: f64 = 100.0;
     let alpha = c - 1.0;
     let beta = 0.5;
-    let coefficient = |j: usize| -> f64 {
-        let m = (j / 2) as f64;
-        if j % 2 == 0 {
-            m * (beta - m) * w / ((alpha + 2.0 * m - 1.0) * (alpha + 2.0 * m))
-        } else {
-            -(alpha + m) * (alpha + beta + m) * w / ((alpha + 2.0 * m) * (alpha + 2.0 * m + 1.0))
-        }
+    // d_{2m} = n/q and 1 + d_{2m+1} = r/p, numerators and denominators apart.
+    let even = |m: f64| -> (f64, f64) {
+        (
+            m * (beta - m) * w,
+            (alpha + 2.0 * m - 1.0) * (alpha + 2.0 * m),
+        )
     };
-    let one_plus_odd = |j: usize| -> f64 {
-        let m = (j / 2) as f64;
+    let odd = |m: f64| -> (f64, f64) {
         let p = (alpha + 2.0 * m) * (alpha + 2.0 * m + 1.0);
-        (p * s + w * (alpha * (2.0 * m + 0.5) + 3.0 * m * m + 1.5 * m)) / p
+        (
+            p * s + w * (alpha * (2.0 * m + 0.5) + 3.0 * m * m + 1.5 * m),
+            p,
+        )
     };
-    // Forward (modified Lentz) only to count the terms needed.
-    const TINY: f64 = 1e-300;
-    let mut cc = 1.0;
-    let mut dd = 0.0;
+    // Forward: continuants of 1 + d₃/(1 + d₄/(1 + …)) from A₋₁ = 1, B₋₁ = 0, A₀ = B₀ = 1; the
+    // determinant starts at −1. Rescaled (all by the same power of two, the determinant by its
+    // square) if they leave [1e-100, 1e100].
+    const BIG: f64 = 8.749_002_899_132_048e99; // 2^332
+    const SMALL: f64 = 1.142_987_391_282_275e-100; // 2^-332
+    let (mut a_prev, mut b_prev, mut a, mut b) = (1.0, 0.0, 1.0, 1.0);
+    let mut det: f64 = -1.0;
     let mut needed = None;
-    for j in 3..MAX_TERMS {
-        let a = coefficient(j);
-        dd = 1.0 + a * dd;
-        if dd.abs() < TINY {
-            dd = TINY;
+    // Levels in pairs j = 2m+1, 2m+2 (m = 1, 2, …), sharing one division:
+    // d_{2m+1} = −(α+m)(α+β+m)w (α+2m+2) / P,  d_{2m+2} = (m+1)(β−m−1)w (α+2m) / P,
+    // P = (α+2m)(α+2m+1)(α+2m+2).
+    let mut j = 3;
+    'pairs: while j < MAX_TERMS {
+        let pair = match table.and_then(|t| t.pairs.get(j / 2 - 1)) {
+            Some(&[odd, even]) => [odd * w, even * w],
+            None => {
+                let m = (j / 2) as f64;
+                let (e0, e1, e2) = (
+                    alpha + 2.0 * m,
+                    alpha + 2.0 * m + 1.0,
+                    alpha + 2.0 * m + 2.0,
+                );
+                let inverse = w / (e0 * e1 * e2);
+                [
+                    -(alpha + m) * (alpha + beta + m) * e2 * inverse,
+                    (m + 1.0) * (beta - m - 1.0) * e0 * inverse,
+                ]
+            }
+        };
+        for (k, d) in pair.into_iter().enumerate() {
+            let (a_next, b_next) = (a + d * a_prev, b + d * b_prev);
+            det *= -d;
+            (a_prev, b_prev, a, b) = (a, b, a_next, b_next);
+            if det.abs() < 1e-16 * (a_prev * b).abs() {
+                needed = Some(j + k);
+                break 'pairs;
+            }
         }
-        cc = 1.0 + a / cc;
-        if cc.abs() < TINY {
-            cc = TINY;
+        let size = b.abs();
+        if size > BIG {
+            (a_prev, b_prev, a, b) = (a_prev * SMALL, b_prev * SMALL, a * SMALL, b * SMALL);
+            det *= SMALL * SMALL;
+        } else if size < SMALL {
+            (a_prev, b_prev, a, b) = (a_prev * BIG, b_prev * BIG, a * BIG, b * BIG);
+            det *= BIG * BIG;
         }
-        dd = 1.0 / dd;
-        if (cc * dd - 1.0).abs() < 1e-16 {
-            needed = Some(j);
-            break;
-        }
+        j += 2;
     }
     let Some(needed) = needed else {
         return f64::NAN;
     };
-    // Backward from an odd depth, carrying t and t − 1.
+    if c <= FORWARD_MAX {
+        // t₃ = Aₙ/Bₙ: the forward value is as accurate as the backward one here.
+        let (n, q) = even(1.0);
+        return n * b / (q * a);
+    }
+    // Backward from an odd depth 2M + 1: t = (1 + d_{2M+1}) = r/p, then pairs of levels.
     let depth = (needed + needed / 2 + 10) | 1;
-    let (mut t, mut t_minus_one) = (1.0, 0.0);
-    for j in (3..=depth).rev() {
-        if j % 2 == 1 {
-            let next = (one_plus_odd(j) + t_minus_one) / t;
-            t_minus_one = next - 1.0;
-            t = next;
-        } else {
-            t_minus_one = coefficient(j) / t;
-            t = 1.0 + t_minus_one;
+    let (r, p) = odd((depth / 2) as f64);
+    let (mut big_p, mut big_q) = (r, p);
+    for m in (1..depth / 2).rev() {
+        let m = m as f64;
+        let (n, q) = even(m + 1.0);
+        let (r, p) = odd(m);
+        let qp_nq = q * big_p + n * big_q;
+        (big_p, big_q) = (r * q * big_p + p * n * big_q, p * qp_nq);
+        if big_q > BIG {
+            (big_p, big_q) = (big_p * SMALL, big_q * SMALL);
         }
     }
-    coefficient(2) / t
+    // δ = d₂ / t₃.
+    let (n, q) = even(1.0);
+    n * big_q / (q * big_p)
 }
 
 /// The denominator Cτ − (C − ½)w of K, as C s + w/2 + Cδ (no cancellation for large C).
