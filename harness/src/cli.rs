@@ -31,6 +31,37 @@ pub enum Command {
         #[arg(long)]
         input: Option<PathBuf>,
     },
+    /// Audit a scene: plan the checks its materials and effects call for, run them against
+    /// independent oracles, print a summary, write report.json and junit.xml into --out.
+    ///
+    /// Exit status 0 if every check passes (expected failures included), 1 if one fails, 2 on
+    /// bad input.
+    Audit {
+        /// The scene file (JSON, DESIGN.md "Scenes"); default: the embedded default scene.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// How hard to look.
+        #[arg(long, value_enum, default_value = "quick")]
+        profile: crate::check::Profile,
+        /// The audit seed (default: MFH_SEED, else a fixed seed).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Output folder.
+        #[arg(long, default_value = "reports/latest")]
+        out: PathBuf,
+        /// Print report.json to standard output instead of the summary.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Print the plan of a scene: one JSON line per check, with the reason it is planned.
+    Plan {
+        /// The scene file; default: the embedded default scene.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// The profile.
+        #[arg(long, value_enum, default_value = "quick")]
+        profile: crate::check::Profile,
+    },
     /// Chi-square test of a model's normal sampler (sample_wm) against its pdf (pdf_wm) over
     /// a grid of R cos θ-rows × 2R φ-columns of the upper hemisphere.
     ///
@@ -86,6 +117,28 @@ where
         }
     };
     match cli.command {
+        Command::Audit {
+            scene,
+            profile,
+            seed,
+            out,
+            json,
+        } => run_audit(scene, profile, seed, out, json, stdout, stderr),
+        Command::Plan { scene, profile } => {
+            let scene = match load_scene(scene.as_deref()) {
+                Ok(s) => s,
+                Err(e) => {
+                    let _ = writeln!(stderr, "mfh plan: {e}");
+                    return EXIT_BAD_INPUT;
+                }
+            };
+            let plan = crate::plan::plan(&scene, profile);
+            for line in crate::plan::describe(&plan) {
+                let _ = writeln!(stdout, "{line}");
+            }
+            let _ = writeln!(stderr, "{} checks planned for scene \"{}\"", plan.len(), scene.name);
+            0
+        }
         Command::Chi2 {
             model,
             samples,
@@ -134,6 +187,85 @@ where
                 }
             }
         }
+    }
+}
+
+/// The scene at `path`, or the embedded default scene.
+fn load_scene(path: Option<&std::path::Path>) -> Result<crate::scene::Scene, crate::scene::SceneError> {
+    match path {
+        Some(p) => crate::scene::Scene::load(p),
+        None => Ok(crate::scene::Scene::default_scene()),
+    }
+}
+
+/// The seed from the option, else `MFH_SEED`, else the default; an unparsable `MFH_SEED` is bad
+/// input.
+pub fn resolve_seed(seed: Option<u64>) -> Result<u64, String> {
+    if let Some(s) = seed {
+        return Ok(s);
+    }
+    match std::env::var("MFH_SEED") {
+        Ok(text) => text
+            .trim()
+            .parse()
+            .map_err(|_| format!("MFH_SEED={text:?} is not an unsigned integer")),
+        Err(_) => Ok(crate::oracle::chi2::DEFAULT_SEED),
+    }
+}
+
+fn run_audit(
+    scene_path: Option<PathBuf>,
+    profile: crate::check::Profile,
+    seed: Option<u64>,
+    out: PathBuf,
+    json: bool,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> i32 {
+    let scene = match load_scene(scene_path.as_deref()) {
+        Ok(s) => s,
+        Err(e) => {
+            let _ = writeln!(stderr, "mfh audit: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let seed = match resolve_seed(seed) {
+        Ok(s) => s,
+        Err(e) => {
+            let _ = writeln!(stderr, "mfh audit: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    if let Err(e) = std::fs::create_dir_all(&out) {
+        let _ = writeln!(stderr, "mfh audit: cannot create {}: {e}", out.display());
+        return EXIT_BAD_INPUT;
+    }
+    let options = crate::audit::AuditOptions {
+        profile,
+        seed,
+        out: Some(out.clone()),
+    };
+    let scene_name = scene_path.as_ref().map(|p| p.display().to_string());
+    let report = crate::audit::audit_scene(&scene, scene_name.as_deref(), &options);
+    let written = match crate::report::write_all(&report, &out) {
+        Ok(w) => w,
+        Err(e) => {
+            let _ = writeln!(stderr, "mfh audit: cannot write the report into {}: {e}", out.display());
+            return EXIT_BAD_INPUT;
+        }
+    };
+    if json {
+        let _ = writeln!(stdout, "{}", crate::report::json::to_string(&report));
+    } else {
+        let _ = write!(stdout, "{}", crate::report::terminal::render(&report, 20));
+        for p in written {
+            let _ = writeln!(stdout, "wrote {}", p.display());
+        }
+    }
+    if report.passed() {
+        0
+    } else {
+        1
     }
 }
 

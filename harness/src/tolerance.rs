@@ -121,6 +121,24 @@ pub struct ExpectedFailure {
 pub const EXPECTED_FAILURES: &[ExpectedFailure] = &[
     ExpectedFailure {
         check: "smith.lambda_route",
+        family: "ggx",
+        route: "table1",
+        erratum: "limit",
+        reason: "seed 001 Table 1 (γ = 2 row) writes GGX Λ as (−1 + √(1 + α²tan²θ))/2, which \
+                 cancels near normal incidence (relative error ~1e-9 at θ = 1e-3, total below \
+                 θ ≈ 1e-8); the default route uses α²tan²θ/(1 + √(1 + α²tan²θ))/2",
+    },
+    ExpectedFailure {
+        check: "smith.lambda_route",
+        family: "beckmann",
+        route: "table1",
+        erratum: "limit",
+        reason: "seed 001 Table 1 (γ = ∞ row) writes Beckmann Λ as (e^{−a²}/(a√π) − erfc a)/2, \
+                 a difference of nearly equal terms for large a (near normal incidence); the \
+                 default route uses a continued fraction of the difference",
+    },
+    ExpectedFailure {
+        check: "smith.lambda_route",
         family: "student",
         route: "2f1",
         erratum: "limit",

@@ -1,0 +1,273 @@
+//! The audit: runs a plan in parallel with per-check seeds, applies the Šidák correction across
+//! its statistical checks, and summarizes. This is also the public API a renderer's own tests
+//! call as a CI gate (`audit_scene(..)?.assert_pass()`).
+
+use crate::check::{Planned, Profile, RunContext};
+use crate::oracle::chi2::{sidak_alpha, splitmix64, DEFAULT_SEED};
+use crate::plan::plan;
+use crate::record::{CheckRecord, Measured, Verdict, SCHEMA_VERSION};
+use crate::scene::Scene;
+use crate::tolerance::STATISTICAL_ALPHA;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// How to run an audit.
+#[derive(Debug, Clone)]
+pub struct AuditOptions {
+    /// The profile.
+    pub profile: Profile,
+    /// The audit seed (every check's stream derives from it).
+    pub seed: u64,
+    /// Where artefacts go (None: none are written).
+    pub out: Option<PathBuf>,
+}
+
+impl Default for AuditOptions {
+    fn default() -> Self {
+        Self {
+            profile: Profile::Quick,
+            seed: DEFAULT_SEED,
+            out: None,
+        }
+    }
+}
+
+/// Counts and extremes of an audit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// Records by verdict name.
+    pub counts: BTreeMap<String, usize>,
+    /// The worst measured error (relative or absolute) per model family, with its check.
+    pub worst_error: BTreeMap<String, (f64, String)>,
+    /// Records, time (s) and worst error per check id.
+    pub by_check: BTreeMap<String, CheckSummary>,
+    /// The Šidák level each statistical check was judged at, and how many there were.
+    pub statistical: (usize, f64),
+    /// Wall time of the whole audit, seconds.
+    pub wall_seconds: f64,
+}
+
+/// Per-check-id totals.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct CheckSummary {
+    /// Records.
+    pub records: usize,
+    /// Failing records (fail or error).
+    pub failures: usize,
+    /// Expected failures.
+    pub expected_failures: usize,
+    /// Summed wall time of its records (CPU-parallel, so it can exceed the audit's wall time).
+    pub seconds: f64,
+    /// The worst measured error among passing records.
+    pub worst_passing_error: f64,
+}
+
+/// The result of an audit, as written to `report.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct AuditReport {
+    /// The record schema version.
+    pub schema_version: u32,
+    /// mfh's version.
+    pub mfh_version: &'static str,
+    /// The scene's name.
+    pub scene: String,
+    /// The profile.
+    pub profile: Profile,
+    /// The audit seed.
+    pub seed: u64,
+    /// The command that reproduces the run.
+    pub command: String,
+    /// The summary.
+    pub summary: Summary,
+    /// Every record, in plan order.
+    pub records: Vec<CheckRecord>,
+}
+
+impl AuditReport {
+    /// Whether the audit passes: no record failed or errored (expected failures pass).
+    pub fn passed(&self) -> bool {
+        !self.records.iter().any(|r| r.verdict.is_failure())
+    }
+
+    /// The CI gate: Ok when the audit passes, else an error listing the failures.
+    pub fn assert_pass(&self) -> Result<(), String> {
+        let failures: Vec<String> = self
+            .records
+            .iter()
+            .filter(|r| r.verdict.is_failure())
+            .map(|r| format!("{} {} {}: {:?}", r.check, r.model, r.case, r.verdict))
+            .collect();
+        if failures.is_empty() {
+            Ok(())
+        } else {
+            Err(format!(
+                "{} check(s) failed (seed {}; reproduce: {}):\n{}",
+                failures.len(),
+                self.seed,
+                self.command,
+                failures.join("\n")
+            ))
+        }
+    }
+}
+
+/// FNV-1a of a string: a stable key for seeding (std's hasher may change between releases).
+fn fnv1a(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// The seed of one planned check: the audit seed mixed with its id, model and case, so that
+/// neither plan order nor thread count changes any stream.
+pub fn check_seed(seed: u64, planned: &Planned) -> u64 {
+    splitmix64(seed ^ fnv1a(&format!("{}|{}|{}", planned.check, planned.model, planned.case)))
+}
+
+/// Runs a plan: every check in parallel (with `MFH_TRACE` set, each start and end is printed
+/// to standard error with its time), records in plan order, statistical verdicts at the
+/// Šidák-corrected level.
+pub fn run_plan(plan: &[Planned], options: &AuditOptions) -> (Vec<CheckRecord>, usize, f64) {
+    let trace = std::env::var_os("MFH_TRACE").is_some();
+    let mut records: Vec<CheckRecord> = plan
+        .par_iter()
+        .map(|p| {
+            if trace {
+                eprintln!("start {} {} {}", p.check, p.model, p.case);
+            }
+            let ctx = RunContext {
+                seed: check_seed(options.seed, p),
+                out: options.out.clone(),
+            };
+            let mut r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| (p.run)(&ctx)))
+                .unwrap_or_else(|e| {
+                    let mut r = CheckRecord::new(&p.check, p.model.clone(), p.case.clone(), "");
+                    let message = e
+                        .downcast_ref::<String>()
+                        .cloned()
+                        .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
+                        .unwrap_or_default();
+                    r.verdict = Verdict::Error {
+                        message: format!("the check panicked: {message}"),
+                    };
+                    r
+                });
+            if r.covers.is_empty() {
+                r.covers = p.covers.clone();
+            }
+            if trace {
+                eprintln!(
+                    "done {:.3}s {} {} {} {}",
+                    r.cost.wall_seconds,
+                    r.verdict.name(),
+                    p.check,
+                    p.model,
+                    p.case
+                );
+            }
+            r
+        })
+        .collect();
+    let k = records.iter().filter(|r| r.is_statistical()).count();
+    let alpha = sidak_alpha(STATISTICAL_ALPHA.value, k);
+    for r in records.iter_mut() {
+        if let Some(Measured::PValue { p, statistic, dof, .. }) = r.measured {
+            r.measured = Some(Measured::PValue {
+                p,
+                statistic,
+                dof,
+                alpha,
+            });
+            if matches!(r.verdict, Verdict::Pass | Verdict::Fail) {
+                r.verdict = if p >= alpha { Verdict::Pass } else { Verdict::Fail };
+            }
+        }
+    }
+    (records, k, alpha)
+}
+
+/// The family of a record's model (its `family` key), or the check's family for non-NDF checks.
+fn family_of(r: &CheckRecord) -> String {
+    r.model
+        .get("family")
+        .and_then(|f| f.as_str())
+        .map(str::to_string)
+        .unwrap_or_else(|| r.check.split('.').next().unwrap_or("").to_string())
+}
+
+/// Summarizes records.
+pub fn summarize(records: &[CheckRecord], statistical: (usize, f64), wall_seconds: f64) -> Summary {
+    let mut counts = BTreeMap::new();
+    for name in ["pass", "fail", "expected_failure", "skipped", "error"] {
+        counts.insert(name.to_string(), 0);
+    }
+    let mut worst_error: BTreeMap<String, (f64, String)> = BTreeMap::new();
+    let mut by_check: BTreeMap<String, CheckSummary> = BTreeMap::new();
+    for r in records {
+        *counts.entry(r.verdict.name().to_string()).or_default() += 1;
+        let c = by_check.entry(r.check.clone()).or_default();
+        c.records += 1;
+        c.seconds += r.cost.wall_seconds;
+        if r.verdict.is_failure() {
+            c.failures += 1;
+        }
+        if matches!(r.verdict, Verdict::ExpectedFailure { .. }) {
+            c.expected_failures += 1;
+        }
+        if r.verdict == Verdict::Pass {
+            if let Some(e) = r.measured.and_then(|m| m.error()) {
+                c.worst_passing_error = c.worst_passing_error.max(e);
+                if !matches!(r.measured, Some(Measured::Rate { .. })) {
+                    let w = worst_error
+                        .entry(family_of(r))
+                        .or_insert((0.0, String::new()));
+                    if e > w.0 {
+                        *w = (e, format!("{} {}", r.check, r.case));
+                    }
+                }
+            }
+        }
+    }
+    Summary {
+        counts,
+        worst_error,
+        by_check,
+        statistical,
+        wall_seconds,
+    }
+}
+
+/// The command line that reproduces an audit.
+pub fn reproduce_command(scene: Option<&str>, options: &AuditOptions) -> String {
+    let mut c = format!(
+        "mfh audit --profile {} --seed {}",
+        options.profile.name(),
+        options.seed
+    );
+    if let Some(s) = scene {
+        c.push_str(&format!(" --scene {s}"));
+    }
+    c
+}
+
+/// Audits a scene: plans, runs, corrects, summarizes. `scene_path` only names the scene in
+/// the reproduce command.
+pub fn audit_scene(scene: &Scene, scene_path: Option<&str>, options: &AuditOptions) -> AuditReport {
+    let t = Instant::now();
+    let planned = plan(scene, options.profile);
+    let (records, k, alpha) = run_plan(&planned, options);
+    let summary = summarize(&records, (k, alpha), t.elapsed().as_secs_f64());
+    AuditReport {
+        schema_version: SCHEMA_VERSION,
+        mfh_version: env!("CARGO_PKG_VERSION"),
+        scene: scene.name.clone(),
+        profile: options.profile,
+        seed: options.seed,
+        command: reproduce_command(scene_path, options),
+        summary,
+        records,
+    }
+}
