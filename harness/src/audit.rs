@@ -124,7 +124,12 @@ fn fnv1a(text: &str) -> u64 {
 /// The seed of one planned check: the audit seed mixed with its id, model and case, so that
 /// neither plan order nor thread count changes any stream.
 pub fn check_seed(seed: u64, planned: &Planned) -> u64 {
-    splitmix64(seed ^ fnv1a(&format!("{}|{}|{}", planned.check, planned.model, planned.case)))
+    splitmix64(
+        seed ^ fnv1a(&format!(
+            "{}|{}|{}",
+            planned.check, planned.model, planned.case
+        )),
+    )
 }
 
 /// Runs a plan: every check in parallel (with `MFH_TRACE` set, each start and end is printed
@@ -174,7 +179,10 @@ pub fn run_plan(plan: &[Planned], options: &AuditOptions) -> (Vec<CheckRecord>, 
     let k = records.iter().filter(|r| r.is_statistical()).count();
     let alpha = sidak_alpha(STATISTICAL_ALPHA.value, k);
     for r in records.iter_mut() {
-        if let Some(Measured::PValue { p, statistic, dof, .. }) = r.measured {
+        if let Some(Measured::PValue {
+            p, statistic, dof, ..
+        }) = r.measured
+        {
             r.measured = Some(Measured::PValue {
                 p,
                 statistic,
@@ -182,7 +190,11 @@ pub fn run_plan(plan: &[Planned], options: &AuditOptions) -> (Vec<CheckRecord>, 
                 alpha,
             });
             if matches!(r.verdict, Verdict::Pass | Verdict::Fail) {
-                r.verdict = if p >= alpha { Verdict::Pass } else { Verdict::Fail };
+                r.verdict = if p >= alpha {
+                    Verdict::Pass
+                } else {
+                    Verdict::Fail
+                };
             }
         }
     }

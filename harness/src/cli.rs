@@ -136,7 +136,12 @@ where
             for line in crate::plan::describe(&plan) {
                 let _ = writeln!(stdout, "{line}");
             }
-            let _ = writeln!(stderr, "{} checks planned for scene \"{}\"", plan.len(), scene.name);
+            let _ = writeln!(
+                stderr,
+                "{} checks planned for scene \"{}\"",
+                plan.len(),
+                scene.name
+            );
             0
         }
         Command::Chi2 {
@@ -191,7 +196,9 @@ where
 }
 
 /// The scene at `path`, or the embedded default scene.
-fn load_scene(path: Option<&std::path::Path>) -> Result<crate::scene::Scene, crate::scene::SceneError> {
+fn load_scene(
+    path: Option<&std::path::Path>,
+) -> Result<crate::scene::Scene, crate::scene::SceneError> {
     match path {
         Some(p) => crate::scene::Scene::load(p),
         None => Ok(crate::scene::Scene::default_scene()),
@@ -250,7 +257,11 @@ fn run_audit(
     let written = match crate::report::write_all(&report, &out) {
         Ok(w) => w,
         Err(e) => {
-            let _ = writeln!(stderr, "mfh audit: cannot write the report into {}: {e}", out.display());
+            let _ = writeln!(
+                stderr,
+                "mfh audit: cannot write the report into {}: {e}",
+                out.display()
+            );
             return EXIT_BAD_INPUT;
         }
     };

@@ -3,15 +3,15 @@
 //!
 //! The binary `mfh` is a thin layer over [`cli::run`].
 
+pub mod audit;
 pub mod check;
 pub mod chi2_command;
 pub mod cli;
 pub mod eval;
 pub mod eval_sg;
-pub mod audit;
 pub mod oracle;
 pub mod plan;
-pub mod scene;
 pub mod record;
 pub mod report;
+pub mod scene;
 pub mod tolerance;

@@ -11,7 +11,11 @@ use std::sync::Arc;
 /// The source document (seed id) each family comes from.
 pub fn document_of(family: &str) -> &'static [&'static str] {
     match family {
-        "beckmann" | "ggx" | "std" | "hyper_cauchy" | "student_fixed_variance"
+        "beckmann"
+        | "ggx"
+        | "std"
+        | "hyper_cauchy"
+        | "student_fixed_variance"
         | "student_general" => &["001"],
         "gtr" => &["004"],
         "piecewise_linear" | "blend" => &["000"],
@@ -35,7 +39,10 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
         documents.extend(document_of(family).iter().copied());
         let spec = serde_json::to_value(&material.model).unwrap_or(Value::Null);
         let why = format!("material `{}` ({family})", material.name);
-        out.extend(normalization::plan(model.clone(), &format!("{why} evaluates D")));
+        out.extend(normalization::plan(
+            model.clone(),
+            &format!("{why} evaluates D"),
+        ));
         out.extend(stability::plan(
             &spec,
             &format!("{why}: its parameters pushed to the ends of their domains"),

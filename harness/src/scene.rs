@@ -249,15 +249,27 @@ mod tests {
         let e = Scene::parse(r#"{"name": "x", "materials": []}"#, "s.json").unwrap_err();
         assert!(matches!(e, SceneError::NoMaterials { .. }));
         let bad = r#"{"name": "x", "materials": [{"name": "a", "model": {"family": "ggx", "alpha": -1}}]}"#;
-        assert!(matches!(Scene::parse(bad, "s").unwrap_err(), SceneError::InvalidModel { .. }));
+        assert!(matches!(
+            Scene::parse(bad, "s").unwrap_err(),
+            SceneError::InvalidModel { .. }
+        ));
         let dup = r#"{"name": "x", "materials": [{"name": "a", "model": {"family": "ggx", "alpha": 0.1}},
                      {"name": "a", "model": {"family": "ggx", "alpha": 0.2}}]}"#;
-        assert!(matches!(Scene::parse(dup, "s").unwrap_err(), SceneError::DuplicateMaterial { .. }));
+        assert!(matches!(
+            Scene::parse(dup, "s").unwrap_err(),
+            SceneError::DuplicateMaterial { .. }
+        ));
         let theta = r#"{"name": "x", "materials": [{"name": "a", "model": {"family": "ggx", "alpha": 0.1}}],
                        "incidence": {"theta_max": 2}}"#;
-        assert!(matches!(Scene::parse(theta, "s").unwrap_err(), SceneError::ThetaMax { .. }));
+        assert!(matches!(
+            Scene::parse(theta, "s").unwrap_err(),
+            SceneError::ThetaMax { .. }
+        ));
         let key = r#"{"name": "x", "materials": [{"name": "a", "model": {"family": "ggx", "alpha": 0.1}, "shading": 1}]}"#;
-        assert!(Scene::parse(key, "s").unwrap_err().to_string().contains("shading"));
+        assert!(Scene::parse(key, "s")
+            .unwrap_err()
+            .to_string()
+            .contains("shading"));
     }
 
     #[test]

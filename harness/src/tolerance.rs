@@ -121,6 +121,24 @@ pub struct ExpectedFailure {
 pub const EXPECTED_FAILURES: &[ExpectedFailure] = &[
     ExpectedFailure {
         check: "smith.lambda_route",
+        family: "gtr",
+        route: "implementation",
+        erratum: "limit",
+        reason: "seed 004 §3 gives the implementation forms as G1, and Λ = 1/G1 − 1 cancels \
+                 near normal incidence (Λ ≈ 1e-8 at θ = 1e-3: relative error ~1e-9, measured \
+                 1.4e-9 at γ = 1, 3.4e-9 at γ = 2); the G1 values themselves agree to 1.4e-13",
+    },
+    ExpectedFailure {
+        check: "smith.lambda_route",
+        family: "piecewise_linear",
+        route: "domain_split_adaptive",
+        erratum: "limit",
+        reason: "seed 000 eq 34 forms Λ as (I₁₁ + I₂)/cos θ − ½, a difference of O(1) terms: \
+                 only absolute accuracy (|ΔΛ|/(1 + Λ) ≤ 1e-13), so near normal incidence, where \
+                 Λ ≈ 3e-11 at θ = 1e-3, the relative error reaches ~1e-6",
+    },
+    ExpectedFailure {
+        check: "smith.lambda_route",
         family: "ggx",
         route: "table1",
         erratum: "limit",

@@ -130,6 +130,23 @@ pub fn lobe_width(spec: &Value) -> f64 {
     }
 }
 
+/// The polar angles (radians, strictly inside (0, π/2)) where D has kinks for every azimuth:
+/// the breakpoints of a piecewise-linear NDF's profiles (both profiles of the anisotropic blend
+/// of seed 000 eq 1, whose weights depend on φ only). Quadrature oracles cut there, so that each
+/// piece is smooth and the double-exponential rule converges at its usual rate.
+pub fn theta_kinks(spec: &Value) -> Vec<f64> {
+    let mut out: Vec<f64> = ["x", "y"]
+        .iter()
+        .filter_map(|k| spec.get(k)?.get("theta")?.as_array())
+        .flatten()
+        .filter_map(Value::as_f64)
+        .filter(|t| *t > 0.0 && *t < std::f64::consts::FRAC_PI_2)
+        .collect();
+    out.sort_by(f64::total_cmp);
+    out.dedup();
+    out
+}
+
 /// Fills `record` with the comparison of `value` against the oracle's estimate: relative error
 /// (absolute where the oracle is 0), pass when it is within `tolerance` plus the oracle's own
 /// relative error bound.

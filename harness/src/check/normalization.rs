@@ -1,7 +1,7 @@
 //! Normalization: ∫ D(m)(m·n) dm = 1 over the hemisphere, by nested adaptive quadrature.
 
-use super::{compare, covers, lobe_width, timed, Planned};
-use crate::oracle::quadrature::{integrate_hemisphere, Accuracy};
+use super::{compare, covers, lobe_width, theta_kinks, timed, Planned};
+use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
 use crate::oracle::Estimate;
 use crate::record::CheckRecord;
 use crate::tolerance::NORMALIZATION;
@@ -32,10 +32,14 @@ pub fn plan(model: Arc<dyn Model>, why: &str) -> Vec<Planned> {
                      seed 004 §2)",
                 );
                 r.covers = vec![covers(family, "d", "default")];
+                let kinks = theta_kinks(&spec_run);
                 let e = integrate_hemisphere(
                     &|w| m.d(w) * w[2],
                     lobe_width(&spec_run),
-                    None,
+                    Some(Cuts {
+                        theta: &|_| kinks.clone(),
+                        phi: &[],
+                    }),
                     Accuracy::relative(1e-11),
                 );
                 // The value under test is the quadrature of the closed form, so the

@@ -6,6 +6,7 @@ pub mod cubature;
 pub mod domain;
 pub mod monte_carlo;
 pub mod quadrature;
+pub mod student_t;
 
 /// An integral (or other numerical) estimate with a bound on its error.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]

@@ -15,6 +15,22 @@ use std::cell::Cell;
 /// (honest) error bound rather than bisecting for ever at round-off.
 pub const MAX_PIECES: usize = 400;
 
+/// The relative round-off floor of a target: 32 ulps of the summed magnitudes of the pieces.
+const ROUNDOFF: f64 = 32.0 * f64::EPSILON;
+
+/// How much rounding of the nodes themselves magnifies round-off on [lo, hi]: a node next to
+/// an end point x is known only to ~ε|x|, so on a piece narrow next to its own position (the
+/// sliver between a terminator and the horizon at normal incidence, θ ≈ π/2 over 1e-5) an
+/// integrand that varies across the piece is resolved only to ~ε|x|/(hi − lo) relative.
+fn node_noise(lo: f64, hi: f64) -> f64 {
+    let width = (hi - lo).abs();
+    if width > 0.0 {
+        1.0 + 0.125 * lo.abs().max(hi.abs()) / width
+    } else {
+        1.0
+    }
+}
+
 /// The accuracy asked of an integral: stop when the error bound is ≤ max(relative·|I|, absolute).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Accuracy {
@@ -95,7 +111,16 @@ pub fn integrate_pieces(f: &dyn Fn(f64) -> f64, points: &[f64], accuracy: Accura
     loop {
         let value: f64 = pieces.iter().map(|p| p.value).sum();
         let error: f64 = pieces.iter().map(|p| p.error).sum();
-        let target = (accuracy.relative * value.abs()).max(accuracy.absolute);
+        let magnitude: f64 = pieces
+            .iter()
+            .map(|p| p.value.abs() * node_noise(p.lo, p.hi))
+            .sum();
+        // Never ask for less than the round-off of the sum: past it, bisection only trades one
+        // rounding error for another (and used to run to MAX_PIECES on every inner integral of
+        // a nested cubature).
+        let target = (accuracy.relative * value.abs())
+            .max(accuracy.absolute)
+            .max(ROUNDOFF * magnitude);
         let unrefined = pieces.iter().position(|p| !p.refined);
         if unrefined.is_none() && (!(error > target) || pieces.len() >= MAX_PIECES) {
             return Estimate {
@@ -113,7 +138,13 @@ pub fn integrate_pieces(f: &dyn Fn(f64) -> f64, points: &[f64], accuracy: Accura
                 .unwrap_or(0)
         });
         let piece = pieces.swap_remove(worst);
-        let share = |lo: f64, hi: f64| 0.5 * target * (hi - lo) / span.max(f64::MIN_POSITIVE);
+        // A piece's share of the target, but not below its own round-off (a double-exponential
+        // rule asked for less runs to its deepest level for nothing).
+        let floor = ROUNDOFF * piece.value.abs() * node_noise(piece.lo, piece.hi);
+        let share = |lo: f64, hi: f64| {
+            (0.5 * target * (hi - lo) / span.max(f64::MIN_POSITIVE))
+                .max(floor * (hi - lo) / (piece.hi - piece.lo))
+        };
         if !piece.refined {
             pieces.push(estimate(
                 piece.lo,
@@ -238,6 +269,25 @@ pub fn integrate_cap(
     accuracy: Accuracy,
 ) -> Estimate {
     let frame = frame_about(axis);
+    integrate_cap_polar(
+        &|theta, phi| f(direction(&frame, theta, phi)),
+        theta_max,
+        width,
+        cuts,
+        accuracy,
+    )
+}
+
+/// [`integrate_cap`] for an integrand given in the cap's own polar coordinates (θ, φ), for
+/// integrands that are better computed from the angles than from the direction (e.g. w·m near
+/// its zero, as R sin(θ_t − θ) without the cancellation of a Cartesian dot product).
+pub fn integrate_cap_polar(
+    f: &dyn Fn(f64, f64) -> f64,
+    theta_max: f64,
+    width: f64,
+    cuts: Option<Cuts<'_>>,
+    accuracy: Accuracy,
+) -> Estimate {
     let evaluations = Cell::new(0u64);
     let inner_error = Cell::new(0.0f64);
     let mut polar_cuts = vec![0.0];
@@ -267,7 +317,7 @@ pub fn integrate_cap(
         points.dedup();
         let e = integrate_pieces(
             &|theta| {
-                let v = f(direction(&frame, theta, phi));
+                let v = f(theta, phi);
                 if v == 0.0 {
                     0.0
                 } else {
@@ -306,6 +356,17 @@ pub fn integrate_cap(
         error_bound: outer.error_bound + mean_inner * tau,
         evaluations: evaluations.get(),
     }
+}
+
+/// [`integrate_hemisphere`] for an integrand of (θ, φ), the spherical coordinates of m about +z
+/// with φ measured from +x.
+pub fn integrate_hemisphere_polar(
+    f: &dyn Fn(f64, f64) -> f64,
+    width: f64,
+    cuts: Option<Cuts<'_>>,
+    accuracy: Accuracy,
+) -> Estimate {
+    integrate_cap_polar(f, std::f64::consts::FRAC_PI_2, width, cuts, accuracy)
 }
 
 /// ∫ f(m) dm over the upper hemisphere (n = +z), for an f peaked at the normal with width `width`.

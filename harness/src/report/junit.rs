@@ -30,7 +30,11 @@ pub fn render(report: &AuditReport) -> String {
         suites.entry(r.check.as_str()).or_default().push(r);
     }
     let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    let failures = report.records.iter().filter(|r| r.verdict == Verdict::Fail).count();
+    let failures = report
+        .records
+        .iter()
+        .filter(|r| r.verdict == Verdict::Fail)
+        .count();
     let errors = report
         .records
         .iter()
@@ -43,14 +47,22 @@ pub fn render(report: &AuditReport) -> String {
         report.summary.wall_seconds
     ));
     for (check, records) in suites {
-        let f = records.iter().filter(|r| r.verdict == Verdict::Fail).count();
+        let f = records
+            .iter()
+            .filter(|r| r.verdict == Verdict::Fail)
+            .count();
         let e = records
             .iter()
             .filter(|r| matches!(r.verdict, Verdict::Error { .. }))
             .count();
         let s = records
             .iter()
-            .filter(|r| matches!(r.verdict, Verdict::Skipped { .. } | Verdict::ExpectedFailure { .. }))
+            .filter(|r| {
+                matches!(
+                    r.verdict,
+                    Verdict::Skipped { .. } | Verdict::ExpectedFailure { .. }
+                )
+            })
             .count();
         out.push_str(&format!(
             "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{f}\" errors=\"{e}\" skipped=\"{s}\">\n",

@@ -47,7 +47,11 @@ pub fn render(report: &AuditReport, max_failures: usize) -> String {
     for (family, (e, at)) in &s.worst_error {
         let _ = writeln!(o, "  {family:<24} {e:.2e}  ({at})");
     }
-    let failures: Vec<_> = report.records.iter().filter(|r| r.verdict.is_failure()).collect();
+    let failures: Vec<_> = report
+        .records
+        .iter()
+        .filter(|r| r.verdict.is_failure())
+        .collect();
     if !failures.is_empty() {
         let _ = writeln!(o, "\nfailures ({}):", failures.len());
         for r in failures.iter().take(max_failures) {
@@ -64,7 +68,11 @@ pub fn render(report: &AuditReport, max_failures: usize) -> String {
             );
         }
         if failures.len() > max_failures {
-            let _ = writeln!(o, "  … and {} more (report.json)", failures.len() - max_failures);
+            let _ = writeln!(
+                o,
+                "  … and {} more (report.json)",
+                failures.len() - max_failures
+            );
         }
     }
     let _ = writeln!(
