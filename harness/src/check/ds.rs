@@ -480,3 +480,42 @@ mod tests {
         assert!(plan(ggx, Profile::Quick, 1.5, "").is_empty());
     }
 }
+
+/// Prints every record of the standard plan (diagnostic: `cargo test -p mfh-harness --lib
+/// check::ds::dump -- --ignored --nocapture`).
+#[cfg(test)]
+mod dump {
+    use super::*;
+
+    #[test]
+    #[ignore]
+    fn standard() {
+        let spec = ModelSpec::GaussianSlopes {
+            mean: [0.1, -0.2],
+            cov: [[0.04, 0.01], [0.01, 0.09]],
+        };
+        let ctx = crate::check::RunContext { seed: 1, out: None };
+        for p in plan(
+            Arc::from(spec.build().unwrap()),
+            Profile::Standard,
+            1.57,
+            "",
+        ) {
+            let r = (p.run)(&ctx);
+            println!(
+                "{:30} {:16} {:.2e} {:.3}s {}",
+                r.check,
+                r.verdict.name(),
+                r.measured.and_then(|m| m.error()).unwrap_or(f64::NAN),
+                r.cost.wall_seconds,
+                r.case
+                    .as_object()
+                    .map(|o| format!(
+                        "{} {} θ={} φ={} z0={}",
+                        o["variant"], o["route"], o["theta"], o["phi"], o["z0"]
+                    ))
+                    .unwrap_or_default()
+            );
+        }
+    }
+}

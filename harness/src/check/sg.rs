@@ -834,10 +834,11 @@ mod tests {
     fn quick_plan_passes_or_fails_as_expected() {
         let plan = plan(Profile::Quick, true, true, "test");
         let ctx = RunContext { seed: 1, out: None };
+        use rayon::prelude::*;
+        let records: Vec<CheckRecord> = plan.par_iter().map(|p| (p.run)(&ctx)).collect();
         let mut expected = 0;
         let mut errors = Vec::new();
-        for p in &plan {
-            let r = (p.run)(&ctx);
+        for r in records {
             match &r.verdict {
                 Verdict::Pass => {}
                 Verdict::ExpectedFailure { .. } => expected += 1,
