@@ -2,10 +2,12 @@
 //! into a [`CheckRecord`] against an oracle (DESIGN.md, "Checks and records"). A check never
 //! panics and never asserts; only the audit's verdicts decide.
 
+pub mod ds;
 pub mod limits;
 pub mod moments;
 pub mod normalization;
 pub mod sampling;
+pub mod sg;
 pub mod smith;
 pub mod stability;
 

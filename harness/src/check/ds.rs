@@ -1,0 +1,521 @@
+//! Visible-slope moments: the mean and covariance of the visible-slope distribution D_s of a
+//! Gaussian slope distribution (seed 002, eq 12–46), by every route, against 2-D adaptive
+//! cubature of their defining integrals (eq 16, 19–23), for regular, near-singular and
+//! back-facing (mean facet facing away at grazing incidence) cases.
+
+use super::{applied, apply_expected, covers, timed, Planned, Profile};
+use crate::oracle::cubature::{integrate_rectangle, Tolerance as CubatureTolerance};
+use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
+use crate::tolerance::VISIBLE_MOMENTS;
+use mfh_reference::geometry::from_spherical;
+use mfh_reference::model::VisibleMoments;
+use mfh_reference::{Model, ModelSpec, Vec3};
+use serde_json::{json, Value};
+use std::sync::{Arc, OnceLock};
+
+const SOURCE: &str = "seed 002 eq 12–16 (D_s(s) = p_s(s) W(s) H(s) / N, W = ω_z − s·ω_xy, \
+                      H = Heaviside(W)), eq 19–23 (moments), eq 42–46 (back to x, y)";
+
+/// The half-width of the integration window, in standard deviations of the Gaussian
+/// (e^{−72} ≈ 5e-32 of the mass lies outside).
+const WINDOW: f64 = 12.0;
+
+/// Below this z₀ = (cot θ − s̄_o)/σ_o the mean facet faces away from the view and D_s lives in
+/// the Gaussian's tail: such cases are checked as `ds.visible_moments_backfacing`, where the
+/// transcribed printed formulas cancel (ERRATA.md seed 002, numerical limits).
+const BACKFACING_Z0: f64 = -3.0;
+
+/// The components of a D_s moment set, in the order of [`components`].
+const NAMES: [&str; 5] = ["mean_x", "mean_y", "var_x", "var_y", "cov_xy"];
+
+fn components(m: &VisibleMoments) -> [f64; 5] {
+    [m.mean[0], m.mean[1], m.cov[0][0], m.cov[1][1], m.cov[0][1]]
+}
+
+/// The oracle's moments of D_s with their error bounds.
+#[derive(Debug, Clone)]
+struct Oracle {
+    values: [f64; 5],
+    bounds: [f64; 5],
+    evaluations: u64,
+}
+
+/// The rotated statistics of N(s̄, Σ) along the view azimuth ô (and ô⊥): used only to place the
+/// integration window and to shear it along the Gaussian's ridge; any affine change of
+/// variables leaves the integral unchanged, so their rounding does not enter the oracle.
+struct Window {
+    o: [f64; 2],
+    perp: [f64; 2],
+    mean_o: f64,
+    mean_perp: f64,
+    sigma_o: f64,
+    slope: f64,
+    conditional: f64,
+    z0: f64,
+}
+
+fn window(mean: [f64; 2], cov: [[f64; 2]; 2], w: Vec3) -> Window {
+    let qn = w[0].hypot(w[1]);
+    let o = if qn > 0.0 {
+        [w[0] / qn, w[1] / qn]
+    } else {
+        [1.0, 0.0]
+    };
+    let perp = [-o[1], o[0]];
+    let quad = |a: [f64; 2], b: [f64; 2]| {
+        a[0] * (cov[0][0] * b[0] + cov[0][1] * b[1]) + a[1] * (cov[1][0] * b[0] + cov[1][1] * b[1])
+    };
+    let a = quad(o, o);
+    let c = quad(perp, o);
+    let det = (cov[0][0] * cov[1][1] - cov[0][1] * cov[1][0]).max(0.0);
+    let mean_o = mean[0] * o[0] + mean[1] * o[1];
+    let sigma_o = a.sqrt();
+    let mu = if qn > 0.0 { w[2] / qn } else { f64::INFINITY };
+    Window {
+        o,
+        perp,
+        mean_o,
+        mean_perp: mean[0] * perp[0] + mean[1] * perp[1],
+        sigma_o,
+        slope: c / a,
+        conditional: (det / a).sqrt(),
+        z0: (mu - mean_o) / sigma_o,
+    }
+}
+
+/// z₀ = (cot θ − s̄_o)/σ_o of a Gaussian slope spec seen from `w` (+∞ at normal incidence).
+fn z0_of(spec: &Value, w: Vec3) -> f64 {
+    match parse(spec) {
+        Some((mean, cov)) => window(mean, cov, w).z0,
+        None => f64::NAN,
+    }
+}
+
+fn parse(spec: &Value) -> Option<([f64; 2], [[f64; 2]; 2])> {
+    let mean = spec.get("mean")?.as_array()?;
+    let cov = spec.get("cov")?.as_array()?;
+    let row = |v: &Value| -> Option<[f64; 2]> {
+        let a = v.as_array()?;
+        Some([a.first()?.as_f64()?, a.get(1)?.as_f64()?])
+    };
+    Some((
+        [mean.first()?.as_f64()?, mean.get(1)?.as_f64()?],
+        [row(cov.first()?)?, row(cov.get(1)?)?],
+    ))
+}
+
+/// The mean and covariance of D_s seen from `w`, by 2-D adaptive cubature of their definitions
+/// (seed 002, eq 16, 19–23), with p_s of eq 1 written in the frame that factorizes it (the
+/// marginal of s_o times the conditional of s_⊥; evaluating the model's own p22 there instead
+/// adds rounding noise of ~1e-12 across the thin direction of a near-singular Σ, which the
+/// cubature then chases to its depth limit):
+///
+/// ```text
+/// N       = ∫∫ p_s(s) (ω_z − s·ω_xy)⁺ d²s
+/// mean_i  = s̄_i + ∫∫ (s_i − s̄_i) p_s W H d²s / N
+/// cov_ij  = ∫∫ (s_i − mean_i)(s_j − mean_j) p_s W H d²s / N      (central: no mean² subtracted)
+/// ```
+///
+/// The integration variables are s_o = u ∈ [lo, min(cot θ, s̄_o + 12σ_o)] (the facets that face
+/// ω lie at s_o < cot θ, so the integrand is smooth on the rectangle) and t ∈ [−12, 12] with
+/// s_⊥ = s̄_⊥ + (c_o⊥/σ_o²)(u − s̄_o) + t √(|Σ|/σ_o²) (a shear along the Gaussian's ridge, so
+/// that a near-singular Σ is a well-resolved band, not a thin diagonal needle); the weight
+/// W = ω_z − s·ω_xy is taken from the definition with s = u ô + s_⊥ ô⊥.
+fn oracle(spec: &Value, w: Vec3) -> Result<Oracle, String> {
+    let (mean, cov) = parse(spec).ok_or("the spec has no mean and cov")?;
+    let win = window(mean, cov, w);
+    let (sigma_o, h) = (win.sigma_o, win.conditional);
+    if !(sigma_o > 0.0 && h > 0.0) {
+        return Err(format!("singular covariance (σ_o = {sigma_o}, h = {h})"));
+    }
+    let mu = win.mean_o + win.z0 * sigma_o;
+    let hi = (win.mean_o + WINDOW * sigma_o).min(mu);
+    let lo = if win.z0 >= -0.5 * WINDOW {
+        win.mean_o - WINDOW * sigma_o
+    } else {
+        // Deep in the tail the weighted density decays like e^{−|z₀| x}, x = (μ − u)/σ_o.
+        mu - 60.0 * sigma_o / win.z0.abs()
+    };
+    if !(hi > lo) {
+        return Err("no facet faces the view direction".into());
+    }
+    let point = |u: f64, t: f64| -> [f64; 2] {
+        let sp = win.mean_perp + win.slope * (u - win.mean_o) + t * h;
+        [
+            u * win.o[0] + sp * win.perp[0],
+            u * win.o[1] + sp * win.perp[1],
+        ]
+    };
+    let weighted = |u: f64, t: f64| -> (f64, [f64; 2]) {
+        let s = point(u, t);
+        let wt = (w[2] - s[0] * w[0] - s[1] * w[1]).max(0.0);
+        // p_s(s) d²s = φ(z) φ(t) / (σ_o h) · h du dt, z = (u − s̄_o)/σ_o.
+        let z = (u - win.mean_o) / sigma_o;
+        let density = (-0.5 * (z * z + t * t)).exp() / (std::f64::consts::TAU * sigma_o);
+        (density * wt, s)
+    };
+    let mut evaluations = 0u64;
+    let mut integrate = |f: &dyn Fn(f64, f64) -> f64, absolute: f64| {
+        let e = integrate_rectangle(
+            &|u, t| f(u, t),
+            [lo, hi],
+            [-WINDOW, WINDOW],
+            CubatureTolerance {
+                absolute,
+                relative: 1e-11,
+            },
+        );
+        evaluations += e.evaluations;
+        e
+    };
+    let n = integrate(&|u, t| weighted(u, t).0, 0.0);
+    if !(n.value > 0.0) {
+        return Err(format!("N = {} is not positive", n.value));
+    }
+    let scale = [cov[0][0].sqrt(), cov[1][1].sqrt()];
+    let mut values = [0.0; 5];
+    let mut bounds = [0.0; 5];
+    let rel_n = n.error_bound / n.value;
+    for i in 0..2 {
+        let e = integrate(
+            &|u, t| {
+                let (f, s) = weighted(u, t);
+                (s[i] - mean[i]) * f
+            },
+            1e-13 * n.value * scale[i],
+        );
+        let shift = e.value / n.value;
+        values[i] = mean[i] + shift;
+        bounds[i] = e.error_bound / n.value + shift.abs() * rel_n;
+    }
+    let m = [values[0], values[1]];
+    for i in 0..2 {
+        let e = integrate(
+            &|u, t| {
+                let (f, s) = weighted(u, t);
+                let d = s[i] - m[i];
+                d * d * f
+            },
+            0.0,
+        );
+        values[2 + i] = e.value / n.value;
+        bounds[2 + i] = e.error_bound / n.value + values[2 + i] * rel_n;
+    }
+    let floor = 1e-14 * n.value * (values[2] * values[3]).sqrt();
+    let e = integrate(
+        &|u, t| {
+            let (f, s) = weighted(u, t);
+            (s[0] - m[0]) * (s[1] - m[1]) * f
+        },
+        floor,
+    );
+    values[4] = e.value / n.value;
+    bounds[4] = e.error_bound / n.value + values[4].abs() * rel_n;
+    Ok(Oracle {
+        values,
+        bounds,
+        evaluations,
+    })
+}
+
+/// The scale each component's error is measured in: a mean in units of max(|mean_i|, σ_i) of
+/// D_s, a variance relative to itself, the covariance relative to σ_x σ_y (as a correlation).
+fn units(o: &[f64; 5]) -> [f64; 5] {
+    let (sx, sy) = (o[2].abs().sqrt(), o[3].abs().sqrt());
+    [
+        o[0].abs().max(sx),
+        o[1].abs().max(sy),
+        o[2].abs(),
+        o[3].abs(),
+        sx * sy,
+    ]
+}
+
+/// Fills `r` with the worst component of `value` against the oracle.
+fn judge(r: &mut CheckRecord, value: &VisibleMoments, o: &Oracle) {
+    let v = components(value);
+    let u = units(&o.values);
+    let mut worst = (0usize, -1.0f64, 0.0f64);
+    let mut finite = true;
+    for i in 0..5 {
+        let err = (v[i] - o.values[i]).abs() / u[i];
+        let allowed = o.bounds[i] / u[i];
+        if !(v[i].is_finite() && err.is_finite()) {
+            finite = false;
+            worst = (i, f64::INFINITY, allowed);
+            break;
+        }
+        if err > worst.1 {
+            worst = (i, err, allowed);
+        }
+    }
+    let (i, err, allowed) = worst;
+    r.value = Some(v[i]);
+    r.oracle = Some(OracleValue {
+        value: o.values[i],
+        uncertainty: o.bounds[i],
+        kind: "error_bound",
+    });
+    r.cost.evaluations += o.evaluations;
+    r.measured = Some(Measured::Relative { error: err });
+    r.tolerance = Some(applied(&VISIBLE_MOMENTS));
+    if let Some(case) = r.case.as_object_mut() {
+        case.insert("worst_component".into(), json!(NAMES[i]));
+        case.insert("value_components".into(), json!(v.map(finite_or_null)));
+        case.insert("oracle_components".into(), json!(o.values));
+        case.insert("oracle_bounds".into(), json!(o.bounds));
+    }
+    r.verdict = if finite && err <= VISIBLE_MOMENTS.value + allowed {
+        Verdict::Pass
+    } else {
+        Verdict::Fail
+    };
+}
+
+fn finite_or_null(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        Value::Null
+    }
+}
+
+/// The cases of a model: the model itself, a near-singular variant (correlation 1 − 1e-9, the
+/// model's variances and mean) and a back-facing variant (the model's covariance with a mean
+/// slope so steep along x that the mean facet faces away from views at θ ≥ 1.2 along φ = 0).
+fn variants(spec: &Value) -> Vec<(&'static str, Value)> {
+    let mut out = vec![("as given", spec.clone())];
+    if let Some((mean, cov)) = parse(spec) {
+        let c = (1.0 - 1e-9) * (cov[0][0] * cov[1][1]).sqrt();
+        out.push((
+            "correlation 1 − 1e-9",
+            json!({"family": "gaussian_slopes", "mean": mean, "cov": [[cov[0][0], c], [c, cov[1][1]]]}),
+        ));
+        let steep = 1.5f64.cos() / 1.5f64.sin() + 6.0 * cov[0][0].sqrt();
+        out.push((
+            "mean facing away",
+            json!({"family": "gaussian_slopes", "mean": [steep, mean[1]], "cov": cov}),
+        ));
+    }
+    out
+}
+
+/// The view azimuths of a profile (φ = 0 and at least one φ ≠ 0; −π/2 as Table 3, row 4).
+fn phis(profile: Profile) -> &'static [f64] {
+    match profile {
+        Profile::Quick => &[0.0, 0.7],
+        Profile::Standard => &[0.0, 0.7, -std::f64::consts::FRAC_PI_2],
+        Profile::Thorough => &[0.0, 0.7, -std::f64::consts::FRAC_PI_2, 2.5, 4.0],
+    }
+}
+
+/// The check id of a case: regular, near-singular Σ, or back-facing (z₀ < −3).
+fn check_id(variant: &str, z0: f64) -> &'static str {
+    if variant == "correlation 1 − 1e-9" {
+        "ds.visible_moments_singular"
+    } else if z0 < BACKFACING_Z0 {
+        "ds.visible_moments_backfacing"
+    } else {
+        "ds.visible_moments"
+    }
+}
+
+type Shared = Arc<OnceLock<Result<Oracle, String>>>;
+
+/// Plans the visible-slope moment checks of a model with visible moments (family
+/// `gaussian_slopes`): every route of `visible_moments_routes()` at every incidence θ of the
+/// profile (≤ `theta_max`) and two or more azimuths, for the model, a near-singular and a
+/// back-facing variant. The oracle of a case is computed once and shared by its routes.
+pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) -> Vec<Planned> {
+    let Some(visible) = model.as_visible_moments() else {
+        return Vec::new();
+    };
+    let routes = visible.visible_moments_routes();
+    let family = model.family();
+    let spec = serde_json::to_value(model.spec()).unwrap_or(Value::Null);
+    let mut out = Vec::new();
+    for (label, variant) in variants(&spec) {
+        let built: Result<Arc<dyn Model>, String> = if label == "as given" {
+            Ok(model.clone())
+        } else {
+            serde_json::from_value::<ModelSpec>(variant.clone())
+                .map_err(|e| e.to_string())
+                .and_then(|s| s.build().map_err(|e| e.to_string()))
+                .map(Arc::from)
+        };
+        for theta in profile.thetas(theta_max) {
+            for &phi in phis(profile) {
+                let w = from_spherical(theta, phi);
+                let check = check_id(label, z0_of(&variant, w));
+                let shared: Shared = Arc::new(OnceLock::new());
+                for &route in &routes {
+                    let case = json!({"variant": label, "route": route, "theta": theta,
+                                      "phi": phi, "z0": z0_of(&variant, w)});
+                    let covered = vec![covers(family, "visible_moments", route)];
+                    let (built, shared) = (built.clone(), shared.clone());
+                    let (variant_run, case_run, covered_run) =
+                        (variant.clone(), case.clone(), covered.clone());
+                    out.push(Planned {
+                        check: check.into(),
+                        model: variant.clone(),
+                        case,
+                        why: format!("{why}: D_s moments by route `{route}` ({label})"),
+                        covers: covered,
+                        statistical: false,
+                        run: Box::new(move |_| {
+                            timed(|| {
+                                let mut r = CheckRecord::new(
+                                    check,
+                                    variant_run.clone(),
+                                    case_run.clone(),
+                                    SOURCE,
+                                );
+                                r.covers = covered_run.clone();
+                                let m = match &built {
+                                    Ok(m) => m,
+                                    Err(e) => {
+                                        r.verdict = Verdict::Error {
+                                            message: format!("variant rejected: {e}"),
+                                        };
+                                        return r;
+                                    }
+                                };
+                                let Some(vis) = m.as_visible_moments() else {
+                                    r.verdict = Verdict::Error {
+                                        message: "the model lost its visible moments".into(),
+                                    };
+                                    return r;
+                                };
+                                let value = match vis.visible_moments_route(w, route) {
+                                    Ok(v) => v,
+                                    Err(e) => {
+                                        r.verdict = Verdict::Error {
+                                            message: format!("route `{route}` refused: {e}"),
+                                        };
+                                        return r;
+                                    }
+                                };
+                                let o = shared.get_or_init(|| oracle(&variant_run, w));
+                                match o {
+                                    Ok(o) => {
+                                        judge(&mut r, &value, o);
+                                        apply_expected(&mut r, family, route);
+                                    }
+                                    Err(e) => {
+                                        r.verdict = Verdict::Error {
+                                            message: format!("oracle: {e}"),
+                                        };
+                                    }
+                                }
+                                r
+                            })
+                        }),
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn model() -> Arc<dyn Model> {
+        let spec = ModelSpec::GaussianSlopes {
+            mean: [0.1, -0.2],
+            cov: [[0.04, 0.01], [0.01, 0.09]],
+        };
+        Arc::from(spec.build().unwrap())
+    }
+
+    #[test]
+    fn quick_plan_passes_or_fails_as_expected() {
+        let plan = plan(model(), Profile::Quick, 1.5, "test");
+        assert!(!plan.is_empty());
+        let ctx = super::super::RunContext { seed: 1, out: None };
+        let mut expected = 0;
+        let mut seen = std::collections::BTreeSet::new();
+        for p in &plan {
+            let r = (p.run)(&ctx);
+            seen.insert(r.check.clone());
+            match &r.verdict {
+                Verdict::Pass => {}
+                Verdict::ExpectedFailure { .. } => expected += 1,
+                v => panic!("{} {} {:?}: {v:?}", r.check, r.case, r.measured),
+            }
+            if r.case["route"] == "default" {
+                assert_eq!(r.verdict, Verdict::Pass, "{}", r.case);
+            }
+        }
+        assert!(expected > 0);
+        assert_eq!(seen.len(), 3, "{seen:?}");
+    }
+
+    #[test]
+    fn the_oracle_catches_a_wrong_moment() {
+        // A perturbation of 1e-6 in one component must fail.
+        let m = model();
+        let spec = serde_json::to_value(m.spec()).unwrap();
+        let w = from_spherical(1.2, 0.7);
+        let o = oracle(&spec, w).unwrap();
+        let mut v = m.as_visible_moments().unwrap().visible_moments(w).unwrap();
+        let mut r = CheckRecord::new("ds.visible_moments", spec.clone(), json!({}), SOURCE);
+        judge(&mut r, &v, &o);
+        assert_eq!(r.verdict, Verdict::Pass, "{:?}", r.measured);
+        v.cov[0][1] *= 1.0 + 1e-6;
+        judge(&mut r, &v, &o);
+        assert_eq!(r.verdict, Verdict::Fail);
+    }
+
+    #[test]
+    fn no_plan_without_visible_moments() {
+        let ggx: Arc<dyn Model> = Arc::from(
+            serde_json::from_value::<ModelSpec>(json!({"family": "ggx", "alpha": 0.3}))
+                .unwrap()
+                .build()
+                .unwrap(),
+        );
+        assert!(plan(ggx, Profile::Quick, 1.5, "").is_empty());
+    }
+}
+
+/// Prints every record of the standard plan (diagnostic: `cargo test -p mfh-harness --lib
+/// check::ds::dump -- --ignored --nocapture`).
+#[cfg(test)]
+mod dump {
+    use super::*;
+
+    #[test]
+    #[ignore]
+    fn standard() {
+        let spec = ModelSpec::GaussianSlopes {
+            mean: [0.1, -0.2],
+            cov: [[0.04, 0.01], [0.01, 0.09]],
+        };
+        let ctx = crate::check::RunContext { seed: 1, out: None };
+        for p in plan(
+            Arc::from(spec.build().unwrap()),
+            Profile::Standard,
+            1.57,
+            "",
+        ) {
+            let r = (p.run)(&ctx);
+            println!(
+                "{:30} {:16} {:.2e} {:.3}s {}",
+                r.check,
+                r.verdict.name(),
+                r.measured.and_then(|m| m.error()).unwrap_or(f64::NAN),
+                r.cost.wall_seconds,
+                r.case
+                    .as_object()
+                    .map(|o| format!(
+                        "{} {} θ={} φ={} z0={}",
+                        o["variant"], o["route"], o["theta"], o["phi"], o["z0"]
+                    ))
+                    .unwrap_or_default()
+            );
+        }
+    }
+}
