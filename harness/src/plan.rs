@@ -1,7 +1,9 @@
 //! The planner: a scene's effects → the checks they call for, each with the reason it was
 //! planned; nothing the scene does not use is simulated (DESIGN.md, "Scenes").
 
-use crate::check::{limits, moments, normalization, sampling, smith, stability, Planned, Profile};
+use crate::check::{
+    ds, limits, moments, normalization, sampling, sg, smith, stability, Planned, Profile,
+};
 use crate::scene::{Sampling, Scene};
 use mfh_reference::Model;
 use serde_json::Value;
@@ -71,6 +73,14 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
                 &format!("{why}: slope moments feed Gaussian-slope filtering"),
             ));
         }
+        if scene.filtering.gaussian_slopes {
+            out.extend(ds::plan(
+                model.clone(),
+                profile,
+                theta_max,
+                &format!("{why}: Gaussian-slope filtering uses the visible-slope moments"),
+            ));
+        }
         if family == "std" {
             if let Some(a) = spec.get("alpha").and_then(Value::as_f64) {
                 if !std_alphas.contains(&a) {
@@ -85,6 +95,12 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
     }
     if scene.lighting.spherical_gaussians || scene.lighting.anisotropic_spherical_gaussians {
         documents.insert("003");
+        out.extend(sg::plan(
+            profile,
+            scene.lighting.spherical_gaussians,
+            scene.lighting.anisotropic_spherical_gaussians,
+            "the scene lights with spherical Gaussians",
+        ));
     }
     let _ = documents;
     out
