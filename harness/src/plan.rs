@@ -2,7 +2,7 @@
 //! planned; nothing the scene does not use is simulated (DESIGN.md, "Scenes").
 
 use crate::check::{
-    ds, limits, moments, normalization, sampling, sg, smith, stability, Planned, Profile,
+    claims, ds, errata, limits, moments, normalization, sampling, sg, smith, stability, Planned, Profile,
 };
 use crate::scene::{Sampling, Scene};
 use mfh_reference::Model;
@@ -102,7 +102,10 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
             "the scene lights with spherical Gaussians",
         ));
     }
-    let _ = documents;
+    let documents: Vec<&str> = documents.into_iter().collect();
+    let used = format!("the scene uses seed(s) {}", documents.join(", "));
+    out.extend(errata::plan(&documents, &used));
+    out.extend(claims::plan(&documents, &used));
     out
 }
 

@@ -2,7 +2,9 @@
 //! into a [`CheckRecord`] against an oracle (DESIGN.md, "Checks and records"). A check never
 //! panics and never asserts; only the audit's verdicts decide.
 
+pub mod claims;
 pub mod ds;
+pub mod errata;
 pub mod limits;
 pub mod moments;
 pub mod normalization;
