@@ -2,7 +2,8 @@
 //! planned; nothing the scene does not use is simulated (DESIGN.md, "Scenes").
 
 use crate::check::{
-    claims, ds, errata, limits, moments, normalization, sampling, sg, smith, stability, Planned, Profile,
+    claims, ds, errata, limits, moments, normalization, sampling, sg, smith, stability, Planned,
+    Profile,
 };
 use crate::scene::{Sampling, Scene};
 use mfh_reference::Model;

@@ -10,8 +10,7 @@ use super::{applied, covers, timed, Planned};
 use crate::oracle::quadrature::{integrate_line, Accuracy};
 use crate::record::{CheckRecord, Measured, Verdict};
 use crate::tolerance::{
-    Tolerance, GTR_CLAMP, GTR_LIMIT, GTR_SPLINE, IDENTITY,
-    PIECEWISE_TRAPEZOID, SLOPE_MOMENT_CLAIM,
+    Tolerance, GTR_CLAMP, GTR_LIMIT, GTR_SPLINE, IDENTITY, PIECEWISE_TRAPEZOID, SLOPE_MOMENT_CLAIM,
 };
 use mfh_reference::geometry::from_spherical;
 use mfh_reference::ndf::gtr::Gtr;
