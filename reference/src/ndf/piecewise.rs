@@ -566,13 +566,20 @@ impl Ndf for PiecewiseLinear {
             return 0.0;
         }
         let r2 = m[0] * m[0] + m[1] * m[1];
-        let theta = r2.sqrt().atan2(m[2]);
         let cos2phi = if r2 > 0.0 {
             (m[0] * m[0] - m[1] * m[1]) / r2
         } else {
             1.0 // at the pole both terms of eq 1 equal D_x(0) D_y(0) / c
         };
-        self.d_theta(theta, cos2phi)
+        let r = r2.sqrt();
+        if m[2] < r {
+            // Below 45° elevation, from the co-angle ε = π/2 − θ (relatively accurate from
+            // m_z): θ itself resolves π/2 − ε only to ~2e-16 absolute, which made D relatively
+            // inaccurate by ~1e-16/ε where a profile vanishes at the horizon.
+            let (vx, vy) = self.d_xy_co(m[2].atan2(r));
+            return 0.5 * (self.kx * vx * (1.0 + cos2phi) + self.ky * vy * (1.0 - cos2phi));
+        }
+        self.d_theta(r.atan2(m[2]), cos2phi)
     }
 }
 
