@@ -45,9 +45,9 @@ fn levels() -> &'static [Vec<Node>] {
 /// The nodes new at level `j`.
 fn level_nodes(j: usize) -> Vec<Node> {
     let h = DoubleDouble::ONE.ldexp(-(j as i32));
-    let (start, step) = if j == 0 { (1, 1) } else { (1, 2) };
+    let step = if j == 0 { 1 } else { 2 };
     let mut nodes = Vec::new();
-    let mut k = start;
+    let mut k = 1;
     loop {
         let node = node_at(h.mul_f64(f64::from(k)));
         if node.distance.hi() < SMALLEST_DISTANCE {

@@ -84,7 +84,7 @@ fn lambda_matches_a_plain_substitution_of_its_integral() {
 #[test]
 fn ggx_lambda_matches_its_elementary_form_in_double_double() {
     let model = PreciseModel::new(Family::Ggx, 0.3).expect("valid");
-    for theta in [1e-3, 0.2, 0.8, 1.3, 1.55, 1.5707] {
+    for theta in [1e-3, 0.2, 0.8, 1.3, 1.55, 1.5706] {
         let w = from_spherical(theta, 0.4);
         let certified = model.lambda(w).expect("certified");
         // Λ = 1/(2a² + 2a√(a² + 1)), a = μ/α.
@@ -211,4 +211,32 @@ fn bad_input_is_an_error_not_a_panic() {
         serde_json::from_str(r#"{"family":"ggx","alpha_x":0.1,"alpha_y":0.2}"#).expect("spec");
     assert!(PreciseModel::from_spec(&anisotropic).is_err());
     assert!(student_norm(0.5).is_err());
+}
+
+#[test]
+fn extreme_parameters_give_a_value_or_an_error() {
+    let models = [
+        PreciseModel::new(Family::Std { gamma: 1e8 }, 0.3),
+        PreciseModel::new(Family::Std { gamma: 1.5 + 1e-9 }, 0.3),
+        PreciseModel::new(Family::Std { gamma: 1.05 }, 0.3),
+        PreciseModel::new(Family::Beckmann, 1e-4),
+        PreciseModel::new(Family::Ggx, 1e4),
+    ];
+    for model in models {
+        let model = model.expect("valid");
+        for theta in [0.0, 1e-8, 0.5, 1.5, std::f64::consts::FRAC_PI_2 - 1e-9] {
+            let w = from_spherical(theta, 0.3);
+            let lambda = model.lambda(w);
+            let d = model.d(w);
+            println!(
+                "{:?} θ = {theta}: Λ {lambda:?}\n    D {d:?}",
+                model.family()
+            );
+            for result in [lambda, d] {
+                if let Ok(c) = result {
+                    assert!(c.value.is_finite() && c.relative_bound() <= CERTIFIED_RELATIVE);
+                }
+            }
+        }
+    }
 }
