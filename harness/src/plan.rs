@@ -2,8 +2,8 @@
 //! planned; nothing the scene does not use is simulated (DESIGN.md, "Scenes").
 
 use crate::check::{
-    claims, ds, errata, limits, moments, normalization, sampling, sg, smith, stability, Planned,
-    Profile,
+    claims, ds, errata, limits, moments, normalization, precise, sampling, sg, smith, stability,
+    Planned, Profile,
 };
 use crate::scene::{Sampling, Scene};
 use mfh_reference::Model;
@@ -45,6 +45,12 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
         out.extend(normalization::plan(
             model.clone(),
             &format!("{why} evaluates D"),
+        ));
+        out.extend(precise::plan(
+            model.clone(),
+            profile,
+            theta_max,
+            &format!("{why} evaluates D and Λ"),
         ));
         out.extend(stability::plan(
             &spec,

@@ -8,6 +8,7 @@ pub mod errata;
 pub mod limits;
 pub mod moments;
 pub mod normalization;
+pub mod precise;
 pub mod sampling;
 pub mod sg;
 pub mod smith;
