@@ -6,7 +6,9 @@
 //! §7.2, the bias of its estimator with the weight of eq 43 as printed and with the unbiased one.
 
 use super::{applied, compare, compare_exact, covers, timed, Planned, Profile};
-use crate::oracle::chi2::{chi2_test, chi2_test_sampler, Chi2Config};
+use crate::oracle::chi2::{
+    chi2_test, chi2_test_sampler, chi2_test_to, Chi2Config, KINKED_CELL_RELATIVE_TOLERANCE,
+};
 use crate::oracle::monte_carlo::{estimate, two_sided_p};
 use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
@@ -262,6 +264,14 @@ pub fn visible_kinks(wi: Vec3, phi: f64) -> Vec<f64> {
     out
 }
 
+/// The azimuths of m in [0, 2π) where the terminator of ⟨wi·m⟩⁺ meets the normal, for wi at
+/// azimuth `phi_i`: φi ± π/2 (the polar kinks of [`visible_kinks`] start there).
+pub fn terminator_azimuths(phi_i: f64) -> [f64; 2] {
+    let tau = std::f64::consts::TAU;
+    let q = std::f64::consts::FRAC_PI_2;
+    [(phi_i + q).rem_euclid(tau), (phi_i - q).rem_euclid(tau)]
+}
+
 /// Plans the visible-normal sampling checks of one model (scene `sampling: visible_normals`):
 /// `sampling.chi2_visible` at each of [`VISIBLE_INCIDENCES`] and
 /// `sampling.pdf_visible_normalization` (∫ pdf_wm_visible dm = 1 by quadrature). A model without
@@ -323,10 +333,11 @@ pub fn plan_visible(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<P
                         seed: ctx.seed,
                         alpha: STATISTICAL_ALPHA.value,
                     };
-                    let result = chi2_test(
+                    let result = chi2_test_to(
                         &|u| v.sample_wm_visible(wi, u),
                         &|mm| v.pdf_wm_visible(wi, mm),
                         &config,
+                        KINKED_CELL_RELATIVE_TOLERANCE,
                     );
                     fill_chi2(&mut r, &result, ctx, samples);
                     r
@@ -360,7 +371,7 @@ pub fn plan_visible(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<P
                         width,
                         Some(Cuts {
                             theta: &kinks,
-                            phi: &[],
+                            phi: &terminator_azimuths(phi),
                         }),
                         Accuracy::relative(1e-11),
                     );
@@ -500,6 +511,7 @@ fn pseudo_vnis_record(
     );
     let std = v.target();
     let kinks = |p: f64| visible_kinks(wi, p);
+    let phi_cuts = terminator_azimuths(phi);
     let truth = integrate_hemisphere(
         &|m| {
             let c = dot(wi, m);
@@ -515,7 +527,7 @@ fn pseudo_vnis_record(
         width,
         Some(Cuts {
             theta: &kinks,
-            phi: &[],
+            phi: &phi_cuts,
         }),
         Accuracy::relative(1e-9),
     );
@@ -556,5 +568,125 @@ fn pseudo_vnis_record(
     };
     if printed {
         super::apply_expected(r, "std", "printed");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::RunContext;
+
+    fn run(plan: &[Planned]) -> Vec<CheckRecord> {
+        let ctx = RunContext { seed: 7, out: None };
+        plan.iter()
+            .map(|p| {
+                let r = (p.run)(&ctx);
+                eprintln!(
+                    "{} {} {} {:?} {:?} {:.3}s",
+                    r.check, r.model, r.case, r.verdict, r.measured, r.cost.wall_seconds
+                );
+                r
+            })
+            .collect()
+    }
+
+    fn model(json: &str) -> (ModelSpec, Arc<dyn Model>) {
+        let spec: ModelSpec = serde_json::from_str(json).unwrap();
+        let m: Arc<dyn Model> = Arc::from(spec.build().unwrap());
+        (spec, m)
+    }
+
+    #[test]
+    fn visible_samplers_pass_their_checks() {
+        for json in [
+            r#"{"family":"ggx","alpha_x":0.2,"alpha_y":0.5}"#,
+            r#"{"family":"beckmann","alpha_x":0.3,"alpha_y":0.15}"#,
+            r#"{"family":"std","gamma":"inf","alpha":0.3}"#,
+        ] {
+            let (_, m) = model(json);
+            let records = run(&plan_visible(m, Profile::Quick, "test"));
+            assert_eq!(records.len(), 2 * VISIBLE_INCIDENCES.len());
+            for r in &records {
+                assert_eq!(r.verdict, Verdict::Pass, "{r:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_model_without_a_visible_sampler_is_skipped_with_its_reason() {
+        let (spec, m) = model(r#"{"family":"std","gamma":3,"alpha":0.3}"#);
+        let records = run(&plan_visible(m, Profile::Quick, "test"));
+        assert_eq!(records.len(), 1);
+        assert!(
+            matches!(&records[0].verdict, Verdict::Skipped { reason } if reason.contains("std")),
+            "{:?}",
+            records[0].verdict
+        );
+        let (ggx, _) = model(r#"{"family":"ggx","alpha":0.3}"#);
+        let records = run(&plan_pseudo_vnis(&ggx, None, Profile::Quick, "test"));
+        assert!(matches!(&records[0].verdict, Verdict::Skipped { .. }));
+        // An STD whose Λ diverges (γ ≤ 3/2) has no pseudo-VNIS weight.
+        let (low, _) = model(r#"{"family":"std","gamma":1.4,"alpha":0.3}"#);
+        let records = run(&plan_pseudo_vnis(&low, None, Profile::Quick, "test"));
+        assert!(matches!(&records[0].verdict, Verdict::Skipped { .. }));
+        let _ = spec;
+    }
+
+    #[test]
+    fn the_printed_pseudo_vnis_weight_is_biased_and_the_unbiased_one_is_not() {
+        let (spec, _) = model(r#"{"family":"std","gamma":3,"alpha":0.4}"#);
+        let records = run(&plan_pseudo_vnis(
+            &spec,
+            Some(Masking::Uncorrelated),
+            Profile::Quick,
+            "test",
+        ));
+        assert_eq!(records.len(), 2 * VISIBLE_INCIDENCES.len());
+        for r in &records {
+            assert_eq!(r.case["proxy"], "ggx");
+            match r.case["weight"].as_str() {
+                Some("printed") => assert!(
+                    matches!(&r.verdict, Verdict::ExpectedFailure { reason }
+                             if reason.starts_with("[001-§7.2]")),
+                    "{r:?}"
+                ),
+                _ => assert_eq!(r.verdict, Verdict::Pass, "{r:?}"),
+            }
+        }
+        // γ = 2 is GGX: the proxy is exact and eq 43 unbiased.
+        let (spec, _) = model(r#"{"family":"std","gamma":2,"alpha":0.4}"#);
+        let records = run(&plan_pseudo_vnis(
+            &spec,
+            Some(Masking::HeightCorrelated),
+            Profile::Quick,
+            "test",
+        ));
+        for r in &records {
+            assert_eq!(r.verdict, Verdict::Pass, "{r:?}");
+        }
+    }
+
+    #[test]
+    fn a_wrong_visible_density_fails_the_chi_square() {
+        let (_, a) = model(r#"{"family":"ggx","alpha":0.3}"#);
+        let (_, b) = model(r#"{"family":"ggx","alpha":0.33}"#);
+        let (va, vb) = (a.as_visible_sampler().unwrap(), b.as_visible_sampler().unwrap());
+        let wi = from_spherical(1.3, 0.3);
+        let config = Chi2Config {
+            resolution: 16,
+            samples: 200_000,
+            seed: 3,
+            alpha: STATISTICAL_ALPHA.value,
+        };
+        let r = chi2_test(
+            &|u| va.sample_wm_visible(wi, u),
+            &|m| vb.pdf_wm_visible(wi, m),
+            &config,
+        );
+        assert!(r.p_value < 1e-6, "{r:?}");
+        // The normal sampler is not a visible-normal sampler.
+        let s = a.as_sampler().unwrap();
+        let r = chi2_test(&|u| s.sample_wm(u), &|m| va.pdf_wm_visible(wi, m), &config);
+        assert_eq!(r.verdict, crate::oracle::chi2::Verdict::Fail);
     }
 }
