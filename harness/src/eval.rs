@@ -531,7 +531,10 @@ mod tests {
     #[test]
     fn visible_normal_sampling_answers_the_library() {
         let ggx = r#"{"family":"ggx","alpha_x":0.2,"alpha_y":0.5}"#;
-        let m = serde_json::from_str::<ModelSpec>(ggx).unwrap().build().unwrap();
+        let m = serde_json::from_str::<ModelSpec>(ggx)
+            .unwrap()
+            .build()
+            .unwrap();
         let v = m.as_visible_sampler().unwrap();
         let wi = from_spherical(1.1, 0.4);
         let got = value(&format!(

@@ -7,7 +7,7 @@
 
 use super::{applied, compare, compare_exact, covers, timed, Planned, Profile};
 use crate::oracle::chi2::{
-    chi2_test, chi2_test_sampler, chi2_test_to, Chi2Config, KINKED_CELL_RELATIVE_TOLERANCE,
+    chi2_test_sampler, chi2_test_to, Chi2Config, KINKED_CELL_RELATIVE_TOLERANCE,
 };
 use crate::oracle::monte_carlo::{estimate, two_sided_p};
 use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
@@ -233,8 +233,12 @@ const VISIBLE_SOURCE: &str = "Heitz & d'Eon 2014 (CGF 33(4)) eq 2 and §4 (Beckm
 
 /// A skipped record for a check the scene calls for but the model cannot support.
 fn skipped(check: &str, spec: &Value, case: Value, why: &str, reason: String) -> Planned {
-    let (spec_run, case_run, check_run, reason_run) =
-        (spec.clone(), case.clone(), check.to_string(), reason.clone());
+    let (spec_run, case_run, check_run, reason_run) = (
+        spec.clone(),
+        case.clone(),
+        check.to_string(),
+        reason.clone(),
+    );
     Planned {
         check: check.into(),
         model: spec.clone(),
@@ -325,7 +329,9 @@ pub fn plan_visible(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<P
                     );
                     r.covers = ids_run.clone();
                     r.seed = Some(ctx.seed);
-                    let v = m.as_visible_sampler().expect("planned for visible samplers");
+                    let v = m
+                        .as_visible_sampler()
+                        .expect("planned for visible samplers");
                     let wi = from_spherical(theta, phi);
                     let config = Chi2Config {
                         resolution,
@@ -363,7 +369,9 @@ pub fn plan_visible(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<P
                         VISIBLE_SOURCE,
                     );
                     r.covers = vec![covers(family, "pdf_wm_visible", "default")];
-                    let v = m.as_visible_sampler().expect("planned for visible samplers");
+                    let v = m
+                        .as_visible_sampler()
+                        .expect("planned for visible samplers");
                     let wi = from_spherical(theta, phi);
                     let kinks = |p: f64| visible_kinks(wi, p);
                     let e = integrate_hemisphere(
@@ -409,8 +417,10 @@ fn std_parameters(spec: &ModelSpec) -> Result<(f64, f64, f64), String> {
 
 const PSEUDO_VNIS_SOURCE: &str = "seed 001 §7.2, Algorithm 1 and eq 43 (weight(v) = G/G1(v))";
 
-/// Plans `sampling.pseudo_vnis` for one material sampled with the pseudo-VNIS of seed 001 §7.2
-/// (scene `sampling: pseudo_vnis`): at each of [`VISIBLE_INCIDENCES`], the Monte Carlo mean of
+/// Plans `sampling.chi2_pseudo_vnis` and `sampling.pseudo_vnis` for one material sampled with
+/// the pseudo-VNIS of seed 001 §7.2 (scene `sampling: pseudo_vnis`): at each of
+/// [`VISIBLE_INCIDENCES`], the chi-square of the proxy's samples against the proxy's density,
+/// and the Monte Carlo mean of
 /// the estimator of E(wi) = ∫ G2(wo, wi, m)⟨wi·m⟩⁺D(m)/cos θi dm (wo the mirror of wi about m,
 /// F = 1) with samples from Algorithm 1's proxy, against E(wi) by quadrature, once with eq 43's
 /// weight as printed (`weight: printed`; an expected failure, erratum `001-§7.2`, where the bias
@@ -445,6 +455,47 @@ pub fn plan_pseudo_vnis(
     let width = super::lobe_width(&spec_value);
     let mut out = Vec::new();
     for &(theta, phi) in &VISIBLE_INCIDENCES {
+        let resolution = 16;
+        let case = json!({"theta_i": theta, "phi_i": phi, "proxy": vnis.proxy().name(),
+                          "sigma": vnis.sigma(), "samples": samples, "resolution": resolution});
+        let (v, spec_run, case_run) = (vnis.clone(), spec_value.clone(), case.clone());
+        out.push(Planned {
+            check: "sampling.chi2_pseudo_vnis".into(),
+            model: spec_value.clone(),
+            case,
+            why: format!(
+                "{why}: the pseudo-VNIS sampler ({} proxy) must draw from its density",
+                vnis.proxy().name()
+            ),
+            covers: Vec::new(),
+            statistical: true,
+            run: Box::new(move |ctx| {
+                timed(|| {
+                    let mut r = CheckRecord::new(
+                        "sampling.chi2_pseudo_vnis",
+                        spec_run.clone(),
+                        case_run.clone(),
+                        PSEUDO_VNIS_SOURCE,
+                    );
+                    r.seed = Some(ctx.seed);
+                    let wi = from_spherical(theta, phi);
+                    let config = Chi2Config {
+                        resolution,
+                        samples,
+                        seed: ctx.seed,
+                        alpha: STATISTICAL_ALPHA.value,
+                    };
+                    let result = chi2_test_to(
+                        &|u| v.sample_wm(wi, u),
+                        &|m| v.pdf_wm(wi, m),
+                        &config,
+                        KINKED_CELL_RELATIVE_TOLERANCE,
+                    );
+                    fill_chi2(&mut r, &result, ctx, samples);
+                    r
+                })
+            }),
+        });
         for weight in ["printed", "unbiased"] {
             let case = json!({"theta_i": theta, "phi_i": phi, "weight": weight,
                               "proxy": vnis.proxy().name(), "sigma": vnis.sigma(),
@@ -575,6 +626,7 @@ fn pseudo_vnis_record(
 mod tests {
     use super::*;
     use crate::check::RunContext;
+    use crate::oracle::chi2::chi2_test;
 
     fn run(plan: &[Planned]) -> Vec<CheckRecord> {
         let ctx = RunContext { seed: 7, out: None };
@@ -641,7 +693,7 @@ mod tests {
             Profile::Quick,
             "test",
         ));
-        assert_eq!(records.len(), 2 * VISIBLE_INCIDENCES.len());
+        assert_eq!(records.len(), 3 * VISIBLE_INCIDENCES.len());
         for r in &records {
             assert_eq!(r.case["proxy"], "ggx");
             match r.case["weight"].as_str() {
@@ -670,7 +722,10 @@ mod tests {
     fn a_wrong_visible_density_fails_the_chi_square() {
         let (_, a) = model(r#"{"family":"ggx","alpha":0.3}"#);
         let (_, b) = model(r#"{"family":"ggx","alpha":0.33}"#);
-        let (va, vb) = (a.as_visible_sampler().unwrap(), b.as_visible_sampler().unwrap());
+        let (va, vb) = (
+            a.as_visible_sampler().unwrap(),
+            b.as_visible_sampler().unwrap(),
+        );
         let wi = from_spherical(1.3, 0.3);
         let config = Chi2Config {
             resolution: 16,

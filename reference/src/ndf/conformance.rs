@@ -104,7 +104,12 @@ pub fn assert_lambda(
 /// differences) is 1/pdf_wm(m), and the samples lie on the unit upper hemisphere. Returns the
 /// max relative error.
 pub fn assert_sampler_density(sampler: &dyn NormalSampler, tol: f64, label: &str) -> f64 {
-    assert_density(&|u| sampler.sample_wm(u), &|m| sampler.pdf_wm(m), tol, label)
+    assert_density(
+        &|u| sampler.sample_wm(u),
+        &|m| sampler.pdf_wm(m),
+        tol,
+        label,
+    )
 }
 
 /// [`assert_sampler_density`] for any map `sample` from [0, 1)² to the unit upper hemisphere
@@ -244,9 +249,16 @@ pub fn assert_visible_sampler(model: &dyn VisibleNormalSampler, width: f64, labe
             &here,
         );
         for i in 0..400 {
-            let u = [(i as f64 + 0.5) / 400.0, (i as f64 * 0.618_033_988_749_895).fract()];
+            let u = [
+                (i as f64 + 0.5) / 400.0,
+                (i as f64 * 0.618_033_988_749_895).fract(),
+            ];
             let m = model.sample_wm_visible(wi, u);
-            assert!(dot(wi, m) >= -1e-12, "{here}: u = {u:?}: wi·m = {}", dot(wi, m));
+            assert!(
+                dot(wi, m) >= -1e-12,
+                "{here}: u = {u:?}: wi·m = {}",
+                dot(wi, m)
+            );
         }
     }
     let n = [0.0, 0.0, 1.0];
@@ -256,8 +268,16 @@ pub fn assert_visible_sampler(model: &dyn VisibleNormalSampler, width: f64, labe
         assert!(rel_err(model.pdf_wm_visible(n, m), want) < 1e-14, "{label}");
     }
     // Outside the domain: NaN samples and zero density, no panic.
-    for wi in [[0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [f64::NAN, 0.0, 1.0], [0.0, 0.0, 2.0]] {
-        assert!(model.sample_wm_visible(wi, [0.3, 0.4])[0].is_nan(), "{label}");
+    for wi in [
+        [0.0, 0.0, -1.0],
+        [1.0, 0.0, 0.0],
+        [f64::NAN, 0.0, 1.0],
+        [0.0, 0.0, 2.0],
+    ] {
+        assert!(
+            model.sample_wm_visible(wi, [0.3, 0.4])[0].is_nan(),
+            "{label}"
+        );
         assert_eq!(model.pdf_wm_visible(wi, n), 0.0, "{label}");
     }
 }

@@ -138,11 +138,7 @@ impl VisibleNormalSampler for Ggx {
             t1 * t1v[1] + t2 * t2v[1] + lift * vh[1],
             t1 * t1v[2] + t2 * t2v[2] + lift * vh[2],
         ];
-        normalize([
-            self.alpha_x * nh[0],
-            self.alpha_y * nh[1],
-            nh[2].max(0.0),
-        ])
+        normalize([self.alpha_x * nh[0], self.alpha_y * nh[1], nh[2].max(0.0)])
     }
 }
 
