@@ -425,8 +425,11 @@ const PSEUDO_VNIS_SOURCE: &str = "seed 001 §7.2, Algorithm 1 and eq 43 (weight(
 /// F = 1) with samples from Algorithm 1's proxy, against E(wi) by quadrature, once with eq 43's
 /// weight as printed (`weight: printed`; an expected failure, erratum `001-§7.2`, where the bias
 /// is significant) and once with the unbiased weight D_wi^STD/p_proxy (`weight: unbiased`; must
-/// pass). A z-test with the estimator's standard error decides. Models other than STD with
-/// finite γ get one skipped record with the reason.
+/// pass). A z-test with the estimator's standard error decides. With the Beckmann proxy the
+/// unbiased weight has infinite variance (see `PseudoVnis::weight`): the z-test is then
+/// self-normalized but heuristic; the default scene's STD material uses the GGX proxy, where
+/// the variance is finite. Models other than STD with finite γ get one skipped record with the
+/// reason.
 pub fn plan_pseudo_vnis(
     spec: &ModelSpec,
     masking: Option<Masking>,

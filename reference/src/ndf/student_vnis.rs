@@ -181,6 +181,12 @@ impl PseudoVnis {
 
     /// The unbiased weight G2(wo, wi, m)⟨wi·m⟩⁺D(m)/(cos θi pdf_wm(wi, m)) of the STD for a
     /// sample of `sample_wm` (0 where the sampler's density is 0).
+    ///
+    /// Its variance is finite for the GGX proxy (γ ≥ 2: the STD's slope tail (1 + r²)^{−γ} is
+    /// no heavier than GGX's) but infinite for the Beckmann proxy at every finite γ: the weight
+    /// grows like e^{r²/α²} r^{−2γ} in the slope tail, and ∫ D_STD²/D_Beckmann diverges. The
+    /// estimator stays unbiased, but its standard error is then not a reliable measure of its
+    /// error.
     pub fn weight(&self, wi: Vec3, wo: Vec3, m: Vec3, masking: Masking) -> f64 {
         if !visible_domain(wi) || !(m[2] > 0.0) || !(dot(wi, m) > 0.0) {
             return 0.0;
@@ -277,6 +283,14 @@ mod tests {
         let v = PseudoVnis::new(2.0, 0.4, 0.4).unwrap();
         let t = truth(&v);
         assert!(rel_err(expectation(&v, wi, true), t) < 1e-7);
+        // γ = 6, σ = 0.4: Beckmann proxy, biased too.
+        let v = PseudoVnis::new(6.0, 0.4, 0.4).unwrap();
+        assert_eq!(v.proxy(), Proxy::Beckmann);
+        let t = truth(&v);
+        let printed = expectation(&v, wi, true);
+        eprintln!("γ = 6, σ = 0.4: E = {t}, printed {printed}");
+        assert!(rel_err(expectation(&v, wi, false), t) < 1e-7);
+        assert!(rel_err(printed, t) > 1e-3, "{printed} vs {t}");
         // The normal-sampling branch (σ = 0.1, γ = 5) uses the §6 weight: unbiased.
         let v = PseudoVnis::new(5.0, 0.1, 0.1).unwrap();
         assert_eq!(v.proxy(), Proxy::Normals);
