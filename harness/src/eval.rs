@@ -244,19 +244,25 @@ fn evaluate_quantity(
             let sampler = model
                 .as_sampler()
                 .ok_or_else(|| unsupported(model, quantity))?;
-            let u = q
-                .get("u")
-                .and_then(Value::as_array)
-                .filter(|a| a.len() == 2)
-                .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]))
-                .ok_or_else(|| EvalError::Argument("\"u\" must be [u1, u2]".into()))?;
-            if !u.iter().all(|x| (0.0..1.0).contains(x)) {
-                return Err(EvalError::Argument(format!(
-                    "\"u\" must lie in [0, 1)² (got {u:?})"
-                )));
-            }
-            let m = sampler.sample_wm(u);
+            let m = sampler.sample_wm(unit_square(q)?);
             Ok(Value::Array(m.iter().map(|c| number(*c)).collect()))
+        }
+        "sample_wm_visible" => {
+            no_route(route, quantity)?;
+            let sampler = model
+                .as_visible_sampler()
+                .ok_or_else(|| unsupported(model, quantity))?;
+            let wi = visible_incidence(q)?;
+            let m = sampler.sample_wm_visible(wi, unit_square(q)?);
+            Ok(Value::Array(m.iter().map(|c| number(*c)).collect()))
+        }
+        "pdf_wm_visible" => {
+            no_route(route, quantity)?;
+            let sampler = model
+                .as_visible_sampler()
+                .ok_or_else(|| unsupported(model, quantity))?;
+            let wi = visible_incidence(q)?;
+            Ok(number(sampler.pdf_wm_visible(wi, direction(q, "m")?)))
         }
         "pdf_wm" => {
             no_route(route, quantity)?;
@@ -284,9 +290,38 @@ fn evaluate_quantity(
         }
         other => Err(EvalError::Argument(format!(
             "unknown quantity {other:?} (known: d, lambda, g1, g2, p22, p2, slope_moment, \
-             variance, excess_kurtosis, sample_wm, pdf_wm)"
+             variance, excess_kurtosis, sample_wm, pdf_wm, sample_wm_visible, pdf_wm_visible, \
+             visible_moments, and the SG/ASG quantities)"
         ))),
     }
+}
+
+/// The sample point `"u": [u1, u2]` in [0, 1)².
+fn unit_square(q: &Map<String, Value>) -> Result<[f64; 2], EvalError> {
+    let u = q
+        .get("u")
+        .and_then(Value::as_array)
+        .filter(|a| a.len() == 2)
+        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]))
+        .ok_or_else(|| EvalError::Argument("\"u\" must be [u1, u2]".into()))?;
+    if !u.iter().all(|x| (0.0..1.0).contains(x)) {
+        return Err(EvalError::Argument(format!(
+            "\"u\" must lie in [0, 1)² (got {u:?})"
+        )));
+    }
+    Ok(u)
+}
+
+/// The incident direction of the visible-normal quantities (`"wi"`, or `"theta_i"` and
+/// `"phi_i"`), which must lie strictly above the horizon.
+fn visible_incidence(q: &Map<String, Value>) -> Result<Vec3, EvalError> {
+    let wi = direction(q, "wi")?;
+    if !mfh_reference::model::visible_domain(wi) {
+        return Err(EvalError::Argument(format!(
+            "the incident direction must lie strictly above the horizon (got {wi:?})"
+        )));
+    }
+    Ok(wi)
 }
 
 /// A JSON number, or `"inf"`, `"-inf"`, `"nan"` for non-finite values.
@@ -491,6 +526,46 @@ mod tests {
         assert!((d0 - 1.0 / (std::f64::consts::PI * 0.25)).abs() < 1e-15);
         assert_eq!(lines[1]["error"]["kind"], "parse");
         assert_eq!(lines[2]["value"].as_array().unwrap().len(), 3);
+    }
+
+    #[test]
+    fn visible_normal_sampling_answers_the_library() {
+        let ggx = r#"{"family":"ggx","alpha_x":0.2,"alpha_y":0.5}"#;
+        let m = serde_json::from_str::<ModelSpec>(ggx)
+            .unwrap()
+            .build()
+            .unwrap();
+        let v = m.as_visible_sampler().unwrap();
+        let wi = from_spherical(1.1, 0.4);
+        let got = value(&format!(
+            r#"{{"model":{ggx},"quantity":"sample_wm_visible","theta_i":1.1,"phi_i":0.4,"u":[0.3,0.7]}}"#
+        ));
+        let want = v.sample_wm_visible(wi, [0.3, 0.7]);
+        for k in 0..3 {
+            assert_eq!(got[k].as_f64().unwrap(), want[k]);
+        }
+        let got = value(&format!(
+            r#"{{"model":{ggx},"quantity":"pdf_wm_visible","theta_i":1.1,"phi_i":0.4,"theta":0.3,"phi":1.0}}"#
+        ));
+        let want = v.pdf_wm_visible(wi, from_spherical(0.3, 1.0));
+        assert_eq!(got.as_f64().unwrap(), want);
+        assert!(want > 0.0);
+        for (line, kind) in [
+            (
+                format!(r#"{{"model":{ggx},"quantity":"pdf_wm_visible","theta_i":1.6,"theta":0.3}}"#),
+                "argument",
+            ),
+            (
+                format!(r#"{{"model":{ggx},"quantity":"sample_wm_visible","theta_i":0.3}}"#),
+                "argument",
+            ),
+            (
+                r#"{"model":{"family":"std","gamma":3,"alpha":0.3},"quantity":"sample_wm_visible","theta_i":0.3,"u":[0.1,0.2]}"#.to_string(),
+                "unsupported",
+            ),
+        ] {
+            assert_eq!(error_kind(&line), kind, "{line}");
+        }
     }
 
     #[test]

@@ -65,13 +65,22 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
             ));
         }
         if let Some(s) = material.sampling {
-            out.extend(sampling::plan(
-                model.clone(),
-                profile,
-                &format!("{why} samples ({s:?})"),
-            ));
-            if s == Sampling::PseudoVnis {
-                documents.insert("001");
+            let samples = format!("{why} samples ({s:?})");
+            out.extend(sampling::plan(model.clone(), profile, &samples));
+            match s {
+                Sampling::Normals => {}
+                Sampling::VisibleNormals => {
+                    out.extend(sampling::plan_visible(model.clone(), profile, &samples));
+                }
+                Sampling::PseudoVnis => {
+                    documents.insert("001");
+                    out.extend(sampling::plan_pseudo_vnis(
+                        &material.model,
+                        material.masking,
+                        profile,
+                        &samples,
+                    ));
+                }
             }
         }
         if scene.filtering.gaussian_slopes || family == "gaussian_slopes" {

@@ -18,5 +18,7 @@ mod test_support;
 
 pub use error::{ParamError, QueryError};
 pub use geometry::Vec3;
-pub use model::{Masking, Model, Ndf, NormalSampler, SlopeDistribution, Smith};
+pub use model::{
+    Masking, Model, Ndf, NormalSampler, SlopeDistribution, Smith, VisibleNormalSampler,
+};
 pub use spec::ModelSpec;

@@ -91,6 +91,14 @@ pub fn queries() -> Vec<Value> {
         q.push(with(json!({"quantity": "sample_wm", "u": [0.3, 0.7]})));
         q.push(with(json!({"quantity": "pdf_wm", "m": unit(0.4, 1.0)})));
         q.push(with(
+            json!({"quantity": "sample_wm_visible", "theta_i": 1.1, "phi_i": 0.4,
+                   "u": [0.3, 0.7]}),
+        ));
+        q.push(with(
+            json!({"quantity": "pdf_wm_visible", "theta_i": 1.1, "phi_i": 0.4,
+                   "m": unit(0.4, 1.0)}),
+        ));
+        q.push(with(
             json!({"quantity": "visible_moments", "theta": 0.8, "phi": 0.5}),
         ));
     }

@@ -224,6 +224,12 @@ fn the_default_plan_covers_every_closed_form() {
             required.insert(format!("{f}/sample_wm/default"));
             required.insert(format!("{f}/pdf_wm/default"));
         }
+        if model.as_visible_sampler().is_some()
+            && material.sampling == Some(mfh_harness::scene::Sampling::VisibleNormals)
+        {
+            required.insert(format!("{f}/sample_wm_visible/default"));
+            required.insert(format!("{f}/pdf_wm_visible/default"));
+        }
         if let Some(v) = model.as_visible_moments() {
             for r in v.visible_moments_routes() {
                 required.insert(format!("{f}/visible_moments/{r}"));

@@ -140,7 +140,7 @@ fn families() -> Vec<Value> {
 }
 
 /// The quantities of the contract.
-const QUANTITIES: [&str; 12] = [
+const QUANTITIES: [&str; 14] = [
     "d",
     "lambda",
     "g1",
@@ -153,19 +153,26 @@ const QUANTITIES: [&str; 12] = [
     "sample_wm",
     "pdf_wm",
     "visible_moments",
+    "sample_wm_visible",
+    "pdf_wm_visible",
 ];
 
 /// The quantities a model has a meaning for (DESIGN.md and the source documents): everything
 /// for the elliptic slope families (but Λ, G1, G2 only where γ > 3/2); D, Smith and sampling for
 /// the piecewise-linear NDF; D and Smith for the blend (no closed-form sampler); D, Smith,
 /// slopes and sampling (Burley's inversion) for GTR; D, Smith, slopes and the moments of the
-/// visible slopes for Gaussian slopes (no sampler).
+/// visible slopes for Gaussian slopes (no sampler); visible-normal sampling for GGX and
+/// Beckmann (also as STD with γ = ∞) only.
 fn supported(spec: &Value) -> Vec<&'static str> {
     let smith = ["lambda", "g1", "g2"];
     let slopes = ["p22", "p2", "slope_moment", "variance", "excess_kurtosis"];
     let sampler = ["sample_wm", "pdf_wm"];
     let mut q = vec!["d"];
-    match spec["family"].as_str().unwrap() {
+    let family = spec["family"].as_str().unwrap();
+    if family == "ggx" || family == "beckmann" || spec["gamma"] == "inf" {
+        q.extend(["sample_wm_visible", "pdf_wm_visible"]);
+    }
+    match family {
         "piecewise_linear" => q.extend(smith.iter().chain(&sampler)),
         "blend" => q.extend(smith),
         "gtr" => q.extend(smith.iter().chain(&slopes).chain(&sampler)),
@@ -356,6 +363,45 @@ fn battery(quantity: &str, m: &dyn Model) -> Vec<(Value, Expect)> {
                 ),
             ]
         }
+        "sample_wm_visible" => {
+            let wi = from_spherical(1.2, 0.7);
+            let mut v: Vec<(Value, Expect)> = [[0.3, 0.6], [0.0, 0.0], [0.95, 0.999]]
+                .into_iter()
+                .map(|u| {
+                    (
+                        json!({"theta_i": 1.2, "phi_i": 0.7, "u": u}),
+                        m.as_visible_sampler()
+                            .map(|s| json!(s.sample_wm_visible(wi, u).map(num)))
+                            .ok_or("unsupported"),
+                    )
+                })
+                .collect();
+            let wi = from_spherical(0.2, 3.0);
+            v.push((
+                json!({"wi": vector(wi), "u": [0.5, 0.25]}),
+                m.as_visible_sampler()
+                    .map(|s| json!(s.sample_wm_visible(wi, [0.5, 0.25]).map(num)))
+                    .ok_or("unsupported"),
+            ));
+            v
+        }
+        "pdf_wm_visible" => {
+            let (wi, mm) = (from_spherical(1.2, 0.7), from_spherical(0.4, 1.0));
+            vec![
+                (
+                    json!({"theta_i": 1.2, "phi_i": 0.7, "m": vector(mm)}),
+                    m.as_visible_sampler()
+                        .map(|s| num(s.pdf_wm_visible(wi, mm)))
+                        .ok_or("unsupported"),
+                ),
+                (
+                    json!({"wi": vector(wi), "theta": 0.4, "phi": 1.0}),
+                    m.as_visible_sampler()
+                        .map(|s| num(s.pdf_wm_visible(wi, mm)))
+                        .ok_or("unsupported"),
+                ),
+            ]
+        }
         "visible_moments" => {
             let moments = |v: mfh_reference::model::VisibleMoments| {
                 json!({
@@ -404,6 +450,7 @@ fn every_family_answers_every_quantity_as_the_library_does() {
                 "d" => true,
                 "lambda" | "g1" | "g2" => model.as_smith().is_some(),
                 "sample_wm" | "pdf_wm" => model.as_sampler().is_some(),
+                "sample_wm_visible" | "pdf_wm_visible" => model.as_visible_sampler().is_some(),
                 "visible_moments" => model.as_visible_moments().is_some(),
                 _ => model.as_slopes().is_some(),
             };
@@ -532,10 +579,16 @@ fn error_kinds() {
         (json!({"model": ggx, "quantity": "d", "m": [0, 1]}).to_string(), "argument"),
         (json!({"model": ggx, "quantity": "d", "m": [0, 0, 1], "theta": 0}).to_string(), "argument"),
         (json!({"model": ggx, "quantity": "lambda", "theta": 1, "route": 3}).to_string(), "argument"),
+        (json!({"model": ggx, "quantity": "sample_wm_visible", "u": [0.5, 0.5]}).to_string(), "argument"),
+        (json!({"model": ggx, "quantity": "sample_wm_visible", "theta_i": FRAC_PI_2, "u": [0.5, 0.5]}).to_string(), "argument"),
+        (json!({"model": ggx, "quantity": "pdf_wm_visible", "theta_i": 2.0, "theta": 0.1}).to_string(), "argument"),
+        (json!({"model": ggx, "quantity": "pdf_wm_visible", "theta_i": 0.5}).to_string(), "argument"),
         // unsupported: quantities the family has no meaning for
         (json!({"model": {"family": "std", "gamma": 1.2, "alpha": 0.3}, "quantity": "lambda", "theta": 1}).to_string(), "unsupported"),
         (json!({"model": {"family": "piecewise_linear", "x": {"theta": [0, FRAC_PI_2], "value": [1, 0]}}, "quantity": "p22", "p": 0, "q": 0}).to_string(), "unsupported"),
         (json!({"model": {"family": "blend", "x": ggx, "y": ggx}, "quantity": "sample_wm", "u": [0.1, 0.2]}).to_string(), "unsupported"),
+        (json!({"model": std25, "quantity": "sample_wm_visible", "theta_i": 0.5, "u": [0.1, 0.2]}).to_string(), "unsupported"),
+        (json!({"model": std25, "quantity": "pdf_wm_visible", "theta_i": 0.5, "theta": 0.1}).to_string(), "unsupported"),
     ];
     let input: String = cases.iter().map(|(l, _)| format!("{l}\n")).collect();
     let r = mfh(&["eval"], &input);

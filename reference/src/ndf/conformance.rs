@@ -3,7 +3,7 @@
 //! inversions against their densities.
 
 use crate::geometry::{dot, from_spherical, Vec3};
-use crate::model::{NormalSampler, SlopeDistribution, Smith};
+use crate::model::{NormalSampler, SlopeDistribution, Smith, VisibleNormalSampler};
 use crate::test_support::{integrate, integrate_line, integrate_tail, rel_err};
 use std::f64::consts::PI;
 
@@ -104,25 +104,41 @@ pub fn assert_lambda(
 /// differences) is 1/pdf_wm(m), and the samples lie on the unit upper hemisphere. Returns the
 /// max relative error.
 pub fn assert_sampler_density(sampler: &dyn NormalSampler, tol: f64, label: &str) -> f64 {
+    assert_density(
+        &|u| sampler.sample_wm(u),
+        &|m| sampler.pdf_wm(m),
+        tol,
+        label,
+    )
+}
+
+/// [`assert_sampler_density`] for any map `sample` from [0, 1)² to the unit upper hemisphere
+/// with density `pdf`.
+pub fn assert_density(
+    sample: &dyn Fn([f64; 2]) -> Vec3,
+    pdf_of: &dyn Fn(Vec3) -> f64,
+    tol: f64,
+    label: &str,
+) -> f64 {
     let mut worst: f64 = 0.0;
     let h = 1e-6;
     for i in 1..12 {
         for j in 1..12 {
             let u = [i as f64 / 12.0 + 0.013, j as f64 / 12.0 * 0.97];
-            let m = sampler.sample_wm(u);
+            let m = sample(u);
             assert!(
                 (dot(m, m) - 1.0).abs() < 1e-12 && m[2] >= 0.0,
                 "{label}: m = {m:?}"
             );
-            let d1 = diff(sampler, u, [h, 0.0]);
-            let d2 = diff(sampler, u, [0.0, h]);
+            let d1 = diff(sample, u, [h, 0.0]);
+            let d2 = diff(sample, u, [0.0, h]);
             let cross = [
                 d1[1] * d2[2] - d1[2] * d2[1],
                 d1[2] * d2[0] - d1[0] * d2[2],
                 d1[0] * d2[1] - d1[1] * d2[0],
             ];
             let area = dot(cross, cross).sqrt();
-            let pdf = sampler.pdf_wm(m);
+            let pdf = pdf_of(m);
             if pdf < 1e-8 || m[2] < 1e-4 {
                 continue; // the finite differences are meaningless where m is on the horizon
             }
@@ -135,15 +151,135 @@ pub fn assert_sampler_density(sampler: &dyn NormalSampler, tol: f64, label: &str
             worst = worst.max(e);
         }
     }
-    eprintln!("{label}: max rel err of the sampler's Jacobian against pdf_wm: {worst:.2e}");
+    eprintln!("{label}: max rel err of the sampler's Jacobian against its pdf: {worst:.2e}");
     worst
 }
 
-fn diff(sampler: &dyn NormalSampler, u: [f64; 2], h: [f64; 2]) -> Vec3 {
-    let a = sampler.sample_wm([u[0] + h[0], u[1] + h[1]]);
-    let b = sampler.sample_wm([u[0] - h[0], u[1] - h[1]]);
+fn diff(sample: &dyn Fn([f64; 2]) -> Vec3, u: [f64; 2], h: [f64; 2]) -> Vec3 {
+    let a = sample([u[0] + h[0], u[1] + h[1]]);
+    let b = sample([u[0] - h[0], u[1] - h[1]]);
     let n = 2.0 * (h[0] + h[1]);
     [(a[0] - b[0]) / n, (a[1] - b[1]) / n, (a[2] - b[2]) / n]
+}
+
+/// ∫ pdf(m) dm over the upper hemisphere for a density peaked at the normal with angular width
+/// `width`, with the polar integral cut at `kinks(φ)` (e.g. the terminator of ⟨wi·m⟩⁺) and the
+/// azimuthal one at `phi_kinks` (e.g. where the terminator enters the hemisphere).
+pub fn hemisphere_integral(
+    pdf: &dyn Fn(Vec3) -> f64,
+    width: f64,
+    kinks: &dyn Fn(f64) -> Vec<f64>,
+    phi_kinks: &[f64],
+) -> f64 {
+    let half = PI / 2.0;
+    let inner = |phi: f64| {
+        let (s, c) = phi.sin_cos();
+        let mut cuts = vec![0.0, half];
+        for k in [0.1, 0.3, 1.0, 3.0, 10.0] {
+            if width * k < half {
+                cuts.push(width * k);
+            }
+        }
+        cuts.extend(kinks(phi).into_iter().filter(|t| *t > 0.0 && *t < half));
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        let f = |theta: f64| {
+            let (st, ct) = theta.sin_cos();
+            pdf([st * c, st * s, ct]) * st
+        };
+        cuts.windows(2)
+            .map(|w| integrate(&f, w[0], w[1], 1e-12, 1e-15).0)
+            .sum::<f64>()
+    };
+    let mut cuts: Vec<f64> = (0..=8).map(|k| k as f64 * PI / 4.0).collect();
+    cuts.extend(phi_kinks.iter().map(|p| p.rem_euclid(2.0 * PI)));
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup();
+    cuts.windows(2)
+        .map(|w| integrate(&inner, w[0], w[1], 1e-11, 1e-14).0)
+        .sum()
+}
+
+/// The azimuths of m where the terminator of ⟨wi·m⟩⁺ meets the normal (φi ± π/2).
+pub fn terminator_azimuths(wi: Vec3) -> [f64; 2] {
+    let phi = wi[1].atan2(wi[0]);
+    [phi + PI / 2.0, phi - PI / 2.0]
+}
+
+/// The polar angle of the terminator of ⟨wi·m⟩⁺ along azimuth φ of m, if it is above the
+/// horizon: cos θ wi_z + sin θ (wi_x cos φ + wi_y sin φ) = 0.
+pub fn terminator(wi: Vec3, phi: f64) -> Vec<f64> {
+    let k = wi[0] * phi.cos() + wi[1] * phi.sin();
+    if k < 0.0 {
+        vec![PI / 2.0 + k.atan2(wi[2])]
+    } else {
+        Vec::new()
+    }
+}
+
+/// Checks a visible-normal sampler at several incidences: ∫ pdf_wm_visible(wi, m) dm = 1 by
+/// quadrature, the Jacobian of u ↦ m against 1/pdf_wm_visible, every sample facing `wi`, and at
+/// normal incidence pdf_wm_visible(n, m) = D(m)(m·n). `width` is the smallest roughness, used
+/// to place quadrature nodes.
+pub fn assert_visible_sampler(model: &dyn VisibleNormalSampler, width: f64, label: &str) {
+    for &(theta, phi) in &[
+        (0.0, 0.0),
+        (1e-3, 0.4),
+        (0.5, 0.0),
+        (0.5, 2.2),
+        (1.3, 0.7),
+        (1.55, 4.0),
+    ] {
+        let wi = from_spherical(theta, phi);
+        let n = hemisphere_integral(
+            &|m| model.pdf_wm_visible(wi, m),
+            width.atan(),
+            &|p| terminator(wi, p),
+            &terminator_azimuths(wi),
+        );
+        assert!(
+            (n - 1.0).abs() < 1e-8,
+            "{label}: θi = {theta}: ∫ D_wi = {n}"
+        );
+        let here = format!("{label} θi={theta} φi={phi}");
+        assert_density(
+            &|u| model.sample_wm_visible(wi, u),
+            &|m| model.pdf_wm_visible(wi, m),
+            1e-5,
+            &here,
+        );
+        for i in 0..400 {
+            let u = [
+                (i as f64 + 0.5) / 400.0,
+                (i as f64 * 0.618_033_988_749_895).fract(),
+            ];
+            let m = model.sample_wm_visible(wi, u);
+            assert!(
+                dot(wi, m) >= -1e-12,
+                "{here}: u = {u:?}: wi·m = {}",
+                dot(wi, m)
+            );
+        }
+    }
+    let n = [0.0, 0.0, 1.0];
+    for &(theta, phi) in &[(0.2, 0.1), (0.9, 3.0)] {
+        let m = from_spherical(theta, phi);
+        let want = model.d(m) * m[2];
+        assert!(rel_err(model.pdf_wm_visible(n, m), want) < 1e-14, "{label}");
+    }
+    // Outside the domain: NaN samples and zero density, no panic.
+    for wi in [
+        [0.0, 0.0, -1.0],
+        [1.0, 0.0, 0.0],
+        [f64::NAN, 0.0, 1.0],
+        [0.0, 0.0, 2.0],
+    ] {
+        assert!(
+            model.sample_wm_visible(wi, [0.3, 0.4])[0].is_nan(),
+            "{label}"
+        );
+        assert_eq!(model.pdf_wm_visible(wi, n), 0.0, "{label}");
+    }
 }
 
 /// The conformance suite of an elliptic NDF with a closed-form Smith Λ, P2 and sampler, at

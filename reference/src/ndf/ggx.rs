@@ -4,7 +4,7 @@ use crate::error::{ParamError, QueryError};
 use crate::geometry::{normal_from_slopes, Vec3};
 use crate::model::{
     check_alpha, elliptic_direction, lambda_both_hemispheres, scale_along, standardized_cotangent,
-    Model, Ndf, NormalSampler, SlopeDistribution, Smith,
+    visible_domain, Model, Ndf, NormalSampler, SlopeDistribution, Smith, VisibleNormalSampler,
 };
 use crate::spec::ModelSpec;
 use std::f64::consts::PI;
@@ -96,6 +96,58 @@ impl NormalSampler for Ggx {
     }
 }
 
+impl VisibleNormalSampler for Ggx {
+    /// Heitz 2018, "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), Listing 1 (not
+    /// one of the five source documents): stretch `wi` to the configuration α = 1, where the
+    /// visible normals are those of a hemisphere seen from the stretched direction, i.e. a
+    /// uniform point of the projected disk (a half disk warped by s = (1 + V_z)/2 and a full
+    /// half disk), lifted back onto the hemisphere, then unstretch:
+    ///
+    /// ```text
+    /// V_h = normalize(αx wi_x, αy wi_y, wi_z),  T1 = normalize(−V_h,y, V_h,x, 0) (or +x),  T2 = V_h × T1
+    /// r = √u1, φ = 2π u2, t1 = r cos φ, t2 = (1 − s)√(1 − t1²) + s r sin φ,  s = (1 + V_h,z)/2
+    /// N_h = t1 T1 + t2 T2 + √(max(0, 1 − t1² − t2²)) V_h,  m = normalize(αx N_h,x, αy N_h,y, max(0, N_h,z))
+    /// ```
+    ///
+    /// Exact (the density is `pdf_wm_visible`) for every α and wi_z > 0; NaN outside the domain.
+    fn sample_wm_visible(&self, wi: Vec3, u: [f64; 2]) -> Vec3 {
+        if !visible_domain(wi) {
+            return [f64::NAN; 3];
+        }
+        let vh = normalize([self.alpha_x * wi[0], self.alpha_y * wi[1], wi[2]]);
+        let lensq = vh[0] * vh[0] + vh[1] * vh[1];
+        let t1v = if lensq > 0.0 {
+            let inv = 1.0 / lensq.sqrt();
+            [-vh[1] * inv, vh[0] * inv, 0.0]
+        } else {
+            [1.0, 0.0, 0.0]
+        };
+        let t2v = [
+            vh[1] * t1v[2] - vh[2] * t1v[1],
+            vh[2] * t1v[0] - vh[0] * t1v[2],
+            vh[0] * t1v[1] - vh[1] * t1v[0],
+        ];
+        let r = u[0].sqrt();
+        let (sp, cp) = crate::geometry::sin_cos_turns(u[1]);
+        let t1 = r * cp;
+        let s = 0.5 * (1.0 + vh[2]);
+        let t2 = (1.0 - s) * (1.0 - t1 * t1).max(0.0).sqrt() + s * r * sp;
+        let lift = (1.0 - t1 * t1 - t2 * t2).max(0.0).sqrt();
+        let nh = [
+            t1 * t1v[0] + t2 * t2v[0] + lift * vh[0],
+            t1 * t1v[1] + t2 * t2v[1] + lift * vh[1],
+            t1 * t1v[2] + t2 * t2v[2] + lift * vh[2],
+        ];
+        normalize([self.alpha_x * nh[0], self.alpha_y * nh[1], nh[2].max(0.0)])
+    }
+}
+
+/// `v / |v|`.
+fn normalize(v: Vec3) -> Vec3 {
+    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    [v[0] / l, v[1] / l, v[2] / l]
+}
+
 impl SlopeDistribution for Ggx {
     fn p22(&self, p: f64, q: f64) -> f64 {
         let t = 1.0 + (p / self.alpha_x).powi(2) + (q / self.alpha_y).powi(2);
@@ -147,13 +199,17 @@ impl Model for Ggx {
     fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
         Some(self)
     }
+
+    fn as_visible_sampler(&self) -> Option<&dyn VisibleNormalSampler> {
+        Some(self)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::geometry::from_spherical;
-    use crate::ndf::conformance::assert_elliptic_model;
+    use crate::ndf::conformance::{assert_elliptic_model, assert_visible_sampler};
     use crate::test_support::rel_err;
 
     #[test]
@@ -192,6 +248,14 @@ mod tests {
         let (t, d) = (m.lambda_route(w, "table1").unwrap(), m.lambda(w));
         assert!(rel_err(d, 0.25e-10) < 1e-9, "default {d:e}");
         assert!(rel_err(t, d) > 1e-8, "table1 {t:e} vs {d:e}");
+    }
+
+    #[test]
+    fn visible_normals_conform_to_their_density() {
+        for &alpha in &[(0.3, 0.3), (0.05, 0.05), (1.0, 1.0), (0.1, 0.4)] {
+            let m = Ggx::new(alpha.0, alpha.1).unwrap();
+            assert_visible_sampler(&m, alpha.0.min(alpha.1), &format!("ggx α={alpha:?}"));
+        }
     }
 
     #[test]

@@ -9,6 +9,7 @@ pub mod piecewise;
 pub mod piecewise_lambda;
 pub mod student;
 pub mod student_lambda;
+pub mod student_vnis;
 
 #[cfg(test)]
 mod conformance;
