@@ -458,6 +458,7 @@ pub const EXPECTED_FAILURES: &[ExpectedFailure] = &[
                  the STD's only at γ = 2 and γ → ∞: the estimator's mean is off by the ratio of \
                  the two visible-normal densities (the unbiased weight is \
                  G2⟨wi·m⟩D/(cos θi p_proxy); ERRATA.md, seed 001 notes)",
+        cancellation_bound: None,
     },
     ExpectedFailure {
         check: "ds.visible_moments",
