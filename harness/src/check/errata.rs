@@ -920,11 +920,20 @@ fn e000_14() -> Result<Shown, String> {
         };
         (c2 * m.d_x(theta) * dy0 + s2 * m.d_y(theta) * dx0) * v[2]
     };
-    let printed = integrate_hemisphere(&|v| m.d(v) * v[2], 0.5, None, acc()).value;
+    // Cut at the profiles' breakpoints, where D has kinks (22 s without, in the audit).
+    let kinks = super::theta_kinks(&serde_json::to_value(m.spec()).unwrap_or(Value::Null));
+    let at_kinks = |_: f64| kinks.clone();
+    let cuts = || {
+        Some(crate::oracle::quadrature::Cuts {
+            theta: &at_kinks,
+            phi: &[],
+        })
+    };
+    let printed = integrate_hemisphere(&|v| m.d(v) * v[2], 0.5, cuts(), acc()).value;
     Ok(Shown::new(
         printed,
         c,
-        integrate_hemisphere(&blend, 0.5, None, acc()),
+        integrate_hemisphere(&blend, 0.5, cuts(), acc()),
         &ERRATUM,
     ))
 }
