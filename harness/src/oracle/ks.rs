@@ -317,6 +317,8 @@ struct Piece {
     quadrature_error: f64,
     interpolation_error: f64,
     inner_error: f64,
+    /// The first node of the five where the density is negative or not finite.
+    invalid: Option<(f64, f64)>,
 }
 
 impl CdfTable {
@@ -359,10 +361,10 @@ impl CdfTable {
         let mut total = 0.0;
         let mut last = None;
         for p in &pieces {
+            if table.invalid.is_none() {
+                table.invalid = p.invalid;
+            }
             for (n, mass) in [(p.a, p.left), (p.m, p.right)] {
-                if table.invalid.is_none() && !(n.f.is_finite() && n.f >= 0.0) {
-                    table.invalid = Some((n.x, n.f));
-                }
                 table.knots.push(n.x);
                 table.cdf.push(total);
                 table.density.push(n.f);
@@ -455,8 +457,13 @@ fn refine(
         let interpolation_error = (interpolated - left).abs();
         let share = QUADRATURE_TOLERANCE * h / span.max(f64::MIN_POSITIVE);
         let good = quadrature_error <= share && interpolation_error <= INTERPOLATION_TOLERANCE;
-        let finite = [q1.f, q3.f, na.f, nm.f, nb.f].iter().all(|f| f.is_finite());
-        if good || !finite || depth >= MAX_DEPTH || spans + stack.len() >= MAX_SPANS {
+        // An invalid density fails the test anyway: no point refining it.
+        let invalid = [na, q1, nm, q3, nb]
+            .iter()
+            .find(|n| !(n.f.is_finite() && n.f >= 0.0))
+            .map(|n| (n.x, n.f));
+        let valid = invalid.is_none();
+        if good || !valid || depth >= MAX_DEPTH || spans + stack.len() >= MAX_SPANS {
             let inner = [na, q1, nm, q3, nb]
                 .iter()
                 .map(|n| n.error)
@@ -470,6 +477,7 @@ fn refine(
                 quadrature_error,
                 interpolation_error,
                 inner_error: h * inner,
+                invalid,
             });
         } else {
             stack.push((nm, q3, nb, depth + 1));
