@@ -1,9 +1,11 @@
-//! Sampling: chi-square of `sample_wm` against `pdf_wm` over the hemisphere, `pdf_wm` against
-//! D(m)(m·n) at the sampled normals, and a Monte Carlo estimate of Λ through the sampler
-//! (E[⟨−w·m⟩⁺/(m·n)] = Λ(w) cos θ) against the closed form.
+//! Sampling: chi-square of `sample_wm` against `pdf_wm` over the hemisphere, Kolmogorov–Smirnov
+//! tests of its cos θ and φ marginals (one record per marginal, each a statistical test of its
+//! own), `pdf_wm` against D(m)(m·n) at the sampled normals, and a Monte Carlo estimate of Λ
+//! through the sampler (E[⟨−w·m⟩⁺/(m·n)] = Λ(w) cos θ) against the closed form.
 
-use super::{applied, compare_exact, covers, timed, Planned, Profile};
+use super::{applied, compare_exact, covers, lobe_width, theta_kinks, timed, Planned, Profile};
 use crate::oracle::chi2::{chi2_test_sampler, Chi2Config};
+use crate::oracle::ks::{self, ks_test_sampler, KsConfig, LobeHints, Marginal};
 use crate::oracle::monte_carlo::{estimate, two_sided_p};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
 use crate::tolerance::{PDF_CONSISTENCY, STATISTICAL_ALPHA};
@@ -57,10 +59,8 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> 
                     r.cost.samples = samples;
                     r.tolerance = Some(applied(&STATISTICAL_ALPHA));
                     if let Some(dir) = &ctx.out {
-                        let sub = dir.join("chi2").join(format!("{:016x}", ctx.seed));
-                        if crate::chi2_command::write_tables(&sub, &result).is_ok() {
-                            r.artefacts.push(sub.display().to_string());
-                        }
+                        let sub = dir.join("chi2").join(folder_name(&spec_run, &case_run));
+                        write_chi2_artefacts(&mut r, &sub, &result);
                     }
                     match &result.reason {
                         Some(reason)
@@ -89,6 +89,15 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> 
                 })
             }),
         });
+    }
+    for marginal in [Marginal::CosTheta, Marginal::Phi] {
+        out.push(plan_ks(
+            model.clone(),
+            &spec,
+            marginal,
+            profile.ks_samples(family),
+            why,
+        ));
     }
     {
         let (m, spec_run) = (model.clone(), spec.clone());
@@ -205,4 +214,156 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> 
         });
     }
     out
+}
+
+/// Plans the KS test of one marginal of a model's sampler: `sampling.ks_marginals`, case
+/// `{"marginal": "cos_theta" | "phi", "samples": N}`. The record's value is D_N; its case gains
+/// the table's knots and error bound, Stephens' λ and where D_N is attained. Sanity failures
+/// fail without a p-value; a CDF table too coarse for N is an error (no verdict).
+fn plan_ks(
+    model: Arc<dyn Model>,
+    spec: &Value,
+    marginal: Marginal,
+    samples: u64,
+    why: &str,
+) -> Planned {
+    let family = model.family();
+    let case = json!({"marginal": marginal.name(), "samples": samples});
+    let (spec_run, case_run) = (spec.clone(), case.clone());
+    let (width, kinks) = (lobe_width(spec), theta_kinks(spec));
+    Planned {
+        check: "sampling.ks_marginals".into(),
+        model: spec.clone(),
+        case,
+        why: format!(
+            "{why}: the {} marginal of the sampled normals must follow the pdf's",
+            marginal.name()
+        ),
+        covers: vec![covers(family, "sample_wm", "default")],
+        statistical: true,
+        run: Box::new(move |ctx| {
+            timed(|| {
+                let mut r = CheckRecord::new(
+                    "sampling.ks_marginals",
+                    spec_run.clone(),
+                    case_run.clone(),
+                    SOURCE,
+                );
+                r.covers = vec![covers(family, "sample_wm", "default")];
+                r.seed = Some(ctx.seed);
+                let Some(sampler) = model.as_sampler() else {
+                    r.verdict = Verdict::Error {
+                        message: "the model has no sampler".into(),
+                    };
+                    return r;
+                };
+                let hints = LobeHints {
+                    width,
+                    theta_kinks: &kinks,
+                };
+                let config = KsConfig {
+                    samples,
+                    seed: ctx.seed,
+                    alpha: STATISTICAL_ALPHA.value,
+                };
+                let result = ks_test_sampler(sampler, marginal, &hints, &config);
+                fill_ks(&mut r, &result);
+                r
+            })
+        }),
+    }
+}
+
+/// Fills a `sampling.ks_marginals` record from a KS result.
+fn fill_ks(r: &mut CheckRecord, result: &ks::KsResult) {
+    r.cost.samples = result.samples;
+    r.cost.evaluations = result.evaluations;
+    r.tolerance = Some(applied(&STATISTICAL_ALPHA));
+    if let Value::Object(case) = &mut r.case {
+        case.insert("knots".into(), json!(result.knots));
+        case.insert("table_error_bound".into(), json!(result.table_error_bound));
+    }
+    match &result.reason {
+        Some(ks::Failure::TableInaccurate { .. }) => {
+            r.verdict = Verdict::Error {
+                message: result
+                    .reason
+                    .as_ref()
+                    .map(ToString::to_string)
+                    .unwrap_or_default(),
+            };
+        }
+        Some(reason) if !matches!(reason, ks::Failure::Rejected { .. }) => {
+            r.verdict = Verdict::Fail;
+            if let Value::Object(case) = &mut r.case {
+                case.insert("sanity_failure".into(), json!(reason.to_string()));
+            }
+        }
+        _ => {
+            r.value = Some(result.statistic);
+            if let Value::Object(case) = &mut r.case {
+                case.insert("lambda".into(), json!(result.lambda));
+                case.insert("at".into(), json!(result.at));
+            }
+            r.measured = Some(Measured::PValue {
+                p: result.p_value,
+                statistic: result.statistic,
+                dof: 0,
+                alpha: STATISTICAL_ALPHA.value,
+            });
+            // Provisional: the audit re-decides with the Šidák level.
+            r.verdict = if result.p_value >= STATISTICAL_ALPHA.value {
+                Verdict::Pass
+            } else {
+                Verdict::Fail
+            };
+        }
+    }
+}
+
+/// A file-name-safe folder name for a model and case: their compact JSON with every run of
+/// characters outside `[A-Za-z0-9.-]` turned into one `_`, at most 120 characters.
+pub fn folder_name(model: &Value, case: &Value) -> String {
+    let text = format!("{model}_{case}");
+    let mut out = String::new();
+    for c in text.chars() {
+        if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
+            out.push(c);
+        } else if !out.ends_with('_') {
+            out.push('_');
+        }
+    }
+    let out: String = out.trim_matches('_').chars().take(120).collect();
+    if out.is_empty() {
+        "case".to_string()
+    } else {
+        out
+    }
+}
+
+/// Writes a chi-square result's tables into `dir`, and its heat maps when it fails at the
+/// uncorrected level α (a superset of the audit's failures at the Šidák level, so every chi-square
+/// check the audit fails has its maps) or on a sanity failure; lists what was written in the
+/// record's artefacts. A write error is noted in the artefacts, not fatal.
+fn write_chi2_artefacts(
+    r: &mut CheckRecord,
+    dir: &std::path::Path,
+    result: &crate::oracle::chi2::Chi2Result,
+) {
+    let written = crate::chi2_command::write_tables(dir, result)
+        .map_err(crate::heatmap::HeatMapError::from)
+        .and_then(|mut paths| {
+            if result.verdict == crate::oracle::chi2::Verdict::Fail {
+                paths.extend(crate::chi2_command::write_heat_maps(dir, result)?);
+            }
+            Ok(paths)
+        });
+    match written {
+        Ok(paths) => r
+            .artefacts
+            .extend(paths.iter().map(|p| p.display().to_string())),
+        Err(e) => r
+            .artefacts
+            .push(format!("(could not write to {}: {e})", dir.display())),
+    }
 }

@@ -181,7 +181,9 @@ pub enum Failure {
         tolerance: f64,
     },
     /// The CDF table is not accurate enough for the number of samples: no verdict.
-    #[error("CDF table error bound {error_bound:.2e} above {limit:.2e} ({TABLE_FRACTION} of 1/√N)")]
+    #[error(
+        "CDF table error bound {error_bound:.2e} above {limit:.2e} ({TABLE_FRACTION} of 1/√N)"
+    )]
     TableInaccurate {
         /// The table's error bound.
         error_bound: f64,
@@ -330,7 +332,14 @@ impl CdfTable {
         for w in cuts.windows(2).filter(|w| w[1] > w[0]) {
             for k in 0..INITIAL_PER_PIECE {
                 let t = |k: usize| w[0] + (w[1] - w[0]) * k as f64 / INITIAL_PER_PIECE as f64;
-                initial.push([t(k), if k + 1 == INITIAL_PER_PIECE { w[1] } else { t(k + 1) }]);
+                initial.push([
+                    t(k),
+                    if k + 1 == INITIAL_PER_PIECE {
+                        w[1]
+                    } else {
+                        t(k + 1)
+                    },
+                ]);
             }
         }
         let span = cuts.last().copied().unwrap_or(0.0) - cuts.first().copied().unwrap_or(0.0);
@@ -343,7 +352,10 @@ impl CdfTable {
                 pieces
             })
             .collect();
-        Self::assemble(pieces.into_iter().flatten().collect(), evaluations.into_inner())
+        Self::assemble(
+            pieces.into_iter().flatten().collect(),
+            evaluations.into_inner(),
+        )
     }
 
     /// Knots, prefix sums and error totals from the accepted pieces (in order).
@@ -868,7 +880,11 @@ mod tests {
             for i in 0..=1000 {
                 let x = FRAC_PI_2 * f64::from(i) / 1000.0;
                 let tan2 = x.tan().powi(2);
-                let want = if i == 1000 { 1.0 } else { tan2 / (alpha * alpha + tan2) };
+                let want = if i == 1000 {
+                    1.0
+                } else {
+                    tan2 / (alpha * alpha + tan2)
+                };
                 worst = worst.max((t.cdf(x) - want).abs());
             }
             eprintln!(
@@ -884,7 +900,11 @@ mod tests {
         let p = marginal_cdf(&|m| g.pdf_wm(m), Marginal::Phi, &hints(0.1f64.atan()));
         for i in 0..=100 {
             let x = 0.5 * PI * f64::from(i) / 100.0;
-            let want = if i == 100 { 0.25 } else { (0.25 * x.tan()).atan() / TAU };
+            let want = if i == 100 {
+                0.25
+            } else {
+                (0.25 * x.tan()).atan() / TAU
+            };
             assert!((p.cdf(x) - want).abs() < 1e-8, "{x}: {} {want}", p.cdf(x));
         }
         assert!(p.error_bound() < 1e-7 && (p.total() - 1.0).abs() < 1e-9);
@@ -984,7 +1004,10 @@ mod tests {
             &h,
             &config(10_000, 3),
         );
-        assert!(matches!(half.reason, Some(Failure::MassOff { .. })), "{half:?}");
+        assert!(
+            matches!(half.reason, Some(Failure::MassOff { .. })),
+            "{half:?}"
+        );
         let negative = ks_test(
             &|u| g.sample_wm(u),
             &|m| -g.pdf_wm(m),
@@ -1004,7 +1027,10 @@ mod tests {
             &h,
             &config(10_000, 3),
         );
-        assert!(matches!(nan.reason, Some(Failure::MassOff { .. })), "{nan:?}");
+        assert!(
+            matches!(nan.reason, Some(Failure::MassOff { .. })),
+            "{nan:?}"
+        );
         assert_eq!(nan.verdict, Verdict::Fail);
     }
 
@@ -1017,7 +1043,8 @@ mod tests {
                 .build()
                 .unwrap()
                 .install(|| {
-                    let mut r = ks_test_sampler(&g, Marginal::Phi, &hints(0.1), &config(3 * CHUNK + 77, 5));
+                    let mut r =
+                        ks_test_sampler(&g, Marginal::Phi, &hints(0.1), &config(3 * CHUNK + 77, 5));
                     r.sampling_seconds = 0.0;
                     r.table_seconds = 0.0;
                     r
@@ -1045,6 +1072,9 @@ mod tests {
         let mean = p.iter().sum::<f64>() / p.len() as f64;
         assert!((0.25..0.75).contains(&mean), "{p:?}");
         assert!(p.iter().all(|&p| p > 1e-3), "{p:?}");
-        assert!(p.iter().any(|&p| p < 0.5) && p.iter().any(|&p| p > 0.5), "{p:?}");
+        assert!(
+            p.iter().any(|&p| p < 0.5) && p.iter().any(|&p| p > 0.5),
+            "{p:?}"
+        );
     }
 }
