@@ -322,7 +322,8 @@ fn fill_ks(r: &mut CheckRecord, result: &ks::KsResult) {
 }
 
 /// A file-name-safe folder name for a model and case: their compact JSON with every run of
-/// characters outside `[A-Za-z0-9.-]` turned into one `_`, at most 120 characters.
+/// characters outside `[A-Za-z0-9.-]` turned into one `_`; past 120 characters, the first 111
+/// and 8 hex digits of a hash (FNV-1a) of the whole, so that long names stay distinct.
 pub fn folder_name(model: &Value, case: &Value) -> String {
     let text = format!("{model}_{case}");
     let mut out = String::new();
@@ -333,7 +334,13 @@ pub fn folder_name(model: &Value, case: &Value) -> String {
             out.push('_');
         }
     }
-    let out: String = out.trim_matches('_').chars().take(120).collect();
+    let mut out = out.trim_matches('_').to_string();
+    if out.len() > 120 {
+        let hash = text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+        });
+        out = format!("{}_{:08x}", &out[..111], hash >> 32);
+    }
     if out.is_empty() {
         "case".to_string()
     } else {
@@ -365,5 +372,33 @@ fn write_chi2_artefacts(
         Err(e) => r
             .artefacts
             .push(format!("(could not write to {}: {e})", dir.display())),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::folder_name;
+    use serde_json::json;
+
+    #[test]
+    fn folder_names_are_safe_and_distinct() {
+        let name = folder_name(
+            &json!({"family": "ggx", "alpha": 0.3}),
+            &json!({"samples": 10}),
+        );
+        assert_eq!(name, "alpha_0.3_family_ggx_samples_10");
+        let long = |v: f64| {
+            folder_name(
+                &json!({"family": "piecewise_linear", "x": {"theta": [0.0, 0.5, 1.0, 1.5],
+                        "value": [1.0, 0.6, 0.1, 0.0]}, "y": {"theta": [0.0, 0.3, 0.9, 1.5],
+                        "value": [2.0, 0.8, 0.05, v]}}),
+                &json!({"samples": 200000, "resolution": 16}),
+            )
+        };
+        let (a, b) = (long(0.0), long(1e-3));
+        assert!(a.len() == 120 && b.len() == 120 && a != b, "{a} {b}");
+        assert!(a
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "._-".contains(c)));
     }
 }
