@@ -1,5 +1,5 @@
 //! `mfh chi2`: the chi-square test of a model's normal sampler from the command line, with
-//! text or JSON output and optional observed/expected tables.
+//! text or JSON output and optional observed/expected tables (JSON) and heat maps (PNG).
 
 use crate::cli::EXIT_BAD_INPUT;
 use crate::oracle::chi2::{chi2_test_sampler, Chi2Config, Chi2Result, Verdict, DEFAULT_SEED};
@@ -23,7 +23,8 @@ pub struct Chi2Options {
     pub alpha: f64,
     /// Print one JSON object instead of text.
     pub json: bool,
-    /// Write `chi2_observed.json` and `chi2_expected.json` into this folder.
+    /// Write `chi2_observed.json`, `chi2_expected.json` and the heat maps
+    /// `chi2_observed.png`, `chi2_expected.png`, `chi2_difference.png` into this folder.
     pub out: Option<PathBuf>,
 }
 
@@ -76,14 +77,22 @@ pub fn run_chi2(options: &Chi2Options, stdout: &mut dyn Write, stderr: &mut dyn 
         alpha: options.alpha,
     };
     let result = chi2_test_sampler(sampler, &config);
+    let mut artefacts = Vec::new();
     if let Some(dir) = &options.out {
-        if let Err(e) = write_tables(dir, &result) {
-            return bad(
-                stderr,
-                format!("cannot write tables to {}: {e}", dir.display()),
-            );
+        match write_artefacts(dir, &result) {
+            Ok(paths) => artefacts = paths,
+            Err(e) => {
+                return bad(
+                    stderr,
+                    format!(
+                        "cannot write tables and heat maps to {}: {e}",
+                        dir.display()
+                    ),
+                )
+            }
         }
     }
+    let artefacts: Vec<String> = artefacts.iter().map(|p| p.display().to_string()).collect();
     let spec_text = serde_json::to_string(&model.spec()).unwrap_or_default();
     let reason = result.reason.as_ref().map(|r| r.to_string());
     let written = if options.json {
@@ -104,6 +113,7 @@ pub fn run_chi2(options: &Chi2Options, stdout: &mut dyn Write, stderr: &mut dyn 
             "expected_error_bound": result.expected_error_bound,
             "sampling_seconds": result.sampling_seconds,
             "integration_seconds": result.integration_seconds,
+            "artefacts": artefacts,
         });
         writeln!(stdout, "{value}")
     } else {
@@ -115,7 +125,7 @@ pub fn run_chi2(options: &Chi2Options, stdout: &mut dyn Write, stderr: &mut dyn 
              statistic {:.4}, dof {}, p-value {:.6e}, pooled cells {}\n\
              expected mass {:.12} (cubature error bound {:.2e} counts)\n\
              sampling+binning {:.3e} samples/s ({:.3} s), expected-count integration {:.3} s\n\
-             verdict {} at α = {:e}{}\n\
+             verdict {} at α = {:e}{}\n{}\
              reproduce: mfh chi2 --model '{spec_text}' --samples {} --resolution {} --seed {}",
             2 * r.resolution,
             r.resolution,
@@ -137,6 +147,10 @@ pub fn run_chi2(options: &Chi2Options, stdout: &mut dyn Write, stderr: &mut dyn 
             },
             r.alpha,
             reason.map(|r| format!(": {r}")).unwrap_or_default(),
+            artefacts
+                .iter()
+                .map(|a| format!("wrote {a}\n"))
+                .collect::<String>(),
             r.samples,
             r.resolution,
             r.seed,
@@ -159,9 +173,10 @@ fn finite_or_null(x: f64) -> Value {
     }
 }
 
-/// Writes the observed and expected counts as JSON tables (rows of cos θ, row 0 at the
-/// horizon; columns of φ from 0).
-pub fn write_tables(dir: &Path, result: &Chi2Result) -> std::io::Result<()> {
+/// Writes the observed and expected counts as JSON tables `chi2_observed.json` and
+/// `chi2_expected.json` (rows of cos θ, row 0 at the horizon; columns of φ from 0); returns the
+/// paths written.
+pub fn write_tables(dir: &Path, result: &Chi2Result) -> std::io::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir)?;
     let columns = 2 * result.resolution;
     let layout = format!(
@@ -186,5 +201,101 @@ pub fn write_tables(dir: &Path, result: &Chi2Result) -> std::io::Result<()> {
         });
         std::fs::write(dir.join(name), format!("{value:#}\n"))?;
     }
-    Ok(())
+    Ok(vec![
+        dir.join("chi2_observed.json"),
+        dir.join("chi2_expected.json"),
+    ])
+}
+
+/// The heat maps of a result, written as PNG into `dir`: observed counts and expected counts on
+/// one shared linear scale (0 to the largest count of either), and the signed difference
+/// (O − E)/√E on a diverging scale (blue below, red above, ±max(4, largest |residual|); grey
+/// where E = O = 0, magenta where samples fell in a cell of zero expected count). Grid rows are
+/// cos θ from the horizon (bottom) to the pole (top), columns φ from 0 (left) to 2π (right),
+/// each cell [`crate::heatmap::cell_pixels`] pixels square. Returns the paths written.
+pub fn write_heat_maps(
+    dir: &Path,
+    result: &Chi2Result,
+) -> Result<Vec<PathBuf>, crate::heatmap::HeatMapError> {
+    use crate::heatmap::{write_png, HeatMap, Scale};
+    std::fs::create_dir_all(dir)?;
+    let (rows, columns) = (result.resolution, 2 * result.resolution);
+    let observed: Vec<f64> = result.observed.iter().map(|&o| o as f64).collect();
+    let max = observed
+        .iter()
+        .chain(&result.expected)
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, f64::max);
+    let difference: Vec<f64> = observed
+        .iter()
+        .zip(&result.expected)
+        .map(|(&o, &e)| match (o, e) {
+            (o, e) if e > 0.0 => (o - e) / e.sqrt(),
+            (o, _) if o > 0.0 => f64::INFINITY,
+            _ => f64::NAN,
+        })
+        .collect();
+    let limit = difference
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(4.0f64, |a, v| a.max(v.abs()));
+    let layout = format!(
+        "{rows} cos θ rows (horizon at the bottom, pole at the top) × {columns} φ columns \
+         (φ = 0 at the left); {} samples, seed {}",
+        result.samples, result.seed
+    );
+    let maps = [
+        (
+            "chi2_observed.png",
+            &observed,
+            Scale::Sequential { max },
+            format!(
+                "observed counts, linear scale 0 (dark violet) to {max:.6e} (yellow); {layout}"
+            ),
+        ),
+        (
+            "chi2_expected.png",
+            &result.expected,
+            Scale::Sequential { max },
+            format!(
+                "expected counts, linear scale 0 (dark violet) to {max:.6e} (yellow); {layout}"
+            ),
+        ),
+        (
+            "chi2_difference.png",
+            &difference,
+            Scale::Diverging { limit },
+            format!(
+                "(observed − expected)/√expected, linear scale −{limit:.3} (blue) to +{limit:.3} \
+                 (red), 0 white; grey: no samples and none expected; magenta: samples where \
+                 none are expected; {layout}"
+            ),
+        ),
+    ];
+    let mut paths = Vec::new();
+    for (name, values, scale, description) in maps {
+        let path = dir.join(name);
+        let map = HeatMap {
+            rows,
+            columns,
+            values,
+            scale,
+        };
+        write_png(&path, &map, &description)?;
+        paths.push(path);
+    }
+    Ok(paths)
+}
+
+/// Writes the tables ([`write_tables`]) and the heat maps ([`write_heat_maps`]) into `dir`;
+/// returns the paths written.
+pub fn write_artefacts(
+    dir: &Path,
+    result: &Chi2Result,
+) -> Result<Vec<PathBuf>, crate::heatmap::HeatMapError> {
+    let mut paths = write_tables(dir, result)?;
+    paths.extend(write_heat_maps(dir, result)?);
+    Ok(paths)
 }

@@ -85,7 +85,8 @@ pub enum Command {
         /// Print one JSON object.
         #[arg(long)]
         json: bool,
-        /// Write observed and expected count tables (JSON) into this folder.
+        /// Write observed and expected count tables (JSON) and heat maps of observed, expected
+        /// and (O − E)/√E (PNG) into this folder.
         #[arg(long)]
         out: Option<PathBuf>,
     },
@@ -338,6 +339,30 @@ mod tests {
         assert_eq!(table["counts"].as_array().unwrap().len(), 8);
         assert_eq!(table["counts"][0].as_array().unwrap().len(), 16);
         assert!(dir.join("chi2_expected.json").exists());
+        // The heat maps: valid PNGs of 16 φ × 8 cos θ cells, 16 px each (256 × 128), listed.
+        let listed: Vec<&str> = v["artefacts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|a| a.as_str())
+            .collect();
+        assert_eq!(listed.len(), 5, "{listed:?}");
+        for name in [
+            "chi2_observed.png",
+            "chi2_expected.png",
+            "chi2_difference.png",
+        ] {
+            let path = dir.join(name);
+            assert!(listed.contains(&path.to_str().unwrap()), "{listed:?}");
+            let bytes = std::fs::read(&path).unwrap();
+            assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{name}");
+            let reader = png::Decoder::new(std::io::Cursor::new(bytes))
+                .read_info()
+                .unwrap();
+            let info = reader.info();
+            assert_eq!((info.width, info.height), (256, 128), "{name}");
+            assert_eq!(info.color_type, png::ColorType::Rgb);
+        }
         let _ = std::fs::remove_dir_all(&dir);
     }
 

@@ -59,6 +59,22 @@ impl Profile {
         }
     }
 
+    /// Samples per Kolmogorov–Smirnov test of a marginal; a sampler of a family in
+    /// [`SLOW_SAMPLERS`] gets a tenth (the piecewise-linear inversion costs ~30 µs a sample,
+    /// a thousand times the closed-form samplers).
+    pub fn ks_samples(self, family: &str) -> u64 {
+        let n = match self {
+            Profile::Quick => 200_000,
+            Profile::Standard => 2_000_000,
+            Profile::Thorough => 10_000_000,
+        };
+        if SLOW_SAMPLERS.contains(&family) {
+            n / 10
+        } else {
+            n
+        }
+    }
+
     /// The name as on the command line.
     pub fn name(self) -> &'static str {
         match self {
@@ -68,6 +84,10 @@ impl Profile {
         }
     }
 }
+
+/// Families whose `sample_wm` inverts a CDF numerically (tens of µs a sample): statistical
+/// sampling checks that scale with the sample count take fewer samples of them.
+pub const SLOW_SAMPLERS: &[&str] = &["piecewise_linear"];
 
 /// What a running check may use: its seed and where to write artefacts.
 #[derive(Debug, Clone)]
@@ -378,9 +398,34 @@ mod tests {
             lambda_scale: 1.0,
             flip: true,
         });
-        let f = run(sampling::plan(flipped, Profile::Quick, "test"));
+        let out = std::env::temp_dir().join(format!("mfh-chi2-maps-{}", std::process::id()));
+        let ctx = RunContext {
+            seed: 7,
+            out: Some(out.clone()),
+        };
+        let f: Vec<_> = sampling::plan(flipped, Profile::Quick, "test")
+            .iter()
+            .map(|p| (p.run)(&ctx))
+            .collect();
         assert_eq!(failed(&f, "sampling.pdf_consistency"), 1);
         assert_eq!(failed(&f, "sampling.chi2"), 1);
+        // The failing chi-square wrote its tables and heat maps into out/chi2/<model+case>/.
+        let chi2 = f.iter().find(|r| r.check == "sampling.chi2").unwrap();
+        let maps: Vec<&String> = chi2
+            .artefacts
+            .iter()
+            .filter(|a| a.ends_with(".png"))
+            .collect();
+        assert_eq!(maps.len(), 3, "{:?}", chi2.artefacts);
+        let folder = out
+            .join("chi2")
+            .join("alpha_x_0.1_alpha_y_0.4_family_ggx_resolution_16_samples_200000");
+        for m in maps {
+            assert!(std::path::Path::new(m).starts_with(&folder), "{m}");
+            assert_eq!(&std::fs::read(m).unwrap()[..8], b"\x89PNG\r\n\x1a\n");
+        }
+        let _ = std::fs::remove_dir_all(&out);
+        assert_eq!(failed(&f, "sampling.ks_marginals"), 2);
         let l = run(plan_all(model(1.0, 1.001)));
         assert!(failed(&l, "smith.lambda_route") >= 4, "{l:?}");
         assert_eq!(failed(&l, "smith.white_furnace"), 2);

@@ -1,14 +1,18 @@
-//! Sampling: chi-square of `sample_wm` against `pdf_wm` over the hemisphere, `pdf_wm` against
-//! D(m)(m·n) at the sampled normals, and a Monte Carlo estimate of Λ through the sampler
+//! Sampling: chi-square of `sample_wm` against `pdf_wm` over the hemisphere, Kolmogorov–Smirnov
+//! tests of its cos θ and φ marginals (one record per marginal, each a statistical test of its
+//! own), `pdf_wm` against D(m)(m·n) at the sampled normals, and a Monte Carlo estimate of Λ through the sampler
 //! (E[⟨−w·m⟩⁺/(m·n)] = Λ(w) cos θ) against the closed form; for visible-normal samplers the
 //! chi-square of `sample_wm_visible` against `pdf_wm_visible` at fixed incidences and the
 //! normalization of `pdf_wm_visible`; for STD materials sampled by the pseudo-VNIS of seed 001
 //! §7.2, the bias of its estimator with the weight of eq 43 as printed and with the unbiased one.
 
-use super::{applied, compare, compare_exact, covers, timed, Planned, Profile};
+use super::{
+    applied, compare, compare_exact, covers, lobe_width, theta_kinks, timed, Planned, Profile,
+};
 use crate::oracle::chi2::{
     chi2_test_sampler, chi2_test_to, Chi2Config, KINKED_CELL_RELATIVE_TOLERANCE,
 };
+use crate::oracle::ks::{self, ks_test_sampler, KsConfig, LobeHints, Marginal};
 use crate::oracle::monte_carlo::{estimate, two_sided_p};
 use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
@@ -66,6 +70,15 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> 
                 })
             }),
         });
+    }
+    for marginal in [Marginal::CosTheta, Marginal::Phi] {
+        out.push(plan_ks(
+            model.clone(),
+            &spec,
+            marginal,
+            profile.ks_samples(family),
+            why,
+        ));
     }
     {
         let (m, spec_run) = (model.clone(), spec.clone());
@@ -187,7 +200,8 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> 
 /// Fills a chi-square record from the test's result: a sanity failure (samples outside the
 /// domain, pdf mass off, samples in zero-pdf cells) fails outright; otherwise the p-value,
 /// provisionally judged at the unshared α (the audit re-decides with the Šidák level). Writes
-/// the observed and expected tables when the run has an output folder.
+/// the observed and expected tables (and, when it fails, the heat maps) when the run has an
+/// output folder.
 fn fill_chi2(
     r: &mut CheckRecord,
     result: &crate::oracle::chi2::Chi2Result,
@@ -197,10 +211,8 @@ fn fill_chi2(
     r.cost.samples = samples;
     r.tolerance = Some(applied(&STATISTICAL_ALPHA));
     if let Some(dir) = &ctx.out {
-        let sub = dir.join("chi2").join(format!("{:016x}", ctx.seed));
-        if crate::chi2_command::write_tables(&sub, result).is_ok() {
-            r.artefacts.push(sub.display().to_string());
-        }
+        let sub = dir.join("chi2").join(folder_name(&r.model, &r.case));
+        write_chi2_artefacts(r, &sub, result);
     }
     match &result.reason {
         Some(reason) if !matches!(reason, crate::oracle::chi2::Failure::Rejected { .. }) => {
@@ -625,6 +637,165 @@ fn pseudo_vnis_record(
     }
 }
 
+/// Plans the KS test of one marginal of a model's sampler: `sampling.ks_marginals`, case
+/// `{"marginal": "cos_theta" | "phi", "samples": N}`. The record's value is D_N; its case gains
+/// the table's knots and error bound, Stephens' λ and where D_N is attained. Sanity failures
+/// fail without a p-value; a CDF table too coarse for N is an error (no verdict).
+fn plan_ks(
+    model: Arc<dyn Model>,
+    spec: &Value,
+    marginal: Marginal,
+    samples: u64,
+    why: &str,
+) -> Planned {
+    let family = model.family();
+    let case = json!({"marginal": marginal.name(), "samples": samples});
+    let (spec_run, case_run) = (spec.clone(), case.clone());
+    let (width, kinks) = (lobe_width(spec), theta_kinks(spec));
+    Planned {
+        check: "sampling.ks_marginals".into(),
+        model: spec.clone(),
+        case,
+        why: format!(
+            "{why}: the {} marginal of the sampled normals must follow the pdf's",
+            marginal.name()
+        ),
+        covers: vec![covers(family, "sample_wm", "default")],
+        statistical: true,
+        run: Box::new(move |ctx| {
+            timed(|| {
+                let mut r = CheckRecord::new(
+                    "sampling.ks_marginals",
+                    spec_run.clone(),
+                    case_run.clone(),
+                    SOURCE,
+                );
+                r.covers = vec![covers(family, "sample_wm", "default")];
+                r.seed = Some(ctx.seed);
+                let Some(sampler) = model.as_sampler() else {
+                    r.verdict = Verdict::Error {
+                        message: "the model has no sampler".into(),
+                    };
+                    return r;
+                };
+                let hints = LobeHints {
+                    width,
+                    theta_kinks: &kinks,
+                };
+                let config = KsConfig {
+                    samples,
+                    seed: ctx.seed,
+                    alpha: STATISTICAL_ALPHA.value,
+                };
+                let result = ks_test_sampler(sampler, marginal, &hints, &config);
+                fill_ks(&mut r, &result);
+                r
+            })
+        }),
+    }
+}
+
+/// Fills a `sampling.ks_marginals` record from a KS result.
+fn fill_ks(r: &mut CheckRecord, result: &ks::KsResult) {
+    r.cost.samples = result.samples;
+    r.cost.evaluations = result.evaluations;
+    r.tolerance = Some(applied(&STATISTICAL_ALPHA));
+    if let Value::Object(case) = &mut r.case {
+        case.insert("knots".into(), json!(result.knots));
+        case.insert("table_error_bound".into(), json!(result.table_error_bound));
+    }
+    match &result.reason {
+        Some(ks::Failure::TableInaccurate { .. }) => {
+            r.verdict = Verdict::Error {
+                message: result
+                    .reason
+                    .as_ref()
+                    .map(ToString::to_string)
+                    .unwrap_or_default(),
+            };
+        }
+        Some(reason) if !matches!(reason, ks::Failure::Rejected { .. }) => {
+            r.verdict = Verdict::Fail;
+            if let Value::Object(case) = &mut r.case {
+                case.insert("sanity_failure".into(), json!(reason.to_string()));
+            }
+        }
+        _ => {
+            r.value = Some(result.statistic);
+            if let Value::Object(case) = &mut r.case {
+                case.insert("lambda".into(), json!(result.lambda));
+                case.insert("at".into(), json!(result.at));
+            }
+            r.measured = Some(Measured::PValue {
+                p: result.p_value,
+                statistic: result.statistic,
+                dof: 0,
+                alpha: STATISTICAL_ALPHA.value,
+            });
+            // Provisional: the audit re-decides with the Šidák level.
+            r.verdict = if result.p_value >= STATISTICAL_ALPHA.value {
+                Verdict::Pass
+            } else {
+                Verdict::Fail
+            };
+        }
+    }
+}
+
+/// A file-name-safe folder name for a model and case: their compact JSON with every run of
+/// characters outside `[A-Za-z0-9.-]` turned into one `_`; past 120 characters, the first 111
+/// and 8 hex digits of a hash (FNV-1a) of the whole, so that long names stay distinct.
+pub fn folder_name(model: &Value, case: &Value) -> String {
+    let text = format!("{model}_{case}");
+    let mut out = String::new();
+    for c in text.chars() {
+        if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
+            out.push(c);
+        } else if !out.ends_with('_') {
+            out.push('_');
+        }
+    }
+    let mut out = out.trim_matches('_').to_string();
+    if out.len() > 120 {
+        let hash = text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+        });
+        out = format!("{}_{:08x}", &out[..111], hash >> 32);
+    }
+    if out.is_empty() {
+        "case".to_string()
+    } else {
+        out
+    }
+}
+
+/// Writes a chi-square result's tables into `dir`, and its heat maps when it fails at the
+/// uncorrected level α (a superset of the audit's failures at the Šidák level, so every chi-square
+/// check the audit fails has its maps) or on a sanity failure; lists what was written in the
+/// record's artefacts. A write error is noted in the artefacts, not fatal.
+fn write_chi2_artefacts(
+    r: &mut CheckRecord,
+    dir: &std::path::Path,
+    result: &crate::oracle::chi2::Chi2Result,
+) {
+    let written = crate::chi2_command::write_tables(dir, result)
+        .map_err(crate::heatmap::HeatMapError::from)
+        .and_then(|mut paths| {
+            if result.verdict == crate::oracle::chi2::Verdict::Fail {
+                paths.extend(crate::chi2_command::write_heat_maps(dir, result)?);
+            }
+            Ok(paths)
+        });
+    match written {
+        Ok(paths) => r
+            .artefacts
+            .extend(paths.iter().map(|p| p.display().to_string())),
+        Err(e) => r
+            .artefacts
+            .push(format!("(could not write to {}: {e})", dir.display())),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -746,5 +917,27 @@ mod tests {
         let s = a.as_sampler().unwrap();
         let r = chi2_test(&|u| s.sample_wm(u), &|m| va.pdf_wm_visible(wi, m), &config);
         assert_eq!(r.verdict, crate::oracle::chi2::Verdict::Fail);
+    }
+
+    #[test]
+    fn folder_names_are_safe_and_distinct() {
+        let name = folder_name(
+            &json!({"family": "ggx", "alpha": 0.3}),
+            &json!({"samples": 10}),
+        );
+        assert_eq!(name, "alpha_0.3_family_ggx_samples_10");
+        let long = |v: f64| {
+            folder_name(
+                &json!({"family": "piecewise_linear", "x": {"theta": [0.0, 0.5, 1.0, 1.5],
+                        "value": [1.0, 0.6, 0.1, 0.0]}, "y": {"theta": [0.0, 0.3, 0.9, 1.5],
+                        "value": [2.0, 0.8, 0.05, v]}}),
+                &json!({"samples": 200000, "resolution": 16}),
+            )
+        };
+        let (a, b) = (long(0.0), long(1e-3));
+        assert!(a.len() == 120 && b.len() == 120 && a != b, "{a} {b}");
+        assert!(a
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "._-".contains(c)));
     }
 }

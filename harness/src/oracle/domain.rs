@@ -82,16 +82,7 @@ impl HemisphereGrid {
     /// The z-row of a unit direction in the upper hemisphere, or why it is not in the domain.
     #[inline]
     fn row_of(&self, m: Vec3) -> Result<usize, DomainError> {
-        if !(m[0].is_finite() && m[1].is_finite() && m[2].is_finite()) {
-            return Err(DomainError::NotFinite(m));
-        }
-        let len = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
-        if !((len - 1.0).abs() <= UNIT_TOLERANCE) {
-            return Err(DomainError::NotUnit(m, len));
-        }
-        if m[2] < 0.0 {
-            return Err(DomainError::BelowHorizon(m));
-        }
+        let len = validate(m)?;
         let z = m[2] / len;
         let rows = self.rows();
         // Through i64: the saturating f64 → usize cast costs ~20 instructions, → i64 ~5.
@@ -116,6 +107,23 @@ impl HemisphereGrid {
         let (s, c) = phi.sin_cos();
         [r * c, r * s, z]
     }
+}
+
+/// The length of `m` if it is a unit direction (within [`UNIT_TOLERANCE`]) in the closed upper
+/// hemisphere, else why it is not.
+#[inline]
+pub fn validate(m: Vec3) -> Result<f64, DomainError> {
+    if !(m[0].is_finite() && m[1].is_finite() && m[2].is_finite()) {
+        return Err(DomainError::NotFinite(m));
+    }
+    let len = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
+    if !((len - 1.0).abs() <= UNIT_TOLERANCE) {
+        return Err(DomainError::NotUnit(m, len));
+    }
+    if m[2] < 0.0 {
+        return Err(DomainError::BelowHorizon(m));
+    }
+    Ok(len)
 }
 
 /// Bins directions into the cells of a [`HemisphereGrid`] like [`HemisphereGrid::cell_of`],
