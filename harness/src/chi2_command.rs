@@ -2,7 +2,10 @@
 //! text or JSON output and optional observed/expected tables (JSON) and heat maps (PNG).
 
 use crate::cli::EXIT_BAD_INPUT;
-use crate::oracle::chi2::{chi2_test_sampler, Chi2Config, Chi2Result, Verdict, DEFAULT_SEED};
+use crate::oracle::chi2::{
+    chi2_test_sampler, chi2_test_to, Chi2Config, Chi2Result, Verdict, DEFAULT_SEED,
+    KINKED_CELL_RELATIVE_TOLERANCE,
+};
 use mfh_reference::ModelSpec;
 use serde_json::{json, Value};
 use std::io::Write;
@@ -26,6 +29,22 @@ pub struct Chi2Options {
     /// Write `chi2_observed.json`, `chi2_expected.json` and the heat maps
     /// `chi2_observed.png`, `chi2_expected.png`, `chi2_difference.png` into this folder.
     pub out: Option<PathBuf>,
+    /// What to sample: normals (`sample_wm` against `pdf_wm`) or visible normals
+    /// (`sample_wm_visible` against `pdf_wm_visible` at the incidence).
+    pub sampling: SamplingKind,
+    /// The incidence θi (radians) for visible normals.
+    pub incidence: f64,
+    /// The incidence azimuth φi (radians) for visible normals.
+    pub azimuth: f64,
+}
+
+/// What `mfh chi2` samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SamplingKind {
+    /// `sample_wm` against `pdf_wm` = D(m)(m·n).
+    Normals,
+    /// `sample_wm_visible(wi, ·)` against `pdf_wm_visible(wi, ·)` at the incidence.
+    Visible,
 }
 
 /// Runs `mfh chi2`; returns the exit status (0 pass, 1 fail, 2 bad input).
@@ -42,7 +61,7 @@ pub fn run_chi2(options: &Chi2Options, stdout: &mut dyn Write, stderr: &mut dyn 
         Ok(model) => model,
         Err(e) => return bad(stderr, format!("invalid model parameters: {e}")),
     };
-    let Some(sampler) = model.as_sampler() else {
+    if options.sampling == SamplingKind::Normals && model.as_sampler().is_none() {
         return bad(
             stderr,
             format!(
@@ -50,7 +69,31 @@ pub fn run_chi2(options: &Chi2Options, stdout: &mut dyn Write, stderr: &mut dyn 
                 model.family()
             ),
         );
-    };
+    }
+    if options.sampling == SamplingKind::Visible {
+        if model.as_visible_sampler().is_none() {
+            return bad(
+                stderr,
+                format!(
+                    "family `{}` has no visible-normal sampler (sample_wm_visible); nothing to \
+                     test",
+                    model.family()
+                ),
+            );
+        }
+        let valid = options.incidence >= 0.0
+            && options.incidence < std::f64::consts::FRAC_PI_2
+            && options.azimuth.is_finite();
+        if !valid {
+            return bad(
+                stderr,
+                format!(
+                    "--incidence {} must be in [0, π/2) and --azimuth finite",
+                    options.incidence
+                ),
+            );
+        }
+    }
     if options.resolution == 0 || options.samples == 0 {
         return bad(stderr, "--samples and --resolution must be ≥ 1".to_string());
     }
@@ -76,7 +119,25 @@ pub fn run_chi2(options: &Chi2Options, stdout: &mut dyn Write, stderr: &mut dyn 
         seed,
         alpha: options.alpha,
     };
-    let result = chi2_test_sampler(sampler, &config);
+    let result = match (
+        options.sampling,
+        model.as_sampler(),
+        model.as_visible_sampler(),
+    ) {
+        (SamplingKind::Normals, Some(sampler), _) => chi2_test_sampler(sampler, &config),
+        (SamplingKind::Visible, _, Some(v)) => {
+            let wi = mfh_reference::geometry::from_spherical(options.incidence, options.azimuth);
+            // The visible density has a kink along the terminator of wi: cells that straddle
+            // it converge slowly, so they are integrated to 1e-6 (still ≪ √count).
+            chi2_test_to(
+                &|u| v.sample_wm_visible(wi, u),
+                &|m| v.pdf_wm_visible(wi, m),
+                &config,
+                KINKED_CELL_RELATIVE_TOLERANCE,
+            )
+        }
+        _ => return bad(stderr, "no sampler for this --sampling".to_string()),
+    };
     let mut artefacts = Vec::new();
     if let Some(dir) = &options.out {
         match write_artefacts(dir, &result) {
@@ -114,6 +175,12 @@ pub fn run_chi2(options: &Chi2Options, stdout: &mut dyn Write, stderr: &mut dyn 
             "sampling_seconds": result.sampling_seconds,
             "integration_seconds": result.integration_seconds,
             "artefacts": artefacts,
+            "sampling": if options.sampling == SamplingKind::Visible { "visible" } else { "normals" },
+            "incidence": if options.sampling == SamplingKind::Visible {
+                json!({"theta": options.incidence, "phi": options.azimuth})
+            } else {
+                Value::Null
+            },
         });
         writeln!(stdout, "{value}")
     } else {
@@ -126,7 +193,7 @@ pub fn run_chi2(options: &Chi2Options, stdout: &mut dyn Write, stderr: &mut dyn 
              expected mass {:.12} (cubature error bound {:.2e} counts)\n\
              sampling+binning {:.3e} samples/s ({:.3} s), expected-count integration {:.3} s\n\
              verdict {} at α = {:e}{}\n{}\
-             reproduce: mfh chi2 --model '{spec_text}' --samples {} --resolution {} --seed {}",
+             reproduce: mfh chi2 --model '{spec_text}' --samples {} --resolution {} --seed {}{}",
             2 * r.resolution,
             r.resolution,
             r.samples,
@@ -154,6 +221,14 @@ pub fn run_chi2(options: &Chi2Options, stdout: &mut dyn Write, stderr: &mut dyn 
             r.samples,
             r.resolution,
             r.seed,
+            if options.sampling == SamplingKind::Visible {
+                format!(
+                    " --sampling visible --incidence {} --azimuth {}",
+                    options.incidence, options.azimuth
+                )
+            } else {
+                String::new()
+            },
         )
     };
     if let Err(e) = written.and_then(|_| stdout.flush()) {

@@ -89,6 +89,16 @@ pub enum Command {
         /// and (O − E)/√E (PNG) into this folder.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// What to sample: normals (`sample_wm`) or visible normals (`sample_wm_visible` at
+        /// the incidence).
+        #[arg(long, value_enum, default_value = "normals")]
+        sampling: crate::chi2_command::SamplingKind,
+        /// The incidence θi in radians (visible normals).
+        #[arg(long, default_value_t = 0.5)]
+        incidence: f64,
+        /// The incidence azimuth φi in radians (visible normals).
+        #[arg(long, default_value_t = 0.0)]
+        azimuth: f64,
     },
 }
 
@@ -153,6 +163,9 @@ where
             alpha,
             json,
             out,
+            sampling,
+            incidence,
+            azimuth,
         } => crate::chi2_command::run_chi2(
             &crate::chi2_command::Chi2Options {
                 model,
@@ -162,6 +175,9 @@ where
                 alpha,
                 json,
                 out,
+                sampling,
+                incidence,
+                azimuth,
             },
             stdout,
             stderr,
@@ -298,6 +314,51 @@ mod tests {
             String::from_utf8(out).unwrap(),
             String::from_utf8(err).unwrap(),
         )
+    }
+
+    #[test]
+    fn chi2_cli_visible_normals_at_an_incidence() {
+        let (code, out, err) = run_args(&[
+            "chi2",
+            "--model",
+            r#"{"family":"beckmann","alpha_x":0.3,"alpha_y":0.15}"#,
+            "--sampling",
+            "visible",
+            "--incidence",
+            "1.2",
+            "--azimuth",
+            "0.3",
+            "--samples",
+            "200000",
+            "--resolution",
+            "8",
+            "--json",
+        ]);
+        assert_eq!(code, 0, "{out}{err}");
+        let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+        assert_eq!(v["verdict"], "pass");
+        assert_eq!(v["sampling"], "visible");
+        assert_eq!(v["incidence"]["theta"], 1.2);
+        // A model without a visible sampler, and an incidence below the horizon: bad input.
+        for args in [
+            vec![
+                "chi2",
+                "--model",
+                r#"{"family":"std","gamma":3,"alpha":0.3}"#,
+            ],
+            vec![
+                "chi2",
+                "--model",
+                r#"{"family":"ggx","alpha":0.3}"#,
+                "--incidence",
+                "2",
+            ],
+        ] {
+            let mut args = args;
+            args.extend(["--sampling", "visible"]);
+            let (code, _, err) = run_args(&args);
+            assert_eq!(code, 2, "{err}");
+        }
     }
 
     #[test]
