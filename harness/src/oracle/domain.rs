@@ -144,6 +144,15 @@ pub struct CellFinder {
     boundaries: Vec<[f64; 2]>,
     /// 2R / 2π.
     columns_per_radian: f64,
+    /// The squared lengths |m|² (summed as in [`validate`]) that [`validate`] accepts: the
+    /// closed interval `[squared_length[0], squared_length[1]]` (√ is monotone), so the
+    /// unit-length check needs no square root.
+    squared_length: [f64; 2],
+    /// R as f64.
+    rows: f64,
+    /// How far z·R may be from an integer for ⌊z·R⌋ to be the row of `validate`'s z / |m|
+    /// (|z / |m| − z| ≤ 1.000004e-6 within the unit tolerance, times R, plus rounding).
+    row_margin: f64,
 }
 
 impl CellFinder {
@@ -156,10 +165,14 @@ impl CellFinder {
                 [c, s]
             })
             .collect();
+        let rows = grid.rows() as f64;
         Self {
             grid,
             boundaries,
             columns_per_radian: columns as f64 / TAU,
+            squared_length: accepted_squared_lengths(),
+            rows,
+            row_margin: rows * 2e-6 + 1e-9,
         }
     }
 
@@ -170,14 +183,44 @@ impl CellFinder {
 
     /// The cell index of a direction, or why it is not in the domain: the same answer as
     /// [`HemisphereGrid::cell_of`] (up to directions within ~1e-16 rad of a column boundary).
-    #[inline]
+    #[inline(always)]
     pub fn cell_of(&self, m: Vec3) -> Result<usize, DomainError> {
-        let row = self.grid.row_of(m)?;
+        // The same decisions as `validate` (`squared_length` is its accepted interval of |m|²;
+        // a non-finite component makes |m|² NaN or ∞, outside it), without its square root;
+        // a rejected direction goes through `validate` for the same error.
+        let squared = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+        let [low, high] = self.squared_length;
+        if !(squared >= low && squared <= high && m[2] >= 0.0) {
+            return Err(self.rejection(m));
+        }
+        // ⌊z·R⌋ is ⌊(z / |m|)·R⌋ unless z·R is within `row_margin` of an integer: only then is
+        // the row taken, as by `HemisphereGrid::row_of`, from z / |m|.
+        let t = m[2] * self.rows;
+        let floor = t as i64;
+        let fraction = t - floor as f64;
+        let row = if fraction > self.row_margin && fraction < 1.0 - self.row_margin {
+            (floor as usize).min(self.grid.rows() - 1)
+        } else {
+            self.grid.row_of(m)?
+        };
         Ok(row * self.grid.columns() + self.column(m[0], m[1]))
     }
 
+    /// Why `m`, rejected by the squared-length test, is outside the domain.
+    #[cold]
+    #[inline(never)]
+    fn rejection(&self, m: Vec3) -> DomainError {
+        match validate(m) {
+            Err(error) => error,
+            Ok(len) => unreachable!(
+                "{m:?} (length {len}) passes validate but not |m|² ∈ {:?}",
+                self.squared_length
+            ),
+        }
+    }
+
     /// The column of azimuth atan2(y, x) ∈ [0, 2π).
-    #[inline]
+    #[inline(always)]
     fn column(&self, x: f64, y: f64) -> usize {
         if x == 0.0 && y == 0.0 {
             return 0;
@@ -192,6 +235,13 @@ impl CellFinder {
             let cross = c * y - s * x;
             cross > 0.0 || (cross == 0.0 && c * x + s * y > 0.0)
         };
+        // The first step of the two searches below, without a branch (the estimate is off by
+        // a column in a few % of directions, an unpredictable branch): one step down if not
+        // past j, else one step up if past j + 1 (`boundaries` has 2R + 1 entries). The
+        // searches then go on from there, evaluating the same tests in the same order.
+        let down = j > 0 && !past(j);
+        let up = !down && j + 1 < columns && past(j + 1);
+        j = j - usize::from(down) + usize::from(up);
         while j > 0 && !past(j) {
             j -= 1;
         }
@@ -200,6 +250,35 @@ impl CellFinder {
         }
         j
     }
+}
+
+/// The interval `[low, high]` of squared lengths x² + y² + z² whose square root `validate`
+/// accepts (|√· − 1| ≤ [`UNIT_TOLERANCE`]), found by bisection over the bit patterns of positive
+/// doubles (ordered like their values).
+fn accepted_squared_lengths() -> [f64; 2] {
+    let accepted = |bits: u64| (f64::from_bits(bits).sqrt() - 1.0).abs() <= UNIT_TOLERANCE;
+    // The last accepted pattern in (accepted `a`, rejected `r`) and the first, searching
+    // between a rejected `r` below and an accepted `a` above.
+    let (mut a, mut r) = (1.0f64.to_bits(), 2.0f64.to_bits());
+    while r - a > 1 {
+        let mid = a + (r - a) / 2;
+        if accepted(mid) {
+            a = mid;
+        } else {
+            r = mid;
+        }
+    }
+    let high = f64::from_bits(a);
+    let (mut r, mut a) = (0.5f64.to_bits(), 1.0f64.to_bits());
+    while a - r > 1 {
+        let mid = r + (a - r) / 2;
+        if accepted(mid) {
+            a = mid;
+        } else {
+            r = mid;
+        }
+    }
+    [f64::from_bits(a), high]
 }
 
 /// atan2(y, x) in [0, 2π) to within 0.0015 rad, (x, y) ≠ (0, 0): atan q ≈ πq/4 − q(q − 1)
@@ -284,6 +363,185 @@ mod tests {
                 Err(DomainError::BelowHorizon(_))
             ));
         }
+    }
+
+    /// The cell of `m` as `CellFinder::cell_of` found it before the square-root-free
+    /// validation, the row from z·R and the branch-free first step (validate, row from
+    /// z / |m|, then the two searches from the estimate).
+    fn previous_cell_of(finder: &CellFinder, m: Vec3) -> Result<usize, DomainError> {
+        let row = finder.grid.row_of(m)?;
+        let (x, y) = (m[0], m[1]);
+        let columns = finder.grid.columns();
+        if x == 0.0 && y == 0.0 {
+            return Ok(row * columns);
+        }
+        let mut j = ((approximate_azimuth(x, y) * finder.columns_per_radian) as i64 as usize)
+            .min(columns - 1);
+        let past = |j: usize| {
+            let [c, s] = finder.boundaries[j];
+            let cross = c * y - s * x;
+            cross > 0.0 || (cross == 0.0 && c * x + s * y > 0.0)
+        };
+        while j > 0 && !past(j) {
+            j -= 1;
+        }
+        while j + 1 < columns && past(j + 1) {
+            j += 1;
+        }
+        Ok(row * columns + j)
+    }
+
+    /// The double `steps` doubles above (below, if negative) the finite `v`.
+    fn nudge(mut v: f64, steps: i64) -> f64 {
+        for _ in 0..steps.unsigned_abs() {
+            v = if steps > 0 {
+                v.next_up()
+            } else {
+                v.next_down()
+            };
+        }
+        v
+    }
+
+    #[test]
+    fn cell_finder_matches_previous_finder_and_atan2_on_adversarial_directions() {
+        let mut state: u64 = 11;
+        let mut uniform = || {
+            state = crate::oracle::chi2::splitmix64(state);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        // Debug text: errors carrying NaN compare unequal with ==.
+        let same = |a: &Result<usize, DomainError>, b: &Result<usize, DomainError>| {
+            format!("{a:?}") == format!("{b:?}")
+        };
+        let mut rejected = 0usize;
+        for resolution in [1, 2, 3, 4, 7, 64, 1000, 300_000] {
+            let grid = HemisphereGrid::new(resolution).unwrap();
+            let finder = CellFinder::new(grid);
+            let mut directions: Vec<Vec3> = Vec::new();
+            for _ in 0..20_000 {
+                directions.push(HemisphereGrid::direction(uniform() * TAU, uniform()));
+            }
+            // Column boundaries (the tabulated b_j and the atan2 image of j·2π/2R), and the
+            // doubles next to them, at several heights.
+            let columns = grid.columns();
+            for j in 0..=columns.min(4096) {
+                let [c, s] = finder.boundaries[j];
+                let phi = j as f64 * TAU / columns as f64;
+                for z in [0.0f64, 0.3, 1.0 / 3.0, 0.999_999_9] {
+                    let r = (1.0 - z * z).sqrt();
+                    for (x, y) in [(r * c, r * s), (r * phi.cos(), r * phi.sin())] {
+                        for (dx, dy) in [(0, 0), (1, 0), (-1, 0), (0, 1), (0, -1), (2, -2)] {
+                            directions.push([nudge(x, dx), nudge(y, dy), z]);
+                        }
+                    }
+                }
+            }
+            // φ near 0 and 2π, the axes, the pole and its neighbourhood, the horizon.
+            for tiny in [1e-300, 1e-200, 1e-17, 1e-16, 1e-12, 5e-324] {
+                for (x, y) in [(1.0, tiny), (1.0, -tiny), (-1.0, tiny), (-1.0, -tiny)] {
+                    directions.push([x, y, 0.0]);
+                    directions.push([y, x, 0.0]);
+                }
+                for (x, y) in [(tiny, 0.0), (0.0, tiny), (-tiny, tiny), (-tiny, -tiny)] {
+                    directions.push([x, y, 1.0]);
+                }
+            }
+            for m in [
+                [0.0, 0.0, 1.0],
+                [-0.0, -0.0, 1.0],
+                [1.0, 0.0, -0.0],
+                [0.0, -1.0, 0.0],
+                [-1.0, -0.0, 0.0],
+                [0.6, -0.8, 0.0],
+                [0.6, 0.8, -1e-300],
+            ] {
+                directions.push(m);
+            }
+            // Row boundaries z = k/R and the doubles next to them.
+            for k in 0..=resolution.min(4096) {
+                let z0 = k as f64 / resolution as f64;
+                for dz in [0, 1, -1, 3, -3] {
+                    let z = if z0 == 0.0 {
+                        nudge(z0, dz.max(0))
+                    } else {
+                        nudge(z0, dz)
+                    };
+                    let r = (1.0 - z * z).max(0.0).sqrt();
+                    let phi = uniform() * TAU;
+                    directions.push([r * phi.cos(), r * phi.sin(), z]);
+                }
+            }
+            // Lengths around the unit tolerance: scaled directions, the scale next to the
+            // accepted limits of |m|².
+            let [low, high] = finder.squared_length;
+            for _ in 0..2000 {
+                let m = HemisphereGrid::direction(uniform() * TAU, uniform());
+                let limit = if uniform() < 0.5 { low } else { high };
+                for scale in [
+                    limit.sqrt(),
+                    1.0 + (uniform() - 0.5) * 4e-6,
+                    1.0 + 1e-6,
+                    1.0 - 1e-6,
+                ] {
+                    for ds in -3..=3 {
+                        let s = nudge(scale, ds);
+                        directions.push([m[0] * s, m[1] * s, m[2] * s]);
+                    }
+                }
+            }
+            for ds in -3..=3 {
+                for limit in [low, high] {
+                    let z = nudge(limit.sqrt(), ds);
+                    directions.push([0.0, 0.0, z]);
+                    directions.push([z, 0.0, 0.0]);
+                }
+            }
+            // Outside the domain.
+            for m in [
+                [f64::NAN, 0.0, 1.0],
+                [0.0, f64::INFINITY, 0.0],
+                [0.0, 0.0, f64::NEG_INFINITY],
+                [1e200, 1e200, 1e200],
+                [0.0, 0.6, -0.8],
+                [0.0, 0.0, 1.1],
+                [0.0, 0.0, -1.0 - 1e-7],
+                [0.0, 0.0, 0.0],
+            ] {
+                directions.push(m);
+            }
+            for m in directions {
+                let new = finder.cell_of(m);
+                assert!(
+                    same(&new, &previous_cell_of(&finder, m)),
+                    "R = {resolution}, {m:?}"
+                );
+                let atan2 = grid.cell_of(m);
+                match (new, atan2) {
+                    (Ok(a), Ok(b)) => {
+                        // Same row; the column within one of atan2's (on a boundary, to
+                        // ~1e-16 rad, either side), and equal off the boundaries.
+                        assert_eq!(a / columns, b / columns, "R = {resolution}, {m:?}");
+                        let (ca, cb) = (a % columns, b % columns);
+                        // (At the pole with a signed zero, atan2(−0, −0) = −π: column R, not 0;
+                        // within ~1e-300 of the pole, the side tests b_j × (x, y) underflow to
+                        // 0 and the finder's column is not atan2's, as before.)
+                        let pole = m[0].hypot(m[1]) < 1e-290;
+                        assert!(
+                            pole || ca == cb
+                                || (ca + 1) % columns == cb
+                                || (cb + 1) % columns == ca,
+                            "R = {resolution}, {m:?}: {ca} vs {cb}"
+                        );
+                    }
+                    (a, b) => {
+                        rejected += 1;
+                        assert!(same(&a, &b), "R = {resolution}, {m:?}");
+                    }
+                }
+            }
+        }
+        assert!(rejected > 1000, "{rejected}");
     }
 
     #[test]
