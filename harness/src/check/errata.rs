@@ -428,17 +428,7 @@ fn e001_3() -> Result<Shown, String> {
 fn e001_4() -> Result<Shown, String> {
     let (g, sigma, mu) = (3.0f64, 0.3f64, 0.4f64);
     let t0 = mu / ((g - 1.0).sqrt() * sigma);
-    let n = g as u64 - 2;
-    let sum = |s: f64| -> f64 {
-        let mut b = 1.0;
-        let mut total = 0.0;
-        for k in 0..=n {
-            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
-            total += b * sign / (2 * k + 1) as f64 * (1.0 - s.powi(2 * k as i32 + 1));
-            b = b * (n - k) as f64 / (k + 1) as f64;
-        }
-        total
-    };
+    let sum = |s: f64| mfh_reference::ndf::student_lambda::alternating_tail_sum(g as u64 - 2, s);
     Ok(Shown::new(
         sum(mu / (sigma * (g - 1.0).sqrt() + mu * mu / (sigma * sigma))),
         sum(mu / (sigma * ((g - 1.0) + mu * mu / (sigma * sigma)).sqrt())),

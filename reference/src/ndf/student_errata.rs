@@ -3,6 +3,7 @@
 //! independent integral, and asserts that the printed one fails and the corrected one holds.
 //! The errata of evaluated routes are demonstrated beside them (ERRATA.md names every test).
 
+use crate::ndf::student_lambda::alternating_tail_sum;
 use crate::special::gamma_ratio::gamma_half_ratio;
 use crate::special::hyp2f1::{hyp2f1_lambda, student_norm};
 use crate::test_support::{integrate, integrate_tail, rel_err};
@@ -53,17 +54,7 @@ fn eq28_last_line_misplaces_the_square_root() {
     for &(g, sigma, mu) in &[(3.0f64, 0.3f64, 0.4f64), (5.0, 0.6, 0.5)] {
         let t0 = mu / ((g - 1.0).sqrt() * sigma);
         let truth = tail_integral(g, t0);
-        let n = g as u64 - 2;
-        let sum = |s: f64| -> f64 {
-            let mut b = 1.0;
-            let mut acc = 0.0;
-            for k in 0..=n {
-                let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
-                acc += b * sign / (2 * k + 1) as f64 * (1.0 - s.powi(2 * k as i32 + 1));
-                b = b * (n - k) as f64 / (k + 1) as f64;
-            }
-            acc
-        };
+        let sum = |s: f64| alternating_tail_sum(g as u64 - 2, s);
         let printed = sum(mu / (sigma * (g - 1.0).sqrt() + mu * mu / (sigma * sigma)));
         let corrected = sum(mu / (sigma * ((g - 1.0) + mu * mu / (sigma * sigma)).sqrt()));
         assert!(

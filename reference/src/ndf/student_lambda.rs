@@ -205,6 +205,20 @@ fn binomials(n: u64) -> impl Iterator<Item = f64> {
     })
 }
 
+/// Seed 001 eq 28 (and A2 of eq 30): Σ_{k=0}^{n} C(n, k) (−1)^k/(2k+1) (1 − s^{2k+1}), which
+/// equals ∫_{t0}^∞ (1 + t²)^{½−γ} dt for integer γ = n + 2 when s = t0/√(1 + t0²) = sin(arctan t0)
+/// (the last line of eq 28 prints a different s: ERRATA.md 001-4). An alternating sum: it
+/// cancels for large n.
+pub fn alternating_tail_sum(n: u64, s: f64) -> f64 {
+    binomials(n)
+        .enumerate()
+        .map(|(k, b)| {
+            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+            b * sign / (2 * k + 1) as f64 * (1.0 - s.powi(2 * k as i32 + 1))
+        })
+        .sum()
+}
+
 /// Seed 001 eq 29–30, integer γ ≥ 2, as printed (they are correct):
 ///
 /// ```text
@@ -222,14 +236,7 @@ pub fn lambda_integer(c: f64, x: f64) -> f64 {
     }
     let n = c as u64;
     let a1 = (1..n).fold(1.0, |acc, j| acc * (2 * j - 1) as f64 / (2 * j) as f64);
-    let s = x / (1.0 + x * x).sqrt();
-    let a2: f64 = binomials(n - 2)
-        .enumerate()
-        .map(|(k, b)| {
-            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
-            b * sign / (2 * k + 1) as f64 * (1.0 - s.powi(2 * k as i32 + 1))
-        })
-        .sum();
+    let a2 = alternating_tail_sum(n - 2, x / (1.0 + x * x).sqrt());
     let first = ((1.5 - c) * (x * x).ln_1p()).exp() / (x * (2.0 * c - 3.0));
     (c - 1.0) * a1 * (first - a2)
 }
