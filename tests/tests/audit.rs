@@ -247,21 +247,8 @@ fn the_default_plan_covers_every_closed_form() {
         .filter(|id| !covered.contains(id.as_str()))
         .collect();
     assert!(missing.is_empty(), "not covered by any check: {missing:?}");
-    // The default scene holds every family of DESIGN.md.
-    for f in [
-        "beckmann",
-        "ggx",
-        "std",
-        "hyper_cauchy",
-        "student_fixed_variance",
-        "student_general",
-        "gtr",
-        "piecewise_linear",
-        "blend",
-        "gaussian_slopes",
-    ] {
-        assert!(families.contains(f), "the default scene lacks {f}");
-    }
+    // That the default scene holds every family is `scene::tests`'s check.
+    assert!(families.len() >= 10, "{families:?}");
 }
 
 /// `mfh plan` prints one JSON line per check with the reason it is planned.

@@ -24,6 +24,7 @@ use mfh_reference::ndf::gtr::Gtr;
 use mfh_reference::ndf::piecewise::{PiecewiseLinear, Profile};
 use mfh_reference::ndf::piecewise_lambda::{domain_split, Remaining};
 use mfh_reference::ndf::student::{Member, Student};
+use mfh_reference::ndf::student_lambda::{alternating_tail_sum, eq33_prefactor};
 use mfh_reference::sg::asg::Asg;
 use mfh_reference::sg::circular::{fiber_direction, CircularGaussian};
 use mfh_reference::sg::sg::{f_h, Sg};
@@ -428,7 +429,7 @@ fn e001_3() -> Result<Shown, String> {
 fn e001_4() -> Result<Shown, String> {
     let (g, sigma, mu) = (3.0f64, 0.3f64, 0.4f64);
     let t0 = mu / ((g - 1.0).sqrt() * sigma);
-    let sum = |s: f64| mfh_reference::ndf::student_lambda::alternating_tail_sum(g as u64 - 2, s);
+    let sum = |s: f64| alternating_tail_sum(g as u64 - 2, s);
     Ok(Shown::new(
         sum(mu / (sigma * (g - 1.0).sqrt() + mu * mu / (sigma * sigma))),
         sum(mu / (sigma * ((g - 1.0) + mu * mu / (sigma * sigma)).sqrt())),
@@ -457,23 +458,14 @@ fn e001_5() -> Result<Shown, String> {
 /// against 2(γ−1)^γσ^{2γ−2}/(πμ) Σ C(n,k)(−1)^k/(2k+1).
 fn e001_6() -> Result<Shown, String> {
     let (g, sigma, mu) = (2.5f64, 0.3f64, 0.4f64);
-    let n = (g - 1.5) as u64;
     let k2 = (g - 1.0) * sigma * sigma;
     let t0 = mu / k2.sqrt();
-    let mut b = 1.0;
-    let (mut plain, mut weighted) = (0.0, 0.0);
-    for k in 0..=n {
-        let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
-        plain += b * sign;
-        weighted += b * sign / (2 * k + 1) as f64;
-        b = b * (n - k) as f64 / (k + 1) as f64;
-    }
     let tail = tail_oracle(g, t0).value;
     let bracket = (k2 + mu * mu).powf(1.5 - g) / (2.0 * g - 3.0) - mu / k2.powf(g - 1.0) * tail;
-    let base = 2.0 * (g - 1.0).powf(g) * sigma.powf(2.0 * g - 2.0) / PI;
+    let prefactor = |printed| eq33_prefactor(g, sigma, mu, printed);
     Ok(Shown::new(
-        base / (k2 + mu * mu).powf(g - 0.5) * plain * bracket,
-        base / mu * weighted * bracket,
+        prefactor(true) * bracket,
+        prefactor(false) * bracket,
         std_lambda_oracle(g, sigma, mu),
         &ERRATUM,
     ))

@@ -3,7 +3,7 @@
 //! independent integral, and asserts that the printed one fails and the corrected one holds.
 //! The errata of evaluated routes are demonstrated beside them (ERRATA.md names every test).
 
-use crate::ndf::student_lambda::alternating_tail_sum;
+use crate::ndf::student_lambda::{alternating_tail_sum, eq33_prefactor};
 use crate::special::gamma_ratio::gamma_half_ratio;
 use crate::special::hyp2f1::{hyp2f1_lambda, student_norm};
 use crate::test_support::{integrate, integrate_tail, rel_err};
@@ -74,22 +74,12 @@ fn eq33_prefactor_keeps_q_and_drops_one_over_mu_and_one_over_2k_plus_1() {
     // with a free q. The right prefactor is 2(γ−1)^γ σ^{2γ−2}/(π μ) Σ C(n,k)(−1)^k/(2k+1)
     // (eq 31's constant, the 1/μ of eq 17). Binding q := μ, the printed form is far off.
     for &(g, sigma, mu) in &[(2.5f64, 0.3f64, 0.4f64), (3.5, 0.5, 0.6)] {
-        let n = (g - 1.5) as u64;
         let k2 = (g - 1.0) * sigma * sigma;
         let t0 = mu / k2.sqrt();
-        let mut b = 1.0;
-        let (mut plain, mut weighted) = (0.0, 0.0);
-        for k in 0..=n {
-            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
-            plain += b * sign;
-            weighted += b * sign / (2 * k + 1) as f64;
-            b = b * (n - k) as f64 / (k + 1) as f64;
-        }
         let bracket = (k2 + mu * mu).powf(1.5 - g) / (2.0 * g - 3.0)
             - mu / k2.powf(g - 1.0) * tail_integral(g, t0);
-        let base = 2.0 * (g - 1.0).powf(g) * sigma.powf(2.0 * g - 2.0) / PI;
-        let printed = base / (k2 + mu * mu).powf(g - 0.5) * plain * bracket;
-        let corrected = base / mu * weighted * bracket;
+        let printed = eq33_prefactor(g, sigma, mu, true) * bracket;
+        let corrected = eq33_prefactor(g, sigma, mu, false) * bracket;
         let truth = lambda_definition(g, sigma, mu);
         assert!(
             rel_err(corrected, truth) < 1e-10,

@@ -219,6 +219,30 @@ pub fn alternating_tail_sum(n: u64, s: f64) -> f64 {
         .sum()
 }
 
+/// Seed 001 eq 33 (half-integer γ = n + 3/2): the prefactor of the bracket of eq 31, as
+/// printed and as corrected (ERRATA.md 001-6):
+///
+/// ```text
+/// printed:   2(γ−1)^γ σ^{2γ−2} / (π ((γ−1)σ² + q²)^{γ−½}) Σ_{k=0}^{n} C(n,k)(−1)^k   (q free; bound to μ)
+/// corrected: 2(γ−1)^γ σ^{2γ−2} / (π μ) Σ_{k=0}^{n} C(n,k)(−1)^k/(2k+1)
+/// ```
+///
+/// Λ = prefactor × ((γ−1)σ² + μ²)^{3/2−γ}/(2γ−3) − μ/((γ−1)σ²)^{γ−1} ∫_{t0}^∞ (1+t²)^{½−γ} dt).
+pub fn eq33_prefactor(gamma: f64, sigma: f64, mu: f64, printed: bool) -> f64 {
+    let n = (gamma - 1.5) as u64;
+    let base = 2.0 * (gamma - 1.0).powf(gamma) * sigma.powf(2.0 * gamma - 2.0) / PI;
+    if printed {
+        let plain: f64 = binomials(n)
+            .enumerate()
+            .map(|(k, b)| if k % 2 == 0 { b } else { -b })
+            .sum();
+        let k2 = (gamma - 1.0) * sigma * sigma;
+        base / (k2 + mu * mu).powf(gamma - 0.5) * plain
+    } else {
+        base / mu * alternating_tail_sum(n, 0.0)
+    }
+}
+
 /// Seed 001 eq 29–30, integer γ ≥ 2, as printed (they are correct):
 ///
 /// ```text
