@@ -2,7 +2,7 @@
 //! its statistical checks, and summarizes. This is also the public API a renderer's own tests
 //! call as a CI gate (`audit_scene(..)?.assert_pass()`).
 
-use crate::check::{Planned, Profile, RunContext};
+use crate::check::{PlannedCheck, Profile, RunContext};
 use crate::oracle::chi2::{sidak_alpha, splitmix64, DEFAULT_SEED};
 use crate::plan::plan;
 use crate::record::{CheckRecord, Measured, Verdict, SCHEMA_VERSION};
@@ -92,24 +92,128 @@ impl AuditReport {
         !self.records.iter().any(|r| r.verdict.is_failure())
     }
 
-    /// The CI gate: Ok when the audit passes, else an error listing the failures.
-    pub fn assert_pass(&self) -> Result<(), String> {
-        let failures: Vec<String> = self
+    /// The CI gate: Ok when the audit passes, else the table of failures ([`failure_table`]).
+    pub fn check_pass(&self) -> Result<(), String> {
+        if self.passed() {
+            Ok(())
+        } else {
+            Err(failure_table(self))
+        }
+    }
+
+    /// The CI gate for a test: panics with the table of failures (check, case, measured
+    /// against the oracle, tolerance and why, the seed and the command that reproduces the
+    /// run) unless the audit passes.
+    #[track_caller]
+    pub fn assert_pass(&self) {
+        if let Err(table) = self.check_pass() {
+            panic!("{table}");
+        }
+    }
+
+    /// The records of one check id.
+    pub fn records_of<'r>(&'r self, check: &'r str) -> impl Iterator<Item = &'r CheckRecord> {
+        self.records.iter().filter(move |r| r.check == check)
+    }
+
+    /// The ids of the checks with a failing record, sorted and unique.
+    pub fn failed_checks(&self) -> Vec<&str> {
+        let mut ids: Vec<&str> = self
             .records
             .iter()
             .filter(|r| r.verdict.is_failure())
-            .map(|r| format!("{} {} {}: {:?}", r.check, r.model, r.case, r.verdict))
+            .map(|r| r.check.as_str())
             .collect();
-        if failures.is_empty() {
-            Ok(())
-        } else {
-            Err(format!(
-                "{} check(s) failed (seed {}; reproduce: {}):\n{}",
-                failures.len(),
-                self.seed,
-                self.command,
-                failures.join("\n")
-            ))
+        ids.sort_unstable();
+        ids.dedup();
+        ids
+    }
+}
+
+/// A readable table of an audit's failures: per failing record its check, model and case, the
+/// value against the oracle, the measured error against the tolerance and why, and the verdict;
+/// then the seed and the command that reproduces the run.
+pub fn failure_table(report: &AuditReport) -> String {
+    use std::fmt::Write;
+    let failures: Vec<&CheckRecord> = report
+        .records
+        .iter()
+        .filter(|r| r.verdict.is_failure())
+        .collect();
+    let mut out = format!(
+        "mfh: {} of {} check record(s) failed ({}, profile {}, seed {})\n",
+        failures.len(),
+        report.records.len(),
+        report.scene,
+        report.profile.name(),
+        report.seed
+    );
+    for r in failures {
+        let _ = writeln!(out, "\n  ✗ {}  {}", r.check, r.model);
+        let _ = writeln!(out, "    case      {}", r.case);
+        if let (Some(v), Some(o)) = (r.value, r.oracle) {
+            let _ = writeln!(
+                out,
+                "    value     {v:e}   oracle {:e} (± {:e})",
+                o.value, o.uncertainty
+            );
+        }
+        match (r.measured, &r.tolerance) {
+            (Some(m), Some(t)) => {
+                let measured = match m {
+                    Measured::PValue { p, alpha, .. } => format!("p = {p:e} < α = {alpha:e}"),
+                    Measured::Rate { exponent, expected } => {
+                        format!("rate {exponent} (expected {expected})")
+                    }
+                    other => format!("error {:e}", other.error().unwrap_or(f64::NAN)),
+                };
+                let _ = writeln!(
+                    out,
+                    "    measured  {measured}   tolerance {} = {:e}: {}",
+                    t.name, t.value, t.reason
+                );
+            }
+            (Some(m), None) => {
+                let _ = writeln!(out, "    measured  {m:?}");
+            }
+            _ => {}
+        }
+        match &r.verdict {
+            Verdict::Error { message } => {
+                let _ = writeln!(out, "    error     {message}");
+            }
+            v => {
+                let _ = writeln!(out, "    verdict   {}", v.name());
+            }
+        }
+        if !r.source.is_empty() {
+            let _ = writeln!(out, "    source    {}", r.source);
+        }
+    }
+    let _ = write!(out, "\nreproduce: {}", report.command);
+    out
+}
+
+impl AuditReport {
+    /// Assembles a report from a run's records.
+    pub fn from_records(
+        scene: String,
+        options: &AuditOptions,
+        command: String,
+        records: Vec<CheckRecord>,
+        statistical: (usize, f64),
+        wall_seconds: f64,
+    ) -> Self {
+        let summary = summarize(&records, statistical, wall_seconds);
+        AuditReport {
+            schema_version: SCHEMA_VERSION,
+            mfh_version: env!("CARGO_PKG_VERSION"),
+            scene,
+            profile: options.profile,
+            seed: options.seed,
+            command,
+            summary,
+            records,
         }
     }
 }
@@ -123,7 +227,7 @@ fn fnv1a(text: &str) -> u64 {
 
 /// The seed of one planned check: the audit seed mixed with its id, model and case, so that
 /// neither plan order nor thread count changes any stream.
-pub fn check_seed(seed: u64, planned: &Planned) -> u64 {
+pub fn check_seed(seed: u64, planned: &PlannedCheck<'_>) -> u64 {
     splitmix64(
         seed ^ fnv1a(&format!(
             "{}|{}|{}",
@@ -135,7 +239,10 @@ pub fn check_seed(seed: u64, planned: &Planned) -> u64 {
 /// Runs a plan: every check in parallel (with `MFH_TRACE` set, each start and end is printed
 /// to standard error with its time), records in plan order, statistical verdicts at the
 /// Šidák-corrected level.
-pub fn run_plan(plan: &[Planned], options: &AuditOptions) -> (Vec<CheckRecord>, usize, f64) {
+pub fn run_plan(
+    plan: &[PlannedCheck<'_>],
+    options: &AuditOptions,
+) -> (Vec<CheckRecord>, usize, f64) {
     let trace = std::env::var_os("MFH_TRACE").is_some();
     let mut records: Vec<CheckRecord> = plan
         .par_iter()
@@ -156,7 +263,9 @@ pub fn run_plan(plan: &[Planned], options: &AuditOptions) -> (Vec<CheckRecord>, 
                         .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
                         .unwrap_or_default();
                     r.verdict = Verdict::Error {
-                        message: format!("the check panicked: {message}"),
+                        message: format!(
+                            "a panic inside the check or the model's methods: {message}"
+                        ),
                     };
                     r
                 });
@@ -271,15 +380,12 @@ pub fn audit_scene(scene: &Scene, scene_path: Option<&str>, options: &AuditOptio
     let t = Instant::now();
     let planned = plan(scene, options.profile);
     let (records, k, alpha) = run_plan(&planned, options);
-    let summary = summarize(&records, (k, alpha), t.elapsed().as_secs_f64());
-    AuditReport {
-        schema_version: SCHEMA_VERSION,
-        mfh_version: env!("CARGO_PKG_VERSION"),
-        scene: scene.name.clone(),
-        profile: options.profile,
-        seed: options.seed,
-        command: reproduce_command(scene_path, options),
-        summary,
+    AuditReport::from_records(
+        scene.name.clone(),
+        options,
+        reproduce_command(scene_path, options),
         records,
-    }
+        (k, alpha),
+        t.elapsed().as_secs_f64(),
+    )
 }

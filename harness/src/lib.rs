@@ -1,7 +1,8 @@
 //! mfh-harness: the verification harness for microfacet BSDF mathematics — evaluation of
 //! closed forms (`mfh eval`), and, as the project grows, oracles, checks, audits and reports.
 //!
-//! The binary `mfh` is a thin layer over [`cli::run`].
+//! The binary `mfh` is a thin layer over [`cli::run`]. A renderer's own tests use [`Audit`]
+//! on their models, which implement the traits of [`model`].
 
 pub mod audit;
 pub mod check;
@@ -9,10 +10,18 @@ pub mod chi2_command;
 pub mod cli;
 pub mod eval;
 pub mod eval_sg;
+pub mod gate;
 pub mod heatmap;
 pub mod oracle;
 pub mod plan;
 pub mod record;
 pub mod report;
 pub mod scene;
+pub mod subject;
 pub mod tolerance;
+
+pub use check::Profile;
+pub use gate::Audit;
+pub use mfh_reference::model;
+pub use scene::Sampling;
+pub use subject::Hints;

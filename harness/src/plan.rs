@@ -3,28 +3,64 @@
 
 use crate::check::{
     claims, ds, errata, limits, moments, normalization, precise, sampling, sg, smith, stability,
-    Planned, Profile,
+    Planned, PlannedCheck, Profile,
 };
 use crate::scene::{Sampling, Scene};
-use mfh_reference::Model;
+use crate::subject::Subject;
+use mfh_reference::registry;
+use mfh_reference::{Masking, Model};
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::sync::Arc;
 
-/// The source document (seed id) each family comes from.
-pub fn document_of(family: &str) -> &'static [&'static str] {
-    match family {
-        "beckmann"
-        | "ggx"
-        | "std"
-        | "hyper_cauchy"
-        | "student_fixed_variance"
-        | "student_general" => &["001"],
-        "gtr" => &["004"],
-        "piecewise_linear" | "blend" => &["000"],
-        "gaussian_slopes" => &["002"],
-        _ => &[],
+/// The effects a renderer declares for one model: what it evaluates of it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Effects {
+    /// The G2 form, if the renderer masks.
+    pub masking: Option<Masking>,
+    /// How it samples, if it does.
+    pub sampling: Option<Sampling>,
+    /// Whether it filters with slope moments (Gaussian-slope filtering, seed 002).
+    pub slope_moments: bool,
+    /// The largest incidence it evaluates (radians).
+    pub theta_max: f64,
+}
+
+/// The checks any model gets from its capabilities and the declared effects: normalization and
+/// hard inputs always; Smith checks when it masks; sampling checks when it samples (visible
+/// normals too when declared); slope moments when it filters with them. The same function
+/// plans a scene's reference materials and a user's own model.
+pub fn plan_model<'a>(
+    subject: &Arc<Subject<'a>>,
+    effects: &Effects,
+    profile: Profile,
+    why: &str,
+) -> Vec<PlannedCheck<'a>> {
+    let mut out = Vec::new();
+    out.extend(normalization::plan(subject, &format!("{why} evaluates D")));
+    out.push(stability::plan_incidence(subject, why));
+    if let Some(masking) = effects.masking {
+        out.extend(smith::plan(
+            subject,
+            profile,
+            effects.theta_max,
+            &format!("{why} masks ({masking:?})"),
+        ));
     }
+    if let Some(s) = effects.sampling {
+        let samples = format!("{why} samples ({s:?})");
+        out.extend(sampling::plan(subject, profile, &samples));
+        if s == Sampling::VisibleNormals {
+            out.extend(sampling::plan_visible(subject, profile, &samples));
+        }
+    }
+    if effects.slope_moments {
+        out.extend(moments::plan(
+            subject,
+            &format!("{why}: slope moments feed Gaussian-slope filtering"),
+        ));
+    }
+    out
 }
 
 /// The plan of a scene under a profile.
@@ -38,14 +74,18 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
             continue; // Scene::parse has rejected invalid models already.
         };
         let model: Arc<dyn Model> = Arc::from(model);
-        let family = model.family();
-        documents.extend(document_of(family).iter().copied());
-        let spec = serde_json::to_value(&material.model).unwrap_or(Value::Null);
+        let subject = Subject::from_model(model.clone());
+        let info = registry::info(&material.model);
+        let family = info.name;
+        documents.extend(info.documents.iter().copied());
         let why = format!("material `{}` ({family})", material.name);
-        out.extend(normalization::plan(
-            model.clone(),
-            &format!("{why} evaluates D"),
-        ));
+        let effects = Effects {
+            masking: material.masking,
+            sampling: material.sampling,
+            slope_moments: scene.filtering.gaussian_slopes || info.intrinsic_moments,
+            theta_max,
+        };
+        out.extend(plan_model(&subject, &effects, profile, &why));
         out.extend(precise::plan(
             model.clone(),
             profile,
@@ -53,40 +93,16 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
             &format!("{why} evaluates D and Λ"),
         ));
         out.extend(stability::plan(
-            &spec,
+            &material.model,
             &format!("{why}: its parameters pushed to the ends of their domains"),
         ));
-        if let Some(masking) = material.masking {
-            out.extend(smith::plan(
-                model.clone(),
+        if material.sampling == Some(Sampling::PseudoVnis) {
+            documents.insert("001");
+            out.extend(sampling::plan_pseudo_vnis(
+                &material.model,
+                material.masking,
                 profile,
-                theta_max,
-                &format!("{why} masks ({masking:?})"),
-            ));
-        }
-        if let Some(s) = material.sampling {
-            let samples = format!("{why} samples ({s:?})");
-            out.extend(sampling::plan(model.clone(), profile, &samples));
-            match s {
-                Sampling::Normals => {}
-                Sampling::VisibleNormals => {
-                    out.extend(sampling::plan_visible(model.clone(), profile, &samples));
-                }
-                Sampling::PseudoVnis => {
-                    documents.insert("001");
-                    out.extend(sampling::plan_pseudo_vnis(
-                        &material.model,
-                        material.masking,
-                        profile,
-                        &samples,
-                    ));
-                }
-            }
-        }
-        if scene.filtering.gaussian_slopes || family == "gaussian_slopes" {
-            out.extend(moments::plan(
-                model.clone(),
-                &format!("{why}: slope moments feed Gaussian-slope filtering"),
+                &format!("{why} samples (PseudoVnis)"),
             ));
         }
         if scene.filtering.gaussian_slopes {
@@ -97,7 +113,8 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
                 &format!("{why}: Gaussian-slope filtering uses the visible-slope moments"),
             ));
         }
-        if family == "std" {
+        if info.beckmann_limit {
+            let spec = serde_json::to_value(&material.model).unwrap_or(Value::Null);
             if let Some(a) = spec.get("alpha").and_then(Value::as_f64) {
                 if !std_alphas.contains(&a) {
                     std_alphas.push(a);
@@ -126,7 +143,7 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
 }
 
 /// One line per planned check: id, model, case and why (for `mfh plan`).
-pub fn describe(plan: &[Planned]) -> Vec<Value> {
+pub fn describe(plan: &[PlannedCheck<'_>]) -> Vec<Value> {
     plan.iter()
         .map(|p| {
             serde_json::json!({

@@ -617,6 +617,25 @@ pub fn expected_failure(
         .find(|e| e.check == check && e.family == family && (e.route == "*" || e.route == route))
 }
 
+/// `pdf_wm` against the density of the sampling map (finite differences of `sample_wm`).
+pub const PDF_JACOBIAN: Tolerance = Tolerance {
+    name: "pdf_jacobian",
+    value: 1e-6,
+    reason: "Richardson-extrapolated central differences with steps 1e-4 and 5e-5 err by \
+             O(h⁴) (~1e-12 for the smooth samplers) plus round-off ε/h (~1e-11), amplified by \
+             the map's conditioning near the poles of the inversion; 1e-6 keeps a margin of \
+             10³ over what correct samplers measure and fails a 0.5 % mismatch by 5000×",
+};
+
+/// A user's closed form against mfh's reference closed form of the same model.
+pub const AGAINST_REFERENCE: Tolerance = Tolerance {
+    name: "against_reference",
+    value: 1e-10,
+    reason: "two double-precision evaluations of the same closed form, by different algebra: \
+             ~1e-14 where well conditioned; 1e-10 allows conditioning near grazing incidence \
+             (as CLOSED_FORM) but not a cancellation that loses digits near normal incidence",
+};
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -9,6 +9,7 @@ pub mod error;
 pub mod geometry;
 pub mod model;
 pub mod ndf;
+pub mod registry;
 pub mod sg;
 pub mod slopes;
 pub mod spec;

@@ -2,14 +2,89 @@
 //! them (DESIGN.md, "The model boundary").
 
 use crate::error::QueryError;
-use crate::geometry::{dot, Vec3};
+use crate::geometry::dot;
+pub use crate::geometry::Vec3;
 use crate::spec::ModelSpec;
 
 /// A normal distribution function, normalized so that ∫ D(m) (m·n) dm = 1.
+///
+/// `d` is the one required method. The `as_*` methods say which other capabilities the model
+/// has: an implementation of [`Smith`], [`NormalSampler`], … is audited only where the model
+/// returns `Some(self)` from the matching method (Rust cannot discover a trait impl at run
+/// time). A renderer's own model writes, for example:
+///
+/// ```
+/// use mfh_reference::{Ndf, Smith, Vec3};
+/// struct MyGgx { alpha: f64 }
+/// impl Ndf for MyGgx {
+///     fn d(&self, m: Vec3) -> f64 {
+///         if m[2] <= 0.0 { return 0.0; }
+///         let a2 = self.alpha * self.alpha;
+///         let t = m[2] * m[2] * (a2 - 1.0) + 1.0;
+///         a2 / (std::f64::consts::PI * t * t)
+///     }
+///     fn as_smith(&self) -> Option<&dyn Smith> { Some(self) }
+/// }
+/// impl Smith for MyGgx {
+///     fn lambda(&self, w: Vec3) -> f64 {
+///         let t2 = (w[0] * w[0] + w[1] * w[1]) / (w[2] * w[2]);
+///         ((1.0 + self.alpha * self.alpha * t2).sqrt() - 1.0) / 2.0
+///     }
+/// }
+/// # assert!(MyGgx { alpha: 0.3 }.as_smith().is_some());
+/// ```
 pub trait Ndf: Send + Sync {
     /// D(m) for a unit microfacet normal `m`; 0 below the horizon (m_z ≤ 0).
     fn d(&self, m: Vec3) -> f64;
+
+    /// The Smith capability, if the model has one.
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        None
+    }
+    /// The normal-sampling capability, if the model has one.
+    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+        None
+    }
+    /// The visible-normal sampling capability (Heitz & d'Eon 2014), if the model has one.
+    fn as_visible_sampler(&self) -> Option<&dyn VisibleNormalSampler> {
+        None
+    }
+    /// The slope-space capability, if the model has one.
+    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
+        None
+    }
+    /// The visible-slope-moments capability (seed 002, D_s), if the model has one.
+    fn as_visible_moments(&self) -> Option<&dyn VisibleSlopeMoments> {
+        None
+    }
 }
+
+/// A reference to a model is the model (so that `Arc<&M>` and `Box<dyn Model>` audit as `M`).
+macro_rules! delegate_ndf {
+    ($($ptr:ty),*) => {$(
+        impl<T: Ndf + ?Sized> Ndf for $ptr {
+            fn d(&self, m: Vec3) -> f64 {
+                (**self).d(m)
+            }
+            fn as_smith(&self) -> Option<&dyn Smith> {
+                (**self).as_smith()
+            }
+            fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+                (**self).as_sampler()
+            }
+            fn as_visible_sampler(&self) -> Option<&dyn VisibleNormalSampler> {
+                (**self).as_visible_sampler()
+            }
+            fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
+                (**self).as_slopes()
+            }
+            fn as_visible_moments(&self) -> Option<&dyn VisibleSlopeMoments> {
+                (**self).as_visible_moments()
+            }
+        }
+    )*};
+}
+delegate_ndf!(&T, Box<T>, std::sync::Arc<T>);
 
 /// Which two-direction masking-shadowing form to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -149,32 +224,13 @@ pub trait SlopeDistribution {
     }
 }
 
-/// A model as the harness sees it: its spec and the capabilities it has.
+/// A reference model: a model of a known family, describable as data (its spec). Capabilities
+/// are discovered through [`Ndf`]'s `as_*` methods, as for any model.
 pub trait Model: Ndf {
     /// The model described as data.
     fn spec(&self) -> ModelSpec;
     /// The family name as in model specs (`ggx`, `std`, …).
     fn family(&self) -> &'static str;
-    /// The Smith capability, if the model has one.
-    fn as_smith(&self) -> Option<&dyn Smith> {
-        None
-    }
-    /// The normal-sampling capability, if the model has one.
-    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
-        None
-    }
-    /// The visible-normal sampling capability (Heitz & d'Eon 2014), if the model has one.
-    fn as_visible_sampler(&self) -> Option<&dyn VisibleNormalSampler> {
-        None
-    }
-    /// The slope-space capability, if the model has one.
-    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
-        None
-    }
-    /// The visible-slope-moments capability (seed 002, D_s), if the model has one.
-    fn as_visible_moments(&self) -> Option<&dyn VisibleSlopeMoments> {
-        None
-    }
 }
 
 /// The roughness along an azimuth for an elliptic slope distribution with scales `(sx, sy)`,

@@ -303,7 +303,7 @@ fn variants(spec: &Value) -> Vec<(&'static str, Value)> {
 /// The view azimuths of a profile (φ = 0 and at least one φ ≠ 0; −π/2 as Table 3, row 4).
 fn phis(profile: Profile) -> &'static [f64] {
     match profile {
-        Profile::Quick => &[0.0, 0.7],
+        Profile::Ci | Profile::Quick => &[0.0, 0.7],
         Profile::Standard => &[0.0, 0.7, -std::f64::consts::FRAC_PI_2],
         Profile::Thorough => &[0.0, 0.7, -std::f64::consts::FRAC_PI_2, 2.5, 4.0],
     }

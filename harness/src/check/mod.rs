@@ -2,9 +2,11 @@
 //! into a [`CheckRecord`] against an oracle (DESIGN.md, "Checks and records"). A check never
 //! panics and never asserts; only the audit's verdicts decide.
 
+pub mod against;
 pub mod claims;
 pub mod ds;
 pub mod errata;
+pub mod jacobian;
 pub mod limits;
 pub mod moments;
 pub mod normalization;
@@ -23,10 +25,15 @@ use serde::Serialize;
 use serde_json::Value;
 use std::path::PathBuf;
 
+pub use crate::subject::{lobe_width, theta_kinks};
+
 /// How hard an audit looks: the size of the case grids and of the statistical samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum Profile {
+    /// The CI gate for one model: the quick grids, 10⁶ chi-square samples, no document-level
+    /// checks; ≤ 10 s for an isotropic model with D, Λ and normal sampling on 2 cores.
+    Ci,
     /// A few cases per property, 2·10⁵ samples per sampler: ≤ 60 s on 2 cores.
     Quick,
     /// More incidence angles and 2·10⁶ samples per sampler: ≤ 10 minutes.
@@ -35,16 +42,35 @@ pub enum Profile {
     Thorough,
 }
 
+/// The incidence closest to grazing every profile checks: π/2 − 1e-6.
+pub const NEAR_GRAZING: f64 = std::f64::consts::FRAC_PI_2 - 1e-6;
+
 impl Profile {
     /// Incidence angles θ (radians) at which direction-dependent properties are checked,
-    /// including the hard cases (near normal and near grazing incidence), capped at `theta_max`.
+    /// including the hard cases (near normal and near grazing incidence, up to π/2 − 1e-6),
+    /// capped at `theta_max`.
     pub fn thetas(self, theta_max: f64) -> Vec<f64> {
         let all: &[f64] = match self {
-            Profile::Quick => &[1e-3, 0.5, 1.2, 1.5],
-            Profile::Standard => &[1e-6, 1e-3, 0.2, 0.5, 0.9, 1.2, 1.4, 1.55],
+            Profile::Ci | Profile::Quick => &[1e-3, 0.5, 1.2, 1.5, NEAR_GRAZING],
+            Profile::Standard => &[1e-6, 1e-3, 0.2, 0.5, 0.9, 1.2, 1.4, 1.55, NEAR_GRAZING],
             Profile::Thorough => &[
-                1e-8, 1e-6, 1e-4, 1e-2, 0.1, 0.3, 0.5, 0.7, 0.9, 1.1, 1.2, 1.3, 1.4, 1.5, 1.55,
+                1e-8,
+                1e-6,
+                1e-4,
+                1e-2,
+                0.1,
+                0.3,
+                0.5,
+                0.7,
+                0.9,
+                1.1,
+                1.2,
+                1.3,
+                1.4,
+                1.5,
+                1.55,
                 1.57,
+                NEAR_GRAZING,
             ],
         };
         all.iter().copied().filter(|t| *t <= theta_max).collect()
@@ -53,22 +79,23 @@ impl Profile {
     /// Samples per chi-square test.
     pub fn chi2_samples(self) -> u64 {
         match self {
+            Profile::Ci => 1_000_000,
             Profile::Quick => 200_000,
             Profile::Standard => 2_000_000,
             Profile::Thorough => 20_000_000,
         }
     }
 
-    /// Samples per Kolmogorov–Smirnov test of a marginal; a sampler of a family in
-    /// [`SLOW_SAMPLERS`] gets a tenth (the piecewise-linear inversion costs ~30 µs a sample,
-    /// a thousand times the closed-form samplers).
-    pub fn ks_samples(self, family: &str) -> u64 {
+    /// Samples per Kolmogorov–Smirnov test of a marginal; a slow sampler (one that inverts a
+    /// CDF numerically, ~30 µs a sample, a thousand times the closed-form samplers) gets a
+    /// tenth.
+    pub fn ks_samples(self, slow_sampler: bool) -> u64 {
         let n = match self {
-            Profile::Quick => 200_000,
+            Profile::Ci | Profile::Quick => 200_000,
             Profile::Standard => 2_000_000,
             Profile::Thorough => 10_000_000,
         };
-        if SLOW_SAMPLERS.contains(&family) {
+        if slow_sampler {
             n / 10
         } else {
             n
@@ -78,16 +105,13 @@ impl Profile {
     /// The name as on the command line.
     pub fn name(self) -> &'static str {
         match self {
+            Profile::Ci => "ci",
             Profile::Quick => "quick",
             Profile::Standard => "standard",
             Profile::Thorough => "thorough",
         }
     }
 }
-
-/// Families whose `sample_wm` inverts a CDF numerically (tens of µs a sample): statistical
-/// sampling checks that scale with the sample count take fewer samples of them.
-pub const SLOW_SAMPLERS: &[&str] = &["piecewise_linear"];
 
 /// What a running check may use: its seed and where to write artefacts.
 #[derive(Debug, Clone)]
@@ -99,11 +123,15 @@ pub struct RunContext {
     pub out: Option<PathBuf>,
 }
 
-/// The function that runs a planned check.
-pub type Runner = Box<dyn Fn(&RunContext) -> CheckRecord + Send + Sync>;
+/// The function that runs a planned check; it may borrow the model under audit for `'a`.
+pub type Runner<'a> = Box<dyn Fn(&RunContext) -> CheckRecord + Send + Sync + 'a>;
 
-/// One planned check: what it is, why the planner chose it, and how to run it.
-pub struct Planned {
+/// A planned check that owns everything it needs (reference models, SG lobes).
+pub type Planned = PlannedCheck<'static>;
+
+/// One planned check: what it is, why the planner chose it, and how to run it. `'a` is the
+/// lifetime of the model under audit (a user's model may be borrowed).
+pub struct PlannedCheck<'a> {
     /// The check id, `family.property`.
     pub check: String,
     /// The model spec (JSON), or null.
@@ -117,10 +145,10 @@ pub struct Planned {
     /// Whether its verdict is statistical (it takes a share of the audit's α).
     pub statistical: bool,
     /// Runs it.
-    pub run: Runner,
+    pub run: Runner<'a>,
 }
 
-impl std::fmt::Debug for Planned {
+impl std::fmt::Debug for PlannedCheck<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Planned")
             .field("check", &self.check)
@@ -129,47 +157,6 @@ impl std::fmt::Debug for Planned {
             .field("why", &self.why)
             .finish()
     }
-}
-
-/// The angular width of a model's lobe, read from its spec (α, or the smaller of α_x, α_y; the
-/// square root of the smaller slope variance for Gaussian slopes), for placing quadrature cuts.
-pub fn lobe_width(spec: &Value) -> f64 {
-    let get = |k: &str| spec.get(k).and_then(Value::as_f64);
-    let mut w = f64::INFINITY;
-    for k in ["alpha", "alpha_x", "alpha_y"] {
-        if let Some(a) = get(k) {
-            w = w.min(a);
-        }
-    }
-    if let Some(cov) = spec.get("cov").and_then(Value::as_array) {
-        for (i, row) in cov.iter().enumerate() {
-            if let Some(v) = row.get(i).and_then(Value::as_f64) {
-                w = w.min(v.abs().sqrt());
-            }
-        }
-    }
-    if w.is_finite() && w > 0.0 {
-        w.atan()
-    } else {
-        0.3
-    }
-}
-
-/// The polar angles (radians, strictly inside (0, π/2)) where D has kinks for every azimuth:
-/// the breakpoints of a piecewise-linear NDF's profiles (both profiles of the anisotropic blend
-/// of seed 000 eq 1, whose weights depend on φ only). Quadrature oracles cut there, so that each
-/// piece is smooth and the double-exponential rule converges at its usual rate.
-pub fn theta_kinks(spec: &Value) -> Vec<f64> {
-    let mut out: Vec<f64> = ["x", "y"]
-        .iter()
-        .filter_map(|k| spec.get(k)?.get("theta")?.as_array())
-        .flatten()
-        .filter_map(Value::as_f64)
-        .filter(|t| *t > 0.0 && *t < std::f64::consts::FRAC_PI_2)
-        .collect();
-    out.sort_by(f64::total_cmp);
-    out.dedup();
-    out
 }
 
 /// Fills `record` with the comparison of `value` against the oracle's estimate: relative error
@@ -260,8 +247,9 @@ pub fn covers(family: &str, quantity: &str, route: &str) -> String {
 mod tests {
     use super::*;
     use crate::record::Verdict;
+    use crate::subject::{Hints, Subject};
     use mfh_reference::ndf::Ggx;
-    use mfh_reference::{Model, ModelSpec, Ndf, NormalSampler, SlopeDistribution, Smith, Vec3};
+    use mfh_reference::{Ndf, NormalSampler, SlopeDistribution, Smith, Vec3};
     use std::sync::Arc;
 
     /// GGX with a defect: D scaled by `d_scale`, Λ by `lambda_scale` (the sampler and slopes
@@ -276,6 +264,16 @@ mod tests {
     impl Ndf for Broken {
         fn d(&self, m: Vec3) -> f64 {
             self.d_scale * self.ggx.d(m)
+        }
+
+        fn as_smith(&self) -> Option<&dyn Smith> {
+            Some(self)
+        }
+        fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+            Some(self)
+        }
+        fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
+            self.ggx.as_slopes()
         }
     }
     impl Smith for Broken {
@@ -298,31 +296,17 @@ mod tests {
             }
         }
     }
-    impl Model for Broken {
-        fn spec(&self) -> ModelSpec {
-            self.ggx.spec()
-        }
-        fn family(&self) -> &'static str {
-            "ggx"
-        }
-        fn as_smith(&self) -> Option<&dyn Smith> {
-            Some(self)
-        }
-        fn as_sampler(&self) -> Option<&dyn NormalSampler> {
-            Some(self)
-        }
-        fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
-            self.ggx.as_slopes()
-        }
-    }
-
-    fn run(plan: Vec<Planned>) -> Vec<crate::record::CheckRecord> {
+    fn run(plan: Vec<PlannedCheck<'_>>) -> Vec<crate::record::CheckRecord> {
         let ctx = RunContext { seed: 7, out: None };
         plan.iter().map(|p| (p.run)(&ctx)).collect()
     }
 
-    fn model(d_scale: f64, lambda_scale: f64) -> Arc<dyn Model> {
-        Arc::new(Broken {
+    fn user(b: Broken) -> Arc<Subject<'static>> {
+        Subject::user(Arc::new(b), "broken ggx", Hints::default())
+    }
+
+    fn model(d_scale: f64, lambda_scale: f64) -> Arc<Subject<'static>> {
+        user(Broken {
             ggx: Ggx::new(0.1, 0.4).unwrap(),
             d_scale,
             lambda_scale,
@@ -330,11 +314,11 @@ mod tests {
         })
     }
 
-    fn plan_all(m: Arc<dyn Model>) -> Vec<Planned> {
-        let mut p = normalization::plan(m.clone(), "test");
-        p.extend(smith::plan(m.clone(), Profile::Quick, 1.5, "test"));
-        p.extend(sampling::plan(m.clone(), Profile::Quick, "test"));
-        p.extend(moments::plan(m, "test"));
+    fn plan_all(m: Arc<Subject<'static>>) -> Vec<PlannedCheck<'static>> {
+        let mut p = normalization::plan(&m, "test");
+        p.extend(smith::plan(&m, Profile::Quick, 1.5, "test"));
+        p.extend(sampling::plan(&m, Profile::Quick, "test"));
+        p.extend(moments::plan(&m, "test"));
         p
     }
 
@@ -392,7 +376,7 @@ mod tests {
         // with it; normalization is the check that sees a 0.1 % D (the chi-square's mass sanity
         // test allows 1e-3).
         assert_eq!(failed(&d, "sampling.pdf_consistency"), 0);
-        let flipped: Arc<dyn Model> = Arc::new(Broken {
+        let flipped = user(Broken {
             ggx: Ggx::new(0.1, 0.4).unwrap(),
             d_scale: 1.0,
             lambda_scale: 1.0,
@@ -403,7 +387,7 @@ mod tests {
             seed: 7,
             out: Some(out.clone()),
         };
-        let f: Vec<_> = sampling::plan(flipped, Profile::Quick, "test")
+        let f: Vec<_> = sampling::plan(&flipped, Profile::Quick, "test")
             .iter()
             .map(|p| (p.run)(&ctx))
             .collect();
@@ -417,9 +401,7 @@ mod tests {
             .filter(|a| a.ends_with(".png"))
             .collect();
         assert_eq!(maps.len(), 3, "{:?}", chi2.artefacts);
-        let folder = out
-            .join("chi2")
-            .join("alpha_x_0.1_alpha_y_0.4_family_ggx_resolution_16_samples_200000");
+        let folder = out.join("chi2");
         for m in maps {
             assert!(std::path::Path::new(m).starts_with(&folder), "{m}");
             assert_eq!(&std::fs::read(m).unwrap()[..8], b"\x89PNG\r\n\x1a\n");

@@ -1,13 +1,14 @@
 //! Slope moments: ν₂ₖ, variance and excess kurtosis against integrals of P2, the marginal
 //! P2 = ∫P22 dp, and the normalization ∫P2 dq = 1 (seed 001 eq 4, 6–7, 15; seed 002 eq 2–10).
 
-use super::{compare, covers, lobe_width, timed, Planned};
+use super::{compare, covers, timed, PlannedCheck};
 use crate::oracle::quadrature::{integrate_line, integrate_pieces, Accuracy};
 use crate::oracle::Estimate;
 use crate::record::{CheckRecord, Verdict};
+use crate::subject::Subject;
 use crate::tolerance::MOMENT;
-use mfh_reference::Model;
-use serde_json::{json, Value};
+
+use serde_json::json;
 use std::sync::Arc;
 
 const SOURCE: &str = "seed 001 eq 4, 6–7, 15 (ν₂ₖ = ∫ q^{2k} P2(q) dq); seed 002 eq 2–10";
@@ -23,20 +24,20 @@ const QUANTITIES: &[(&str, &str)] = &[
 ];
 
 /// Plans the moment checks of one slope-space model.
-pub fn plan(model: Arc<dyn Model>, why: &str) -> Vec<Planned> {
-    if model.as_slopes().is_none() {
+pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> {
+    if subject.model.as_slopes().is_none() {
         return Vec::new();
     }
-    let spec = serde_json::to_value(model.spec()).unwrap_or(Value::Null);
-    let family = model.family();
+    let spec = subject.label.clone();
+    let family = subject.family();
     let phi = 0.7;
     QUANTITIES
         .iter()
         .map(|&(quantity, closed)| {
-            let (m, spec_run) = (model.clone(), spec.clone());
+            let (m, spec_run) = (subject.clone(), spec.clone());
             let case = json!({"quantity": quantity, "phi": phi});
             let case_run = case.clone();
-            Planned {
+            PlannedCheck {
                 check: "moments.slopes".into(),
                 model: spec.clone(),
                 case,
@@ -52,8 +53,8 @@ pub fn plan(model: Arc<dyn Model>, why: &str) -> Vec<Planned> {
                             SOURCE,
                         );
                         r.covers = vec![covers(family, closed, "default")];
-                        let slopes = m.as_slopes().expect("planned for slope models");
-                        let scale = lobe_width(&spec_run).tan().max(1e-6);
+                        let slopes = m.model.as_slopes().expect("planned for slope models");
+                        let scale = m.lobe().width.tan().max(1e-6);
                         let acc = Accuracy::relative(1e-12);
                         let raw = |k: i32| {
                             integrate_line(&|q| q.powi(k) * slopes.p2(q, phi), 0.0, scale, acc)

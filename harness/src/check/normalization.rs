@@ -1,23 +1,21 @@
 //! Normalization: ∫ D(m)(m·n) dm = 1 over the hemisphere, by nested adaptive quadrature.
 
-use super::{compare, covers, lobe_width, theta_kinks, timed, Planned};
+use super::{compare, covers, timed, PlannedCheck};
 use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
 use crate::oracle::Estimate;
 use crate::record::CheckRecord;
+use crate::subject::Subject;
 use crate::tolerance::NORMALIZATION;
-use mfh_reference::Model;
-use serde_json::{json, Value};
+use serde_json::json;
 use std::sync::Arc;
 
 /// Plans the normalization check of one model.
-pub fn plan(model: Arc<dyn Model>, why: &str) -> Vec<Planned> {
-    let spec = serde_json::to_value(model.spec()).unwrap_or(Value::Null);
-    let family = model.family();
-    let m = model.clone();
-    let spec_run = spec.clone();
-    vec![Planned {
+pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> {
+    let family = subject.family();
+    let s = subject.clone();
+    vec![PlannedCheck {
         check: "normalization.projected_area".to_string(),
-        model: spec.clone(),
+        model: subject.label.clone(),
         case: json!({}),
         why: why.to_string(),
         covers: vec![covers(family, "d", "default")],
@@ -26,16 +24,16 @@ pub fn plan(model: Arc<dyn Model>, why: &str) -> Vec<Planned> {
             timed(|| {
                 let mut r = CheckRecord::new(
                     "normalization.projected_area",
-                    spec_run.clone(),
+                    s.label.clone(),
                     json!({}),
                     "DESIGN.md model boundary: ∫ D(m)(m·n) dm = 1 (seed 001 eq 3; seed 000 eq 2; \
                      seed 004 §2)",
                 );
                 r.covers = vec![covers(family, "d", "default")];
-                let kinks = theta_kinks(&spec_run);
+                let kinks = s.theta_kinks();
                 let e = integrate_hemisphere(
-                    &|w| m.d(w) * w[2],
-                    lobe_width(&spec_run),
+                    &|w| s.model.d(w) * w[2],
+                    s.lobe().width,
                     Some(Cuts {
                         theta: &|_| kinks.clone(),
                         phi: &[],

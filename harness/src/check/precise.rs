@@ -18,7 +18,7 @@ const SOURCE: &str = "seed 001 eq 5 (Λ = (1/μ)∫_μ^∞ (q − μ) P2 dq), eq
 /// The incidences (Λ) and normal directions (D) checked.
 fn thetas(profile: Profile, theta_max: f64) -> Vec<f64> {
     let all: &[f64] = match profile {
-        Profile::Quick => &[1e-3, 0.7, 1.3],
+        Profile::Ci | Profile::Quick => &[1e-3, 0.7, 1.3],
         Profile::Standard => &[1e-6, 1e-3, 0.3, 0.7, 1.0, 1.3, 1.5],
         Profile::Thorough => &[
             1e-8, 1e-6, 1e-3, 0.1, 0.3, 0.5, 0.7, 0.9, 1.1, 1.3, 1.5, 1.565,

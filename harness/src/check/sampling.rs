@@ -6,9 +6,7 @@
 //! normalization of `pdf_wm_visible`; for STD materials sampled by the pseudo-VNIS of seed 001
 //! §7.2, the bias of its estimator with the weight of eq 43 as printed and with the unbiased one.
 
-use super::{
-    applied, compare, compare_exact, covers, lobe_width, theta_kinks, timed, Planned, Profile,
-};
+use super::{applied, compare, compare_exact, covers, timed, Planned, PlannedCheck, Profile};
 use crate::oracle::chi2::{
     chi2_test_sampler, chi2_test_to, Chi2Config, KINKED_CELL_RELATIVE_TOLERANCE,
 };
@@ -16,10 +14,11 @@ use crate::oracle::ks::{self, ks_test_sampler, KsConfig, LobeHints, Marginal};
 use crate::oracle::monte_carlo::{estimate, two_sided_p};
 use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
+use crate::subject::Subject;
 use crate::tolerance::{NORMALIZATION, PDF_CONSISTENCY, STATISTICAL_ALPHA};
 use mfh_reference::geometry::{dot, from_spherical, Vec3};
 use mfh_reference::ndf::student_vnis::{reflect, PseudoVnis};
-use mfh_reference::{Masking, Model, ModelSpec, Ndf, Smith};
+use mfh_reference::{Masking, ModelSpec, Ndf, Smith};
 use serde_json::{json, Value};
 use std::sync::Arc;
 
@@ -27,20 +26,20 @@ const SOURCE: &str =
     "seed 001 eq 11–12, 40–42; seed 004 (Burley 2012 B.2); seed 000 Algorithms 1–2";
 
 /// Plans the sampling checks of one model that has a normal sampler.
-pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> {
-    if model.as_sampler().is_none() {
+pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<PlannedCheck<'a>> {
+    if subject.model.as_sampler().is_none() {
         return Vec::new();
     }
-    let spec = serde_json::to_value(model.spec()).unwrap_or(Value::Null);
-    let family = model.family();
+    let spec = subject.label.clone();
+    let family = subject.family();
     let mut out = Vec::new();
     let samples = profile.chi2_samples();
     let resolution = 16;
     {
-        let (m, spec_run) = (model.clone(), spec.clone());
+        let (m, spec_run) = (subject.clone(), spec.clone());
         let case = json!({"samples": samples, "resolution": resolution});
         let case_run = case.clone();
-        out.push(Planned {
+        out.push(PlannedCheck {
             check: "sampling.chi2".into(),
             model: spec.clone(),
             case,
@@ -57,7 +56,7 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> 
                     );
                     r.covers = vec![covers(family, "sample_wm", "default")];
                     r.seed = Some(ctx.seed);
-                    let sampler = m.as_sampler().expect("planned for samplers");
+                    let sampler = m.model.as_sampler().expect("planned for samplers");
                     let config = Chi2Config {
                         resolution,
                         samples,
@@ -73,16 +72,15 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> 
     }
     for marginal in [Marginal::CosTheta, Marginal::Phi] {
         out.push(plan_ks(
-            model.clone(),
-            &spec,
+            subject,
             marginal,
-            profile.ks_samples(family),
+            profile.ks_samples(subject.slow_sampler()),
             why,
         ));
     }
     {
-        let (m, spec_run) = (model.clone(), spec.clone());
-        out.push(Planned {
+        let (m, spec_run) = (subject.clone(), spec.clone());
+        out.push(PlannedCheck {
             check: "sampling.pdf_consistency".into(),
             model: spec.clone(),
             case: json!({"points": 4096}),
@@ -98,7 +96,7 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> 
                         SOURCE,
                     );
                     r.covers = vec![covers(family, "pdf_wm", "default")];
-                    let sampler = m.as_sampler().expect("planned for samplers");
+                    let sampler = m.model.as_sampler().expect("planned for samplers");
                     let mut worst = 0.0f64;
                     let g = 0.618_033_988_749_894_9;
                     for i in 0..4096u32 {
@@ -106,7 +104,7 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> 
                         let mm = sampler.sample_wm(u);
                         let len = dot(mm, mm).sqrt();
                         let pdf = sampler.pdf_wm(mm);
-                        let want = m.d(mm) * mm[2];
+                        let want = m.model.d(mm) * mm[2];
                         let e = if !(mm[2] >= 0.0) || !pdf.is_finite() {
                             f64::INFINITY
                         } else {
@@ -122,13 +120,14 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> 
             }),
         });
     }
-    if model.as_smith().is_some() {
-        let (m, spec_run) = (model.clone(), spec.clone());
+    out.push(super::jacobian::plan(subject, why));
+    if subject.model.as_smith().is_some() {
+        let (m, spec_run) = (subject.clone(), spec.clone());
         let theta = 1.2;
         let mc_samples = samples;
         let case = json!({"theta": theta, "phi": 0.3, "samples": mc_samples});
         let case_run = case.clone();
-        out.push(Planned {
+        out.push(PlannedCheck {
             check: "sampling.lambda_monte_carlo".into(),
             model: spec.clone(),
             case,
@@ -145,8 +144,8 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> 
                     );
                     r.covers = vec![covers(family, "sample_wm", "default")];
                     r.seed = Some(ctx.seed);
-                    let sampler = m.as_sampler().expect("planned for samplers");
-                    let smith = m.as_smith().expect("planned for Smith models");
+                    let sampler = m.model.as_sampler().expect("planned for samplers");
+                    let smith = m.model.as_smith().expect("planned for Smith models");
                     let w = from_spherical(theta, 0.3);
                     let e = estimate(
                         &|u| {
@@ -294,10 +293,14 @@ pub fn terminator_azimuths(phi_i: f64) -> [f64; 2] {
 /// a visible-normal sampler gets one skipped `sampling.chi2_visible` record that says so: the
 /// scene is valid (the renderer may sample visible normals its own way), but there is no
 /// reference sampler to check it against.
-pub fn plan_visible(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<Planned> {
-    let spec = serde_json::to_value(model.spec()).unwrap_or(Value::Null);
-    let family = model.family();
-    if model.as_visible_sampler().is_none() {
+pub fn plan_visible<'a>(
+    subject: &Arc<Subject<'a>>,
+    profile: Profile,
+    why: &str,
+) -> Vec<PlannedCheck<'a>> {
+    let spec = subject.label.clone();
+    let family = subject.family();
+    if subject.model.as_visible_sampler().is_none() {
         return vec![skipped(
             "sampling.chi2_visible",
             &spec,
@@ -312,10 +315,10 @@ pub fn plan_visible(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<P
     }
     let samples = profile.chi2_samples();
     let resolution = 16;
-    let width = super::lobe_width(&spec);
+    let width = subject.lobe().width;
     let mut out = Vec::new();
     for &(theta, phi) in &VISIBLE_INCIDENCES {
-        let (m, spec_run) = (model.clone(), spec.clone());
+        let (m, spec_run) = (subject.clone(), spec.clone());
         let case = json!({"theta_i": theta, "phi_i": phi, "samples": samples,
                           "resolution": resolution});
         let case_run = case.clone();
@@ -324,7 +327,7 @@ pub fn plan_visible(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<P
             covers(family, "pdf_wm_visible", "default"),
         ];
         let ids_run = ids.clone();
-        out.push(Planned {
+        out.push(PlannedCheck {
             check: "sampling.chi2_visible".into(),
             model: spec.clone(),
             case,
@@ -342,6 +345,7 @@ pub fn plan_visible(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<P
                     r.covers = ids_run.clone();
                     r.seed = Some(ctx.seed);
                     let v = m
+                        .model
                         .as_visible_sampler()
                         .expect("planned for visible samplers");
                     let wi = from_spherical(theta, phi);
@@ -362,10 +366,10 @@ pub fn plan_visible(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<P
                 })
             }),
         });
-        let (m, spec_run) = (model.clone(), spec.clone());
+        let (m, spec_run) = (subject.clone(), spec.clone());
         let case = json!({"theta_i": theta, "phi_i": phi});
         let case_run = case.clone();
-        out.push(Planned {
+        out.push(PlannedCheck {
             check: "sampling.pdf_visible_normalization".into(),
             model: spec.clone(),
             case,
@@ -382,6 +386,7 @@ pub fn plan_visible(model: Arc<dyn Model>, profile: Profile, why: &str) -> Vec<P
                     );
                     r.covers = vec![covers(family, "pdf_wm_visible", "default")];
                     let v = m
+                        .model
                         .as_visible_sampler()
                         .expect("planned for visible samplers");
                     let wi = from_spherical(theta, phi);
@@ -641,18 +646,19 @@ fn pseudo_vnis_record(
 /// `{"marginal": "cos_theta" | "phi", "samples": N}`. The record's value is D_N; its case gains
 /// the table's knots and error bound, Stephens' λ and where D_N is attained. Sanity failures
 /// fail without a p-value; a CDF table too coarse for N is an error (no verdict).
-fn plan_ks(
-    model: Arc<dyn Model>,
-    spec: &Value,
+fn plan_ks<'a>(
+    subject: &Arc<Subject<'a>>,
     marginal: Marginal,
     samples: u64,
     why: &str,
-) -> Planned {
-    let family = model.family();
+) -> PlannedCheck<'a> {
+    let family = subject.family();
+    let spec = &subject.label;
+    let model = subject.clone();
     let case = json!({"marginal": marginal.name(), "samples": samples});
     let (spec_run, case_run) = (spec.clone(), case.clone());
-    let (width, kinks) = (lobe_width(spec), theta_kinks(spec));
-    Planned {
+    let (width, kinks) = (subject.lobe().width, subject.theta_kinks());
+    PlannedCheck {
         check: "sampling.ks_marginals".into(),
         model: spec.clone(),
         case,
@@ -672,7 +678,7 @@ fn plan_ks(
                 );
                 r.covers = vec![covers(family, "sample_wm", "default")];
                 r.seed = Some(ctx.seed);
-                let Some(sampler) = model.as_sampler() else {
+                let Some(sampler) = model.model.as_sampler() else {
                     r.verdict = Verdict::Error {
                         message: "the model has no sampler".into(),
                     };
@@ -802,7 +808,7 @@ mod tests {
     use crate::check::RunContext;
     use crate::oracle::chi2::chi2_test;
 
-    fn run(plan: &[Planned]) -> Vec<CheckRecord> {
+    fn run(plan: &[PlannedCheck<'_>]) -> Vec<CheckRecord> {
         let ctx = RunContext { seed: 7, out: None };
         plan.iter()
             .map(|p| {
@@ -816,9 +822,9 @@ mod tests {
             .collect()
     }
 
-    fn model(json: &str) -> (ModelSpec, Arc<dyn Model>) {
+    fn model(json: &str) -> (ModelSpec, Arc<Subject<'static>>) {
         let spec: ModelSpec = serde_json::from_str(json).unwrap();
-        let m: Arc<dyn Model> = Arc::from(spec.build().unwrap());
+        let m = Subject::reference(&spec).unwrap();
         (spec, m)
     }
 
@@ -830,7 +836,7 @@ mod tests {
             r#"{"family":"std","gamma":"inf","alpha":0.3}"#,
         ] {
             let (_, m) = model(json);
-            let records = run(&plan_visible(m, Profile::Quick, "test"));
+            let records = run(&plan_visible(&m, Profile::Quick, "test"));
             assert_eq!(records.len(), 2 * VISIBLE_INCIDENCES.len());
             for r in &records {
                 assert_eq!(r.verdict, Verdict::Pass, "{r:?}");
@@ -841,7 +847,7 @@ mod tests {
     #[test]
     fn a_model_without_a_visible_sampler_is_skipped_with_its_reason() {
         let (spec, m) = model(r#"{"family":"std","gamma":3,"alpha":0.3}"#);
-        let records = run(&plan_visible(m, Profile::Quick, "test"));
+        let records = run(&plan_visible(&m, Profile::Quick, "test"));
         assert_eq!(records.len(), 1);
         assert!(
             matches!(&records[0].verdict, Verdict::Skipped { reason } if reason.contains("std")),
@@ -897,8 +903,8 @@ mod tests {
         let (_, a) = model(r#"{"family":"ggx","alpha":0.3}"#);
         let (_, b) = model(r#"{"family":"ggx","alpha":0.33}"#);
         let (va, vb) = (
-            a.as_visible_sampler().unwrap(),
-            b.as_visible_sampler().unwrap(),
+            a.model.as_visible_sampler().unwrap(),
+            b.model.as_visible_sampler().unwrap(),
         );
         let wi = from_spherical(1.3, 0.3);
         let config = Chi2Config {
@@ -914,7 +920,7 @@ mod tests {
         );
         assert!(r.p_value < 1e-6, "{r:?}");
         // The normal sampler is not a visible-normal sampler.
-        let s = a.as_sampler().unwrap();
+        let s = a.model.as_sampler().unwrap();
         let r = chi2_test(&|u| s.sample_wm(u), &|m| va.pdf_wm_visible(wi, m), &config);
         assert_eq!(r.verdict, crate::oracle::chi2::Verdict::Fail);
     }

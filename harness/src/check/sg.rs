@@ -190,7 +190,7 @@ fn compare_claim(r: &mut CheckRecord, value: f64, oracle: Estimate, tolerance: &
 /// Sharpness grid of the profile.
 fn sharpness_grid(profile: Profile) -> &'static [f64] {
     match profile {
-        Profile::Quick => &[1e-3, 1.0, 100.0, 1e4],
+        Profile::Ci | Profile::Quick => &[1e-3, 1.0, 100.0, 1e4],
         _ => &[1e-3, 1.0, 10.0, 100.0, 1e3, 1e4],
     }
 }
@@ -660,7 +660,7 @@ fn asg_of(bandwidths: [f64; 2], amplitude: f64) -> Option<Asg> {
 
 fn plan_asg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
     let bands: &[[f64; 2]] = match profile {
-        Profile::Quick => &[[1.0, 1.0], [2.0, 1.0], [30.0, 8.0], [200.0, 50.0]],
+        Profile::Ci | Profile::Quick => &[[1.0, 1.0], [2.0, 1.0], [30.0, 8.0], [200.0, 50.0]],
         _ => &[
             [0.01, 1e-3],
             [1.0, 1.0],

@@ -2,29 +2,22 @@
 //! ∫⟨−w·m⟩⁺D(m)dm otherwise), the weak white furnace ∫G1(w,m)⟨w·m⟩⁺D(m)dm = cos θ, and the
 //! identities Λ(−w) = −1 − Λ(w), 0 ≤ G1 ≤ 1, G2 ≤ min G1.
 
-use super::{
-    apply_expected, compare, compare_exact, covers, lobe_width, theta_kinks, timed, Planned,
-    Profile,
-};
+use super::{apply_expected, compare, compare_exact, covers, timed, PlannedCheck, Profile};
 use crate::oracle::quadrature::{
     integrate_hemisphere_polar, integrate_pieces, integrate_upper, Accuracy, Cuts,
 };
 use crate::oracle::{student_t, Estimate};
 use crate::record::{CheckRecord, Verdict};
+use crate::subject::Subject;
 use crate::tolerance::{CLOSED_FORM, IDENTITY, NUMERICAL_ROUTE};
 use mfh_reference::geometry::{dot, from_spherical};
 use mfh_reference::{Masking, Model, Vec3};
-use serde_json::{json, Value};
+use serde_json::json;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::sync::{Arc, OnceLock};
 
 const SOURCE_LAMBDA: &str =
     "seed 001 eq 5 (Λ = (1/μ)∫_μ^∞ (q − μ) P2(q) dq), eq 16–21; seed 004 §2; seed 000 eq 10–13";
-
-/// Whether a family's default Λ is itself a numerical integral.
-fn numerical_default(family: &str) -> bool {
-    matches!(family, "gtr" | "piecewise_linear" | "blend")
-}
 
 /// w·m for m = (θ_m, φ_m), as R sin(θ_t − θ_m) with R = |(sin θ cos Δφ, cos θ)| and θ_t the
 /// polar angle of the terminator at that azimuth (> π/2 when w sees the whole meridian): the
@@ -39,16 +32,11 @@ fn projection(w: Vec3) -> impl Fn(f64) -> (f64, f64) {
     }
 }
 
-/// The mean slope along azimuth φ: mean · (cos φ, sin φ) for models with a `mean` (Gaussian
-/// slopes, seed 002), else 0.
-fn mean_slope(spec: &Value, phi: f64) -> f64 {
-    let mean = |i: usize| {
-        spec.get("mean")
-            .and_then(|m| m.get(i))
-            .and_then(Value::as_f64)
-            .unwrap_or(0.0)
-    };
-    mean(0) * phi.cos() + mean(1) * phi.sin()
+/// The mean slope along azimuth φ: mean · (cos φ, sin φ) (non-zero for Gaussian slopes with
+/// a mean, seed 002).
+fn mean_slope(subject: &Subject, phi: f64) -> f64 {
+    let mean = subject.mean_slope();
+    mean[0] * phi.cos() + mean[1] * phi.sin()
 }
 
 /// The polar cuts for azimuth φ_m: the terminator of w on the hemisphere of normals (the polar
@@ -97,34 +85,30 @@ type SharedOracle = Arc<OnceLock<Estimate>>;
 /// expectation of `oracle::student_t` instead.
 const STUDENT_TAIL_LIMIT: f64 = 1.6;
 
-/// The exponent C of a Student-family spec (`gamma` of STD, Hyper-Cauchy and the
-/// fixed-variance member, `c` of the general member), None for other families.
-fn student_exponent(spec: &Value) -> Option<f64> {
-    match spec.get("family")?.as_str()? {
-        "std" | "hyper_cauchy" | "student_fixed_variance" => spec.get("gamma")?.as_f64(),
-        "student_general" => spec.get("c")?.as_f64(),
-        _ => None,
-    }
-}
-
 /// The oracle of Λ(w): (1/μ)∫_μ^∞ (q − μ) P2(q) dq along the azimuth of w for slope-space
 /// models; otherwise ∫⟨−w·m⟩⁺ D(m) dm / cos θ (the back-facing projected area, which equals
 /// Λ cos θ without the cancellation of ∫⟨w·m⟩⁺D dm − cos θ).
-pub fn lambda_oracle(model: &dyn Model, spec: &Value, w: Vec3) -> Estimate {
+/// (`_spec` is the model's spec as JSON, read from the model itself now.)
+pub fn lambda_oracle(model: &dyn Model, _spec: &serde_json::Value, w: Vec3) -> Estimate {
+    lambda_oracle_for(&Subject::borrowed(model), w)
+}
+
+/// [`lambda_oracle`] of a subject (its hints and registry entry place the quadrature's cuts).
+pub fn lambda_oracle_for(subject: &Subject, w: Vec3) -> Estimate {
     let (sin_t, cos_t) = ((w[0] * w[0] + w[1] * w[1]).sqrt(), w[2]);
     if cos_t >= 1.0 || sin_t == 0.0 {
         return Estimate::default();
     }
     let accuracy = Accuracy::relative(1e-12);
-    if let Some(slopes) = model.as_slopes() {
+    if let Some(slopes) = subject.model.as_slopes() {
         let mu = cos_t / sin_t;
         let phi = w[1].atan2(w[0]);
-        if let Some(c) = student_exponent(spec).filter(|c| *c < STUDENT_TAIL_LIMIT) {
+        if let Some(c) = subject.tail_exponent().filter(|c| *c < STUDENT_TAIL_LIMIT) {
             if let Some(e) = student_t::lambda(c, slopes.p2(0.0, phi), mu) {
                 return e;
             }
         }
-        let scale = lobe_width(spec).tan().max(1e-6);
+        let scale = subject.lobe().width.tan().max(1e-6);
         let e = integrate_upper(&|q| (q - mu) * slopes.p2(q, phi), mu, scale, accuracy);
         return Estimate {
             value: e.value / mu,
@@ -132,7 +116,7 @@ pub fn lambda_oracle(model: &dyn Model, spec: &Value, w: Vec3) -> Estimate {
             evaluations: e.evaluations,
         };
     }
-    lambda_oracle_lune(model, spec, w)
+    lambda_oracle_lune(subject, w)
 }
 
 /// ∫⟨−w·m⟩⁺ D(m) dm / cos θ over the lune of back-facing normals: m at azimuth
@@ -143,11 +127,16 @@ pub fn lambda_oracle(model: &dyn Model, spec: &Value, w: Vec3) -> Estimate {
 /// about n, with the terminator as a polar cut, resolve the sliver of width ~θ at normal
 /// incidence only to ~1e-16/θ: at θ = 1e-6 that oracle took 1.4e9 evaluations and was 2e-9
 /// off; this one takes 2e5 and agrees with the closed forms to 3e-14.)
-fn lambda_oracle_lune(model: &dyn Model, spec: &Value, w: Vec3) -> Estimate {
+fn lambda_oracle_lune(subject: &Subject, w: Vec3) -> Estimate {
+    let model = subject.model.as_ref();
     let (st, ct) = ((w[0] * w[0] + w[1] * w[1]).sqrt(), w[2]);
     let phi_w = w[1].atan2(w[0]);
     // The model's polar kinks θ_k, as elevations π/2 − θ_k.
-    let kinks: Vec<f64> = theta_kinks(spec).iter().map(|k| FRAC_PI_2 - k).collect();
+    let kinks: Vec<f64> = subject
+        .theta_kinks()
+        .iter()
+        .map(|k| FRAC_PI_2 - k)
+        .collect();
     let evaluations = std::cell::Cell::new(0u64);
     let inner_error = std::cell::Cell::new(0.0f64);
     let inner = |psi: f64| {
@@ -197,11 +186,7 @@ fn lambda_oracle_lune(model: &dyn Model, spec: &Value, w: Vec3) -> Estimate {
 
 /// Directions (θ, φ) at which direction-dependent checks run: the profile's θ grid, along x
 /// and, for anisotropic models, along a second azimuth.
-pub fn directions(spec: &Value, profile: Profile, theta_max: f64) -> Vec<(f64, f64)> {
-    let anisotropic = spec.get("alpha_x").is_some()
-        || spec.get("y").is_some()
-        || spec.get("cov").is_some()
-        || spec.get("mean").is_some();
+pub fn directions(anisotropic: bool, profile: Profile, theta_max: f64) -> Vec<(f64, f64)> {
     let phis: &[f64] = if anisotropic { &[0.0, 2.2] } else { &[0.0] };
     let mut out = Vec::new();
     for t in profile.thetas(theta_max) {
@@ -213,24 +198,33 @@ pub fn directions(spec: &Value, profile: Profile, theta_max: f64) -> Vec<(f64, f
 }
 
 /// Plans the Smith checks of one model.
-pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) -> Vec<Planned> {
-    let Some(smith) = model.as_smith() else {
+pub fn plan<'a>(
+    subject: &Arc<Subject<'a>>,
+    profile: Profile,
+    theta_max: f64,
+    why: &str,
+) -> Vec<PlannedCheck<'a>> {
+    let Some(smith) = subject.model.as_smith() else {
         return Vec::new();
     };
-    let spec = serde_json::to_value(model.spec()).unwrap_or(Value::Null);
-    let family = model.family();
+    let family = subject.family();
+    let spec = subject.label.clone();
     let mut out = Vec::new();
     // One oracle per direction, shared by every route checked there (computed by whichever
     // route check runs first; the others wait for it).
-    let oracles: Vec<((f64, f64), SharedOracle)> = directions(&spec, profile, theta_max)
-        .into_iter()
-        .map(|d| (d, Arc::new(OnceLock::new())))
-        .collect();
+    let oracles: Vec<((f64, f64), SharedOracle)> = directions(
+        subject.hints.anisotropic.unwrap_or(true),
+        profile,
+        theta_max,
+    )
+    .into_iter()
+    .map(|d| (d, Arc::new(OnceLock::new())))
+    .collect();
     for route in smith.lambda_routes() {
         for ((theta, phi), memo) in oracles.iter().cloned() {
             let case = json!({"route": route, "theta": theta, "phi": phi});
-            let (m, spec_run, case_run) = (model.clone(), spec.clone(), case.clone());
-            out.push(Planned {
+            let (m, spec_run, case_run) = (subject.clone(), spec.clone(), case.clone());
+            out.push(PlannedCheck {
                 check: "smith.lambda_route".into(),
                 model: spec.clone(),
                 case,
@@ -247,8 +241,14 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                         );
                         r.covers = vec![covers(family, "lambda", route)];
                         let w = from_spherical(theta, phi);
-                        let smith = m.as_smith().expect("planned for Smith models");
-                        let value = match smith.lambda_route(w, route) {
+                        let smith = m.model.as_smith().expect("planned for Smith models");
+                        // The default route is the method a renderer calls (and G1, G2 use).
+                        let value = if route == "default" {
+                            Ok(smith.lambda(w))
+                        } else {
+                            smith.lambda_route(w, route)
+                        };
+                        let value = match value {
                             Ok(v) => v,
                             Err(e) => {
                                 r.verdict = Verdict::Skipped {
@@ -257,13 +257,12 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                                 return r;
                             }
                         };
-                        let oracle = *memo.get_or_init(|| lambda_oracle(m.as_ref(), &spec_run, w));
-                        let tol =
-                            if numerical_default(family) && matches!(route, "default" | "exact") {
-                                &NUMERICAL_ROUTE
-                            } else {
-                                &CLOSED_FORM
-                            };
+                        let oracle = *memo.get_or_init(|| lambda_oracle_for(&m, w));
+                        let tol = if m.lambda_numerical() && matches!(route, "default" | "exact") {
+                            &NUMERICAL_ROUTE
+                        } else {
+                            &CLOSED_FORM
+                        };
                         compare(&mut r, value, oracle, tol);
                         apply_expected(&mut r, family, route);
                         r
@@ -275,8 +274,8 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
     // The weak white furnace at two incidences.
     for theta in [0.6, 1.3].into_iter().filter(|t| *t <= theta_max) {
         let case = json!({"theta": theta, "phi": 0.4});
-        let (m, spec_run, case_run) = (model.clone(), spec.clone(), case.clone());
-        out.push(Planned {
+        let (m, spec_run, case_run) = (subject.clone(), spec.clone(), case.clone());
+        out.push(PlannedCheck {
             check: "smith.white_furnace".into(),
             model: spec.clone(),
             case,
@@ -294,12 +293,12 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                     );
                     r.covers = vec![covers(family, "g1", "default")];
                     let w = from_spherical(theta, 0.4);
-                    let smith = m.as_smith().expect("planned for Smith models");
+                    let smith = m.model.as_smith().expect("planned for Smith models");
                     // G1(w, m) = χ⁺(w·m) G1(w, n) (eq 16): its m-dependence is the indicator,
                     // which `smith.identities` checks; evaluating G1 (a quadrature for GTR and
                     // the piecewise-linear NDF) once keeps it out of the integrand.
                     let g1 = smith.g1(w, [0.0, 0.0, 1.0]);
-                    let kinks = theta_kinks(&spec_run);
+                    let kinks = m.theta_kinks();
                     let phis = terminator_azimuths(w, &kinks);
                     let theta_cut = terminator(w, kinks);
                     let p = projection(w);
@@ -309,19 +308,19 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                             if theta_m < theta_t {
                                 g1 * rr
                                     * (theta_t - theta_m).sin()
-                                    * m.d(from_spherical(theta_m, phi_m))
+                                    * m.model.d(from_spherical(theta_m, phi_m))
                             } else {
                                 0.0
                             }
                         },
-                        lobe_width(&spec_run),
+                        m.lobe().width,
                         Some(Cuts {
                             theta: &theta_cut,
                             phi: &phis,
                         }),
                         Accuracy::relative(1e-11),
                     );
-                    let tol = if numerical_default(family) {
+                    let tol = if m.lambda_numerical() {
                         &NUMERICAL_ROUTE
                     } else {
                         &CLOSED_FORM
@@ -330,7 +329,7 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                     // microsurface is tilted, ∫ m D dm ≠ n, and the constraint becomes
                     // G1 (∫⟨w·m⟩⁺D dm + sin θ q̄) = cos θ: in slope space ∫⟨w·m⟩⁺D dm =
                     // sin θ ∫_{−∞}^{μ}(μ − q)P2 dq = cos θ (1 + Λ) − sin θ q̄ (μ = cot θ).
-                    let q_bar = mean_slope(&spec_run, 0.4);
+                    let q_bar = mean_slope(&m, 0.4);
                     // The closed form enters through G1; the integral is the value under test and
                     // its quadrature error bound is the slack `compare` grants.
                     compare(
@@ -344,15 +343,94 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
             }),
         });
     }
+    // G1 and both G2 forms through the methods a renderer calls, against G1 = 1/(1 + Λ) and
+    // G2 = G1·G1 (eq 22) or 1/(1 + Λo + Λi) (eq 23) from the oracle's Λ.
+    let pairs = [
+        ((0.5, 0.0), (1.2, 2.0)),
+        ((1e-3, 0.0), (super::NEAR_GRAZING, 1.0)),
+        ((1.5, 0.3), (1.5, 3.0)),
+    ];
+    for ((to, po), (ti, pi)) in pairs {
+        if to > theta_max || ti > theta_max {
+            continue;
+        }
+        for quantity in ["g1", "g2_uncorrelated", "g2_height_correlated"] {
+            let case = json!({"quantity": quantity, "theta_o": to, "phi_o": po, "theta_i": ti, "phi_i": pi});
+            let (m, spec_run, case_run) = (subject.clone(), spec.clone(), case.clone());
+            let covered = vec![match quantity {
+                "g1" => covers(family, "g1", "default"),
+                "g2_uncorrelated" => covers(family, "g2", "uncorrelated"),
+                _ => covers(family, "g2", "height_correlated"),
+            }];
+            let covered_run = covered.clone();
+            out.push(PlannedCheck {
+                check: "smith.g1_g2".into(),
+                model: spec.clone(),
+                case,
+                why: format!("{why}: {quantity} against the oracle's Λ"),
+                covers: covered,
+                statistical: false,
+                run: Box::new(move |_| {
+                    timed(|| {
+                        let mut r = CheckRecord::new(
+                            "smith.g1_g2",
+                            spec_run.clone(),
+                            case_run.clone(),
+                            "seed 001 eq 16 (G1 = 1/(1 + Λ)), eq 22 (uncorrelated G2), eq 23 \
+                             (height-correlated G2)",
+                        );
+                        r.covers = covered_run.clone();
+                        let smith = m.model.as_smith().expect("planned for Smith models");
+                        let (wo, wi) = (from_spherical(to, po), from_spherical(ti, pi));
+                        let n = [0.0, 0.0, 1.0];
+                        let (lo, li) = (lambda_oracle_for(&m, wo), lambda_oracle_for(&m, wi));
+                        let (go, gi) = (1.0 / (1.0 + lo.value), 1.0 / (1.0 + li.value));
+                        let (value, want, bound) = match quantity {
+                            "g1" => (smith.g1(wo, n), go, lo.error_bound * go * go),
+                            "g2_uncorrelated" => (
+                                smith.g2(wo, wi, n, Masking::Uncorrelated),
+                                go * gi,
+                                (lo.error_bound + li.error_bound) * go * gi,
+                            ),
+                            _ => {
+                                let g = 1.0 / (1.0 + lo.value + li.value);
+                                (
+                                    smith.g2(wo, wi, n, Masking::HeightCorrelated),
+                                    g,
+                                    (lo.error_bound + li.error_bound) * g * g,
+                                )
+                            }
+                        };
+                        let tol = if m.lambda_numerical() {
+                            &NUMERICAL_ROUTE
+                        } else {
+                            &CLOSED_FORM
+                        };
+                        compare(
+                            &mut r,
+                            value,
+                            Estimate {
+                                value: want,
+                                error_bound: bound,
+                                evaluations: lo.evaluations + li.evaluations,
+                            },
+                            tol,
+                        );
+                        r
+                    })
+                }),
+            });
+        }
+    }
     // Identities over a grid of directions.
-    let (m, spec_run) = (model.clone(), spec.clone());
+    let (m, spec_run) = (subject.clone(), spec.clone());
     let covered = vec![
         covers(family, "g1", "default"),
         covers(family, "g2", "uncorrelated"),
         covers(family, "g2", "height_correlated"),
     ];
     let covered_run = covered.clone();
-    out.push(Planned {
+    out.push(PlannedCheck {
         check: "smith.identities".into(),
         model: spec.clone(),
         case: json!({"grid": "θ ∈ {0, …, π/2} × φ ∈ {0, 1, 2.5, 4}"}),
@@ -368,7 +446,7 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                     "Heitz 2014 §5.2 (Λ(−w) = −1 − Λ(w)); seed 001 eq 16, 22, 23",
                 );
                 r.covers = covered_run.clone();
-                let smith = m.as_smith().expect("planned for Smith models");
+                let smith = m.model.as_smith().expect("planned for Smith models");
                 let mut worst = 0.0f64;
                 let mut what = String::new();
                 let mut note = |v: f64, label: String| {

@@ -77,6 +77,19 @@ impl Ndf for Beckmann {
         }
         e / (PI * self.alpha_x * self.alpha_y * z2 * z2)
     }
+
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        Some(self)
+    }
+    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+        Some(self)
+    }
+    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
+        Some(self)
+    }
+    fn as_visible_sampler(&self) -> Option<&dyn VisibleNormalSampler> {
+        Some(self)
+    }
 }
 
 impl Smith for Beckmann {
@@ -239,23 +252,29 @@ impl Model for Beckmann {
             .map(ModelSpec::family)
             .unwrap_or("beckmann")
     }
-
-    fn as_smith(&self) -> Option<&dyn Smith> {
-        Some(self)
-    }
-
-    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
-        Some(self)
-    }
-
-    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
-        Some(self)
-    }
-
-    fn as_visible_sampler(&self) -> Option<&dyn VisibleNormalSampler> {
-        Some(self)
-    }
 }
+
+/// The registry entry of beckmann ([`crate::registry`]).
+pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+    name: "beckmann",
+    documents: &["001"],
+    source: "seed 001 Table 1 (γ → ∞)",
+    domain: "α (or α_x, α_y) finite and > 0",
+    examples: &[
+        r#"{"family": "beckmann", "alpha": 0.3}"#,
+        r#"{"family": "beckmann", "alpha_x": 0.1, "alpha_y": 0.4}"#,
+    ],
+    stress_alpha: &[1e-4, 10.0],
+    stress_gamma: &[],
+    stress_specs: &[],
+    lambda_numerical: false,
+    slow_sampler: false,
+    beckmann_limit: false,
+    intrinsic_moments: false,
+    tail_exponent: crate::registry::no_tail,
+    theta_kinks: crate::registry::no_kinks,
+    mean_slope: crate::registry::zero_mean,
+};
 
 #[cfg(test)]
 mod tests {

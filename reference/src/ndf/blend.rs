@@ -122,6 +122,10 @@ impl Ndf for Blend {
         };
         self.kx * c2 * self.x.d(iso) + self.ky * s2 * self.y.d(iso)
     }
+
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        Some(self)
+    }
 }
 
 impl Smith for Blend {
@@ -158,10 +162,39 @@ impl Model for Blend {
     fn family(&self) -> &'static str {
         "blend"
     }
+}
 
-    fn as_smith(&self) -> Option<&dyn Smith> {
-        Some(self)
-    }
+/// The registry entry of the blend of seed 000 eq 1 ([`crate::registry`]).
+pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+    name: "blend",
+    documents: &["000"],
+    source: "seed 000 eq 1 (two isotropic NDFs)",
+    domain: "x, y: isotropic model specs",
+    examples: &[
+        r#"{"family": "blend", "x": {"family": "ggx", "alpha": 0.2}, "y": {"family": "beckmann", "alpha": 0.4}}"#,
+    ],
+    stress_alpha: &[],
+    stress_gamma: &[],
+    stress_specs: &[],
+    lambda_numerical: true,
+    slow_sampler: false,
+    beckmann_limit: false,
+    intrinsic_moments: false,
+    tail_exponent: crate::registry::no_tail,
+    theta_kinks: blend_kinks,
+    mean_slope: crate::registry::zero_mean,
+};
+
+/// The kinks of a blend: those of its two models.
+pub fn blend_kinks(spec: &crate::ModelSpec) -> Vec<f64> {
+    let crate::ModelSpec::Blend { x, y } = spec else {
+        return Vec::new();
+    };
+    let mut out = (crate::registry::info(x).theta_kinks)(x);
+    out.extend((crate::registry::info(y).theta_kinks)(y));
+    out.sort_by(f64::total_cmp);
+    out.dedup();
+    out
 }
 
 #[cfg(test)]

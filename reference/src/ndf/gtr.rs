@@ -203,6 +203,16 @@ impl Ndf for Gtr {
         let t = m[0] * m[0] + m[1] * m[1] + self.a2 * mz * mz;
         self.c * t.powf(-self.gamma)
     }
+
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        Some(self)
+    }
+    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+        Some(self)
+    }
+    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
+        Some(self)
+    }
 }
 
 impl Smith for Gtr {
@@ -313,19 +323,26 @@ impl Model for Gtr {
     fn family(&self) -> &'static str {
         "gtr"
     }
-
-    fn as_smith(&self) -> Option<&dyn Smith> {
-        Some(self)
-    }
-
-    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
-        Some(self)
-    }
-
-    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
-        Some(self)
-    }
 }
+
+/// The registry entry of gtr ([`crate::registry`]).
+pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+    name: "gtr",
+    documents: &["004"],
+    source: "seed 004 §2 (Burley 2012 GTR), Smith G1 of seed 004",
+    domain: "0 ≤ γ ≤ 10, 1e-4 ≤ α ≤ 1",
+    examples: &[r#"{"family": "gtr", "gamma": 1.5, "alpha": 0.3}"#],
+    stress_alpha: &[1e-4, 0.999],
+    stress_gamma: &[1e-6, 10.0],
+    stress_specs: &[],
+    lambda_numerical: true,
+    slow_sampler: false,
+    beckmann_limit: false,
+    intrinsic_moments: false,
+    tail_exponent: crate::registry::no_tail,
+    theta_kinks: crate::registry::no_kinks,
+    mean_slope: crate::registry::zero_mean,
+};
 
 #[cfg(test)]
 mod tests {

@@ -247,6 +247,16 @@ impl Ndf for Student {
         let ln = -self.c * t.ln_1p() - 2.0 * z2.ln();
         self.p22_norm * ln.exp()
     }
+
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        (self.c > 1.5).then_some(self as &dyn Smith)
+    }
+    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+        Some(self)
+    }
+    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
+        Some(self)
+    }
 }
 
 impl Smith for Student {
@@ -345,17 +355,97 @@ impl Model for Student {
     fn family(&self) -> &'static str {
         member_family(self.member)
     }
+}
 
-    fn as_smith(&self) -> Option<&dyn Smith> {
-        (self.c > 1.5).then_some(self as &dyn Smith)
-    }
+/// The registry entry of STD ([`crate::registry`]).
+pub const STD_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+    name: "std",
+    documents: &["001"],
+    source: "seed 001 eq 1–7 (f = 1/(γ−1)), Table 1",
+    domain: "γ > 1 (Λ needs γ > 3/2), or \"inf\" (Beckmann); α finite and > 0",
+    examples: &[
+        r#"{"family": "std", "gamma": 2.5, "alpha_x": 0.1, "alpha_y": 0.4}"#,
+        r#"{"family": "std", "gamma": "inf", "alpha": 0.3}"#,
+    ],
+    stress_alpha: &[1e-4, 10.0],
+    stress_gamma: &[1.5 + 1e-9, 1e8],
+    stress_specs: &[],
+    lambda_numerical: false,
+    slow_sampler: false,
+    beckmann_limit: true,
+    intrinsic_moments: false,
+    tail_exponent: student_tail_exponent,
+    theta_kinks: crate::registry::no_kinks,
+    mean_slope: crate::registry::zero_mean,
+};
 
-    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
-        Some(self)
-    }
+/// The registry entry of Hyper-Cauchy ([`crate::registry`]).
+pub const HYPER_CAUCHY_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+    name: "hyper_cauchy",
+    documents: &["001"],
+    source: "seed 001 eq 8 (f = 1)",
+    domain: "γ > 1 (Λ needs γ > 3/2); α finite and > 0",
+    examples: &[r#"{"family": "hyper_cauchy", "gamma": 3, "alpha_x": 0.2, "alpha_y": 0.5}"#],
+    stress_alpha: &[1e-4, 10.0],
+    stress_gamma: &[1.5 + 1e-9, 1e8],
+    stress_specs: &[],
+    lambda_numerical: false,
+    slow_sampler: false,
+    beckmann_limit: false,
+    intrinsic_moments: false,
+    tail_exponent: student_tail_exponent,
+    theta_kinks: crate::registry::no_kinks,
+    mean_slope: crate::registry::zero_mean,
+};
 
-    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
-        Some(self)
+/// The registry entry of the fixed-variance Student member ([`crate::registry`]).
+pub const FIXED_VARIANCE_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+    name: "student_fixed_variance",
+    documents: &["001"],
+    source: "seed 001 eq 9 (f = 1/(γ−2))",
+    domain: "γ > 2, or \"inf\" (Beckmann); α finite and > 0",
+    examples: &[r#"{"family": "student_fixed_variance", "gamma": 4, "alpha": 0.3}"#],
+    stress_alpha: &[1e-4, 10.0],
+    stress_gamma: &[2.0 + 1e-9, 1e8],
+    stress_specs: &[],
+    lambda_numerical: false,
+    slow_sampler: false,
+    beckmann_limit: false,
+    intrinsic_moments: false,
+    tail_exponent: student_tail_exponent,
+    theta_kinks: crate::registry::no_kinks,
+    mean_slope: crate::registry::zero_mean,
+};
+
+/// The registry entry of the general Student family ([`crate::registry`]).
+pub const GENERAL_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+    name: "student_general",
+    documents: &["001"],
+    source: "seed 001 eq 1–2 (D^G(B, C))",
+    domain: "B > 0, C > 1 (Λ needs C > 3/2)",
+    examples: &[r#"{"family": "student_general", "b": 4, "c": 2.5}"#],
+    stress_alpha: &[],
+    stress_gamma: &[],
+    stress_specs: &[],
+    lambda_numerical: false,
+    slow_sampler: false,
+    beckmann_limit: false,
+    intrinsic_moments: false,
+    tail_exponent: student_tail_exponent,
+    theta_kinks: crate::registry::no_kinks,
+    mean_slope: crate::registry::zero_mean,
+};
+
+/// The exponent C of the slope marginal of a Student-family spec: γ for STD and Hyper-Cauchy
+/// and the fixed-variance member (seed 001 eq 7–9), `c` for the general member (eq 2).
+pub fn student_tail_exponent(spec: &crate::ModelSpec) -> Option<f64> {
+    use crate::ModelSpec as S;
+    match *spec {
+        S::Std { gamma, .. }
+        | S::HyperCauchy { gamma, .. }
+        | S::StudentFixedVariance { gamma, .. } => Some(gamma).filter(|g| g.is_finite()),
+        S::StudentGeneral { c, .. } => Some(c),
+        _ => None,
     }
 }
 

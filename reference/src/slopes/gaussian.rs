@@ -232,6 +232,16 @@ impl Ndf for GaussianSlopes {
         let z2 = mz * mz;
         p / (z2 * z2)
     }
+
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        Some(self)
+    }
+    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
+        Some(self)
+    }
+    fn as_visible_moments(&self) -> Option<&dyn VisibleSlopeMoments> {
+        Some(self)
+    }
 }
 
 impl Smith for GaussianSlopes {
@@ -343,18 +353,6 @@ impl Model for GaussianSlopes {
 
     fn family(&self) -> &'static str {
         "gaussian_slopes"
-    }
-
-    fn as_smith(&self) -> Option<&dyn Smith> {
-        Some(self)
-    }
-
-    fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
-        Some(self)
-    }
-
-    fn as_visible_moments(&self) -> Option<&dyn VisibleSlopeMoments> {
-        Some(self)
     }
 }
 
@@ -601,3 +599,35 @@ impl Cov2 {
 #[cfg(test)]
 #[path = "gaussian_tests.rs"]
 mod tests;
+
+/// The registry entry of Gaussian slopes ([`crate::registry`]).
+pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+    name: "gaussian_slopes",
+    documents: &["002"],
+    source: "seed 002 eq 1 (slope sign of eq 11)",
+    domain: "mean finite; cov symmetric positive definite",
+    examples: &[
+        r#"{"family": "gaussian_slopes", "mean": [0.1, -0.05], "cov": [[0.04, 0.01], [0.01, 0.09]]}"#,
+    ],
+    stress_alpha: &[],
+    stress_gamma: &[],
+    stress_specs: &[(
+        "cov correlation 1 − 1e-9",
+        r#"{"family": "gaussian_slopes", "mean": [0.1, -0.05], "cov": [[0.04, 0.03999999996], [0.03999999996, 0.04]]}"#,
+    )],
+    lambda_numerical: false,
+    slow_sampler: false,
+    beckmann_limit: false,
+    intrinsic_moments: true,
+    tail_exponent: crate::registry::no_tail,
+    theta_kinks: crate::registry::no_kinks,
+    mean_slope: spec_mean,
+};
+
+/// The mean slope of a Gaussian-slopes spec.
+pub fn spec_mean(spec: &crate::ModelSpec) -> [f64; 2] {
+    match spec {
+        crate::ModelSpec::GaussianSlopes { mean, .. } => *mean,
+        _ => [0.0, 0.0],
+    }
+}

@@ -1,0 +1,214 @@
+//! The CI gate for a renderer's own model: `Audit::of(&model)` plans the checks its
+//! capabilities and declared effects call for, optionally compares it value by value with a
+//! reference spec, runs them, and returns the same report as `mfh audit`.
+//!
+//! ```
+//! use mfh_harness::{Audit, Profile};
+//! use mfh_reference::ndf::Ggx;
+//! let ggx = Ggx::new(0.3, 0.3).unwrap();
+//! Audit::of(&ggx)
+//!     .profile(Profile::Ci)
+//!     .against(r#"{"family":"ggx","alpha":0.3}"#)
+//!     .run()
+//!     .assert_pass();
+//! ```
+
+use crate::audit::{run_plan, AuditOptions, AuditReport};
+use crate::check::{against, PlannedCheck, Profile};
+use crate::oracle::chi2::DEFAULT_SEED;
+use crate::plan::{plan_model, Effects};
+use crate::record::{CheckRecord, Verdict};
+use crate::scene::Sampling;
+use crate::subject::{Hints, Subject};
+use mfh_reference::{Masking, ModelSpec, Ndf};
+use serde_json::json;
+use std::f64::consts::FRAC_PI_2;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// An audit of one model, configured by its builder methods and carried out by [`Audit::run`].
+pub struct Audit<'a> {
+    model: Arc<dyn Ndf + 'a>,
+    name: String,
+    hints: Hints,
+    options: AuditOptions,
+    masking: Option<Option<Masking>>,
+    sampling: Option<Option<Sampling>>,
+    slope_moments: bool,
+    theta_max: f64,
+    against: Option<String>,
+}
+
+impl<'a> Audit<'a> {
+    /// An audit of `model`: by default every capability it has is audited (masking checked in
+    /// both G2 forms, normal sampling, visible-normal sampling where it has that), at the quick
+    /// profile, with the default seed (`MFH_SEED` overrides it).
+    pub fn of<M: Ndf + 'a>(model: &'a M) -> Self {
+        let seed = std::env::var("MFH_SEED")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(DEFAULT_SEED);
+        Self {
+            model: Arc::new(model),
+            name: std::any::type_name::<M>().to_string(),
+            hints: Hints::default(),
+            options: AuditOptions {
+                profile: Profile::Quick,
+                seed,
+                out: None,
+            },
+            masking: None,
+            sampling: None,
+            slope_moments: false,
+            theta_max: FRAC_PI_2,
+            against: None,
+        }
+    }
+
+    /// The name records give the model (default: its Rust type name).
+    pub fn name(mut self, name: &str) -> Self {
+        self.name = name.to_string();
+        self
+    }
+
+    /// The profile (default quick; `Profile::Ci` is sized for one model in CI).
+    pub fn profile(mut self, profile: Profile) -> Self {
+        self.options.profile = profile;
+        self
+    }
+
+    /// The audit seed.
+    pub fn seed(mut self, seed: u64) -> Self {
+        self.options.seed = seed;
+        self
+    }
+
+    /// What is known of the model's lobe, to speed the oracles up (never needed).
+    pub fn hint(mut self, hints: Hints) -> Self {
+        self.hints = hints;
+        self
+    }
+
+    /// The G2 form the renderer uses (None: it does not mask; default: checked if the model
+    /// has Smith masking).
+    pub fn masking(mut self, masking: Option<Masking>) -> Self {
+        self.masking = Some(masking);
+        self
+    }
+
+    /// How the renderer samples (None: it does not; default: normals if the model has a
+    /// sampler, visible normals too if it has a visible-normal sampler).
+    pub fn sampling(mut self, sampling: Option<Sampling>) -> Self {
+        self.sampling = Some(sampling);
+        self
+    }
+
+    /// Whether the renderer filters with slope moments (needs the slope capability).
+    pub fn slope_moments(mut self, on: bool) -> Self {
+        self.slope_moments = on;
+        self
+    }
+
+    /// The largest incidence the renderer evaluates (radians, default π/2).
+    pub fn theta_max(mut self, theta_max: f64) -> Self {
+        self.theta_max = theta_max;
+        self
+    }
+
+    /// Also compare the model value by value with the reference closed forms of `spec`
+    /// (JSON, e.g. `{"family":"ggx","alpha":0.3}`).
+    pub fn against(mut self, spec: &str) -> Self {
+        self.against = Some(spec.to_string());
+        self
+    }
+
+    /// Where reports' artefacts go (chi-square tables, heat maps).
+    pub fn out(mut self, dir: impl Into<PathBuf>) -> Self {
+        self.options.out = Some(dir.into());
+        self
+    }
+
+    /// The effects the plan follows: the declared ones, else what the capabilities allow.
+    pub fn effects(&self) -> Effects {
+        let m = &self.model;
+        Effects {
+            masking: self
+                .masking
+                .unwrap_or_else(|| m.as_smith().is_some().then_some(Masking::HeightCorrelated)),
+            sampling: self.sampling.unwrap_or_else(|| {
+                if m.as_visible_sampler().is_some() {
+                    Some(Sampling::VisibleNormals)
+                } else {
+                    m.as_sampler().is_some().then_some(Sampling::Normals)
+                }
+            }),
+            slope_moments: self.slope_moments,
+            theta_max: self.theta_max,
+        }
+    }
+
+    /// The planned checks, each with the reason it is planned, and any configuration error as
+    /// a record that fails.
+    pub fn plan(&self) -> (Vec<PlannedCheck<'a>>, Vec<CheckRecord>) {
+        let subject = Subject::user(self.model.clone(), &self.name, self.hints.clone());
+        let why = format!("model `{}`", self.name);
+        let mut errors = Vec::new();
+        if !(self.theta_max > 0.0 && self.theta_max <= FRAC_PI_2) {
+            errors.push(config_error(
+                &subject.label,
+                format!("theta_max = {} is outside (0, π/2]", self.theta_max),
+            ));
+        }
+        let effects = self.effects();
+        let mut plan = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            plan_model(&subject, &effects, self.options.profile, &why)
+        }))
+        .unwrap_or_else(|_| {
+            errors.push(config_error(
+                &subject.label,
+                "the model panicked while the audit was planned".into(),
+            ));
+            Vec::new()
+        });
+        if let Some(text) = &self.against {
+            match serde_json::from_str::<ModelSpec>(text)
+                .map_err(|e| e.to_string())
+                .and_then(|s| s.build().map(|_| s).map_err(|e| e.to_string()))
+            {
+                Ok(spec) => plan.extend(against::plan(&subject, &spec, &why)),
+                Err(e) => errors.push(config_error(
+                    &subject.label,
+                    format!("against: the reference spec {text} is invalid: {e}"),
+                )),
+            }
+        }
+        (plan, errors)
+    }
+
+    /// Runs the audit.
+    pub fn run(&self) -> AuditReport {
+        let t = Instant::now();
+        let (plan, mut errors) = self.plan();
+        let (mut records, k, alpha) = run_plan(&plan, &self.options);
+        records.append(&mut errors);
+        let command = format!(
+            "MFH_SEED={} cargo test (Audit::of({}).profile(Profile::{:?}))",
+            self.options.seed, self.name, self.options.profile
+        );
+        AuditReport::from_records(
+            self.name.clone(),
+            &self.options,
+            command,
+            records,
+            (k, alpha),
+            t.elapsed().as_secs_f64(),
+        )
+    }
+}
+
+fn config_error(model: &serde_json::Value, message: String) -> CheckRecord {
+    let mut r = CheckRecord::new("audit.configuration", model.clone(), json!({}), "");
+    r.verdict = Verdict::Error { message };
+    r
+}

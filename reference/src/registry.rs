@@ -1,0 +1,130 @@
+//! The family registry: everything the harness knows about a family of reference models, in one
+//! place. Each family's own file declares its [`FamilyInfo`]; [`FAMILIES`] lists them, and
+//! [`info`] maps a spec to its entry (an exhaustive match: a new `ModelSpec` variant without a
+//! registry entry does not compile). Planners, tests, the default scene's coverage test, the
+//! eval contract and the value-stability vectors iterate this registry, so no list of family
+//! names is written anywhere else.
+
+use crate::spec::ModelSpec;
+
+/// What the harness knows about one family of reference models.
+#[derive(Debug, Clone, Copy)]
+pub struct FamilyInfo {
+    /// The family name, as in specs (`"family": "ggx"`).
+    pub name: &'static str,
+    /// The source documents (seed ids, `../shared/seeds/`) the family's closed forms come from.
+    pub documents: &'static [&'static str],
+    /// Where in the documents the family is defined.
+    pub source: &'static str,
+    /// The parameter domain, as accepted at construction.
+    pub domain: &'static str,
+    /// Example specs (JSON), isotropic and anisotropic where the family has both; the
+    /// value-stability vectors and the eval contract iterate them.
+    pub examples: &'static [&'static str],
+    /// Roughness values at the ends of the domain for the stability checks (replacing the
+    /// material's α), empty where the family has no α.
+    pub stress_alpha: &'static [f64],
+    /// Shape values γ at the ends of the domain for the stability checks, empty where the
+    /// family has no γ.
+    pub stress_gamma: &'static [f64],
+    /// Whole specs at hard points of the domain (e.g. a near-singular covariance).
+    pub stress_specs: &'static [(&'static str, &'static str)],
+    /// Whether the default Λ is itself a numerical integral (its tolerance is the numerical
+    /// route's, not the closed form's).
+    pub lambda_numerical: bool,
+    /// Whether `sample_wm` inverts a CDF numerically (tens of µs a sample): statistical checks
+    /// that scale with the sample count take fewer samples.
+    pub slow_sampler: bool,
+    /// Whether the family tends to Beckmann as γ → ∞ (seed 001 §4), which the limit check
+    /// measures.
+    pub beckmann_limit: bool,
+    /// Whether slope moments are part of the model itself (not only of Gaussian-slope
+    /// filtering), so that they are always checked.
+    pub intrinsic_moments: bool,
+    /// The exponent C of the Student-t slope marginal (P2 ∝ (1 + q²/…)^(−C)), where the family
+    /// has one: heavy tails (C near 3/2) need an oracle that does not integrate the tail.
+    pub tail_exponent: fn(&ModelSpec) -> Option<f64>,
+    /// The polar angles where D has kinks for every azimuth (piecewise-linear profiles), for
+    /// quadrature cuts. A hint: oracles converge without it, only slower.
+    pub theta_kinks: fn(&ModelSpec) -> Vec<f64>,
+    /// The mean slope (s̄x, s̄y) of the slope distribution (non-zero only for Gaussian slopes
+    /// with a mean, seed 002).
+    pub mean_slope: fn(&ModelSpec) -> [f64; 2],
+}
+
+/// No tail exponent.
+pub fn no_tail(_: &ModelSpec) -> Option<f64> {
+    None
+}
+
+/// No kinks.
+pub fn no_kinks(_: &ModelSpec) -> Vec<f64> {
+    Vec::new()
+}
+
+/// A zero mean slope.
+pub fn zero_mean(_: &ModelSpec) -> [f64; 2] {
+    [0.0, 0.0]
+}
+
+/// Every family, in the order reports list them.
+pub const FAMILIES: [&FamilyInfo; 10] = [
+    &crate::ndf::beckmann::INFO,
+    &crate::ndf::ggx::INFO,
+    &crate::ndf::student::STD_INFO,
+    &crate::ndf::student::HYPER_CAUCHY_INFO,
+    &crate::ndf::student::FIXED_VARIANCE_INFO,
+    &crate::ndf::student::GENERAL_INFO,
+    &crate::ndf::gtr::INFO,
+    &crate::ndf::piecewise::INFO,
+    &crate::ndf::blend::INFO,
+    &crate::slopes::gaussian::INFO,
+];
+
+/// The registry entry of a spec's family.
+pub fn info(spec: &ModelSpec) -> &'static FamilyInfo {
+    match spec {
+        ModelSpec::Beckmann { .. } => &crate::ndf::beckmann::INFO,
+        ModelSpec::Ggx { .. } => &crate::ndf::ggx::INFO,
+        ModelSpec::Std { .. } => &crate::ndf::student::STD_INFO,
+        ModelSpec::HyperCauchy { .. } => &crate::ndf::student::HYPER_CAUCHY_INFO,
+        ModelSpec::StudentFixedVariance { .. } => &crate::ndf::student::FIXED_VARIANCE_INFO,
+        ModelSpec::StudentGeneral { .. } => &crate::ndf::student::GENERAL_INFO,
+        ModelSpec::Gtr { .. } => &crate::ndf::gtr::INFO,
+        ModelSpec::PiecewiseLinear { .. } => &crate::ndf::piecewise::INFO,
+        ModelSpec::Blend { .. } => &crate::ndf::blend::INFO,
+        ModelSpec::GaussianSlopes { .. } => &crate::slopes::gaussian::INFO,
+    }
+}
+
+/// The registry entry of a family name.
+pub fn by_name(name: &str) -> Option<&'static FamilyInfo> {
+    FAMILIES.iter().copied().find(|f| f.name == name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every family's examples parse, build, and belong to the family that lists them; names
+    /// are unique; every family has an example.
+    #[test]
+    fn the_registry_is_consistent() {
+        let mut names = std::collections::BTreeSet::new();
+        for f in FAMILIES {
+            assert!(names.insert(f.name), "{} twice", f.name);
+            assert!(!f.examples.is_empty(), "{} has no example", f.name);
+            assert!(!f.documents.is_empty(), "{} cites no document", f.name);
+            for e in f
+                .examples
+                .iter()
+                .chain(f.stress_specs.iter().map(|(_, s)| s))
+            {
+                let spec: ModelSpec = serde_json::from_str(e).expect(e);
+                assert_eq!(spec.family(), f.name, "{e}");
+                assert_eq!(info(&spec).name, f.name, "{e}");
+                spec.build().unwrap_or_else(|err| panic!("{e}: {err}"));
+            }
+        }
+    }
+}
