@@ -215,18 +215,7 @@ mod tests {
         let s = Scene::default_scene();
         let families: std::collections::BTreeSet<_> =
             s.materials.iter().map(|m| m.model.family()).collect();
-        for f in [
-            "beckmann",
-            "ggx",
-            "std",
-            "hyper_cauchy",
-            "student_fixed_variance",
-            "student_general",
-            "gtr",
-            "piecewise_linear",
-            "blend",
-            "gaussian_slopes",
-        ] {
+        for f in mfh_reference::registry::FAMILIES.iter().map(|f| f.name) {
             assert!(families.contains(f), "{f} missing from the default scene");
         }
         assert!(s.lighting.spherical_gaussians && s.filtering.gaussian_slopes);

@@ -75,9 +75,9 @@ pub const FAMILIES: [&FamilyInfo; 10] = [
     &crate::ndf::student::HYPER_CAUCHY_INFO,
     &crate::ndf::student::FIXED_VARIANCE_INFO,
     &crate::ndf::student::GENERAL_INFO,
-    &crate::ndf::gtr::INFO,
     &crate::ndf::piecewise::INFO,
     &crate::ndf::blend::INFO,
+    &crate::ndf::gtr::INFO,
     &crate::slopes::gaussian::INFO,
 ];
 

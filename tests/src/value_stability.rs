@@ -35,26 +35,14 @@ fn profile_y() -> Value {
     json!({"theta": [0.0, 0.5, 1.0, FRAC_PI_2], "value": [1.5, 1.2, 0.3, 0.05]})
 }
 
-/// The model specs of the vectors, one or two per family.
+/// The model specs of the vectors: every example of every family of the registry
+/// (`mfh_reference::registry`), so that a new family gets vectors without editing this list.
 pub fn models() -> Vec<Value> {
-    vec![
-        json!({"family": "beckmann", "alpha": 0.3}),
-        json!({"family": "beckmann", "alpha_x": 0.1, "alpha_y": 0.4}),
-        json!({"family": "ggx", "alpha": 0.3}),
-        json!({"family": "ggx", "alpha_x": 0.1, "alpha_y": 0.4}),
-        json!({"family": "std", "gamma": 2.5, "alpha_x": 0.1, "alpha_y": 0.4}),
-        json!({"family": "std", "gamma": "inf", "alpha": 0.3}),
-        json!({"family": "hyper_cauchy", "gamma": 3, "alpha_x": 0.2, "alpha_y": 0.5}),
-        json!({"family": "student_fixed_variance", "gamma": 4, "alpha": 0.3}),
-        json!({"family": "student_general", "b": 4, "c": 2.5}),
-        json!({"family": "piecewise_linear", "x": profile_x()}),
-        json!({"family": "piecewise_linear", "x": profile_x(), "y": profile_y()}),
-        json!({"family": "blend", "x": {"family": "ggx", "alpha": 0.2},
-               "y": {"family": "beckmann", "alpha": 0.4}}),
-        json!({"family": "gtr", "gamma": 1.5, "alpha": 0.3}),
-        json!({"family": "gaussian_slopes", "mean": [0.1, -0.05],
-               "cov": [[0.04, 0.01], [0.01, 0.09]]}),
-    ]
+    mfh_reference::registry::FAMILIES
+        .iter()
+        .flat_map(|f| f.examples.iter())
+        .map(|e| serde_json::from_str(e).expect("registry examples are JSON"))
+        .collect()
 }
 
 /// The shapes at which every Student Λ route that applies is recorded.

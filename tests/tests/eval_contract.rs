@@ -854,3 +854,20 @@ fn spherical_gaussian_quantities_answer_as_the_library_does() {
     }
     assert_eq!(r.status, 2);
 }
+
+/// The contract's model list covers every family of the registry: a new family must be added
+/// here (this test fails until it is).
+#[test]
+fn the_contract_covers_every_registered_family() {
+    let listed: std::collections::BTreeSet<String> = families()
+        .iter()
+        .filter_map(|m| m["family"].as_str().map(str::to_string))
+        .collect();
+    for f in mfh_reference::registry::FAMILIES {
+        assert!(
+            listed.contains(f.name),
+            "{} missing from the eval contract",
+            f.name
+        );
+    }
+}

@@ -114,6 +114,9 @@ impl Microfacet {
         if t2 == 0.0 {
             return 0.0;
         }
+        if w[2] == 0.0 {
+            return f64::INFINITY; // exactly grazing: every facet is masked
+        }
         let l = match self.family {
             // (√(1 + a⁻²) − 1)/2 with a⁻² = t2/z², written without cancellation.
             Family::Ggx => {
@@ -161,7 +164,10 @@ impl Microfacet {
             rho2 = rho2.powf(1.03);
         }
         let rho = rho2.sqrt();
-        let (px, py) = (self.alpha_x * rho * phi.cos(), self.alpha_y * rho * phi.sin());
+        let (px, py) = (
+            self.alpha_x * rho * phi.cos(),
+            self.alpha_y * rho * phi.sin(),
+        );
         let norm = (1.0 + px * px + py * py).sqrt();
         let z = if self.defect == Defect::BelowHorizonAtUZero && u[0] == 0.0 {
             -1.0
