@@ -25,3 +25,8 @@ pub use gate::Audit;
 pub use mfh_reference::model;
 pub use scene::Sampling;
 pub use subject::Hints;
+
+/// The README's Rust examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+pub struct ReadmeDoctests;
