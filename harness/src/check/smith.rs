@@ -220,7 +220,14 @@ pub fn plan<'a>(
     .into_iter()
     .map(|d| (d, Arc::new(OnceLock::new())))
     .collect();
-    for route in smith.lambda_routes() {
+    // A user's model is audited through the method a renderer calls; the other routes of a
+    // reference model are the reference's own business (each against the same oracle).
+    let routes = if subject.reference.is_some() {
+        smith.lambda_routes()
+    } else {
+        vec!["default"]
+    };
+    for route in routes {
         for ((theta, phi), memo) in oracles.iter().cloned() {
             let case = json!({"route": route, "theta": theta, "phi": phi});
             let (m, spec_run, case_run) = (subject.clone(), spec.clone(), case.clone());
