@@ -24,7 +24,7 @@ use serde_json::Value;
 use std::path::PathBuf;
 
 /// How hard an audit looks: the size of the case grids and of the statistical samples.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Profile {
     /// A few cases per property, 2·10⁵ samples per sampler: ≤ 60 s on 2 cores.
