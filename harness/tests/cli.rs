@@ -323,3 +323,41 @@ fn a_piped_audit_draws_no_progress_bar() {
     let _ = std::fs::remove_file(scene);
     let _ = std::fs::remove_dir_all(out_dir);
 }
+
+/// On a terminal (a pty from util-linux `script`, where installed) a chi2 run longer than a
+/// second draws its progress bar on standard error; `--quiet` draws none.
+#[test]
+fn a_long_chi2_on_a_terminal_shows_a_progress_bar() {
+    let has_script = Command::new("script")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_script {
+        eprintln!("skipped: util-linux `script` is not installed");
+        return;
+    }
+    let run = |quiet: bool| {
+        let command = format!(
+            "stty cols 120 rows 40; {} chi2 --model '{{\"family\":\"ggx\",\"alpha\":0.3}}' \
+             --samples 50000000 --resolution 8{}",
+            env!("CARGO_BIN_EXE_mfh"),
+            if quiet { " --quiet" } else { "" }
+        );
+        let out = Command::new("script")
+            .args(["-qec", &command, "/dev/null"])
+            .stdin(Stdio::null())
+            .output()
+            .expect("script runs");
+        (out.status.code(), text(&out.stdout))
+    };
+    let (code, terminal) = run(false);
+    assert_eq!(code, Some(0), "{terminal}");
+    assert!(
+        terminal.contains("samples") && terminal.contains("ETA") && terminal.contains('\r'),
+        "{terminal:?}"
+    );
+    assert!(terminal.contains("verdict pass"), "{terminal}");
+    let (code, terminal) = run(true);
+    assert_eq!(code, Some(0), "{terminal}");
+    assert!(!terminal.contains("ETA"), "{terminal:?}");
+}
