@@ -12,6 +12,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 use std::time::Instant;
 
 /// How to run an audit.
@@ -23,6 +24,8 @@ pub struct AuditOptions {
     pub seed: u64,
     /// Where artefacts go (None: none are written).
     pub out: Option<PathBuf>,
+    /// Called after each check (from worker threads); None: no progress is reported.
+    pub progress: Option<ProgressFn>,
 }
 
 impl Default for AuditOptions {
@@ -31,7 +34,30 @@ impl Default for AuditOptions {
             profile: Profile::Quick,
             seed: DEFAULT_SEED,
             out: None,
+            progress: None,
         }
+    }
+}
+
+/// How far an audit has got: checks done of those planned, and failures so far (before the
+/// Šidák correction re-judges the statistical checks).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Progress {
+    /// Checks done.
+    pub done: usize,
+    /// Checks planned.
+    pub planned: usize,
+    /// Checks failed or errored so far.
+    pub failures: usize,
+}
+
+/// A progress callback; it never changes a result.
+#[derive(Clone)]
+pub struct ProgressFn(pub std::sync::Arc<dyn Fn(Progress) + Send + Sync>);
+
+impl std::fmt::Debug for ProgressFn {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ProgressFn")
     }
 }
 
@@ -244,6 +270,7 @@ pub fn run_plan(
     options: &AuditOptions,
 ) -> (Vec<CheckRecord>, usize, f64) {
     let trace = std::env::var_os("MFH_TRACE").is_some();
+    let (done, failures) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let mut records: Vec<CheckRecord> = plan
         .par_iter()
         .map(|p| {
@@ -281,6 +308,14 @@ pub fn run_plan(
                     p.model,
                     p.case
                 );
+            }
+            if let Some(f) = &options.progress {
+                let failed = failures.fetch_add(usize::from(r.verdict.is_failure()), Relaxed);
+                (f.0)(Progress {
+                    done: done.fetch_add(1, Relaxed) + 1,
+                    planned: plan.len(),
+                    failures: failed + usize::from(r.verdict.is_failure()),
+                });
             }
             r
         })

@@ -4,6 +4,7 @@
 //! Non-finite numbers, which JSON cannot carry, are written as the strings `"inf"`, `"-inf"`
 //! and `"nan"` (Λ at grazing incidence is +∞).
 
+use crate::messages::{compact_numbers, json_error_message};
 use mfh_reference::geometry::{from_spherical, is_unit, Vec3};
 use mfh_reference::{Masking, Model, ModelSpec, ParamError, QueryError};
 use serde_json::{json, Map, Value};
@@ -76,19 +77,110 @@ pub struct Summary {
     pub failed: usize,
 }
 
-/// Answers every line of `input` on `output`; blank lines are skipped.
-pub fn eval_stream(input: &mut dyn BufRead, output: &mut dyn Write) -> std::io::Result<Summary> {
-    let mut summary = Summary::default();
-    let mut line = String::new();
+/// The longest accepted query line, 1 MiB: a query is a few hundred bytes (a piecewise-linear
+/// profile with 10⁴ breakpoints is ≈ 400 KiB), so this bounds the memory of `mfh eval` to about
+/// one such line whatever the input (`--input /dev/zero` has no line end at all).
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// Why [`eval_stream`] stopped before the end of its input.
+#[derive(Debug, thiserror::Error)]
+pub enum StreamError {
+    /// Reading the input or writing the answers failed.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    /// A line exceeds [`MAX_LINE_BYTES`]; the run stops there (its error line is written).
+    #[error(
+        "line {line} is longer than the maximum query line length of {limit} bytes (1 MiB); \
+         stopped reading there"
+    )]
+    LineTooLong {
+        /// The 1-based line number.
+        line: usize,
+        /// The limit in bytes.
+        limit: usize,
+    },
+}
+
+/// One line read with [`read_bounded_line`].
+enum Line {
+    /// End of input.
+    End,
+    /// A complete line (without its line end) in the buffer.
+    Complete,
+    /// More than the limit without a line end; the buffer holds the first `limit` bytes.
+    TooLong,
+}
+
+/// Reads one line into `buf` (cleared first), never holding more than `limit` bytes.
+/// Hand-written: `BufRead::read_until` grows without bound, and `Read::take` would split an
+/// over-long line into pieces that look like queries.
+fn read_bounded_line(
+    input: &mut dyn BufRead,
+    buf: &mut Vec<u8>,
+    limit: usize,
+) -> std::io::Result<Line> {
+    buf.clear();
+    let mut any = false;
     loop {
-        line.clear();
-        if input.read_line(&mut line)? == 0 {
-            break;
+        let chunk = match input.fill_buf() {
+            Ok(c) => c,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        if chunk.is_empty() {
+            return Ok(if any { Line::Complete } else { Line::End });
         }
-        if line.trim().is_empty() {
-            continue;
+        any = true;
+        let (take, done) = match chunk.iter().position(|&b| b == b'\n') {
+            Some(i) => (i, true),
+            None => (chunk.len(), false),
+        };
+        if buf.len() + take > limit {
+            let room = limit - buf.len();
+            buf.extend_from_slice(&chunk[..room]);
+            input.consume(room);
+            return Ok(Line::TooLong);
         }
-        let answer = answer_line(&line);
+        buf.extend_from_slice(&chunk[..take]);
+        input.consume(if done { take + 1 } else { take });
+        if done {
+            return Ok(Line::Complete);
+        }
+    }
+}
+
+/// Answers every line of `input` on `output`; blank lines are skipped. A line that is not
+/// valid UTF-8 answers a `parse` error and the later lines are answered; a line longer than
+/// [`MAX_LINE_BYTES`] answers a `parse` error and ends the run ([`StreamError::LineTooLong`]).
+pub fn eval_stream(
+    input: &mut dyn BufRead,
+    output: &mut dyn Write,
+) -> Result<Summary, StreamError> {
+    let mut summary = Summary::default();
+    let mut buf = Vec::new();
+    let mut number = 0;
+    loop {
+        number += 1;
+        let answer = match read_bounded_line(input, &mut buf, MAX_LINE_BYTES)? {
+            Line::End => break,
+            Line::TooLong => {
+                let e = StreamError::LineTooLong {
+                    line: number,
+                    limit: MAX_LINE_BYTES,
+                };
+                writeln!(output, "{}", error_answer(&EvalError::Parse(e.to_string())))?;
+                output.flush()?;
+                return Err(e);
+            }
+            Line::Complete => match std::str::from_utf8(&buf) {
+                Ok(line) if line.trim().is_empty() => continue,
+                Ok(line) => answer_line(line),
+                Err(e) => error_answer(&EvalError::Parse(format!(
+                    "line {number} is not valid UTF-8 (invalid byte at offset {})",
+                    e.valid_up_to()
+                ))),
+            },
+        };
         summary.answered += 1;
         if answer.get("error").is_some() {
             summary.failed += 1;
@@ -99,23 +191,41 @@ pub fn eval_stream(input: &mut dyn BufRead, output: &mut dyn Write) -> std::io::
     Ok(summary)
 }
 
+/// The longest error message written (a message quotes the offending value, which may be long).
+pub const MAX_MESSAGE_CHARS: usize = 400;
+
+/// The error line of `e`, its message with long numbers compacted and cut to
+/// [`MAX_MESSAGE_CHARS`].
+fn error_answer(e: &EvalError) -> Value {
+    let mut message = compact_numbers(e.message());
+    if message.chars().count() > MAX_MESSAGE_CHARS {
+        message = message.chars().take(MAX_MESSAGE_CHARS).collect::<String>() + "…";
+    }
+    json!({ "error": { "kind": e.kind(), "message": message } })
+}
+
 /// The answer to one query line: `{"value": …}` or `{"error": {"kind": …, "message": …}}`.
 pub fn answer_line(line: &str) -> Value {
     match evaluate(line) {
         Ok(value) => json!({ "value": value }),
-        Err(e) => json!({ "error": { "kind": e.kind(), "message": e.message() } }),
+        Err(e) => error_answer(&e),
     }
 }
 
 /// Evaluates one query line.
 pub fn evaluate(line: &str) -> Result<Value, EvalError> {
-    let query: Value =
-        serde_json::from_str(line).map_err(|e| EvalError::Parse(format!("not JSON: {e}")))?;
+    let query: Value = serde_json::from_str(line)
+        .map_err(|e| EvalError::Parse(format!("not JSON: {}", json_error_message(&e))))?;
     let obj = query
         .as_object()
         .ok_or_else(|| EvalError::Parse("a query must be a JSON object".into()))?;
     // Spherical-Gaussian quantities (seed 003) take no "model": see eval_sg.
     if let Some(quantity) = obj.get("quantity").and_then(Value::as_str) {
+        if let Some(known) = crate::eval_sg::arguments(quantity) {
+            check_keys(obj, quantity, &["quantity", "route"], known)?;
+        } else if let Some(known) = arguments(quantity) {
+            check_keys(obj, quantity, &["model", "quantity", "route"], known)?;
+        }
         let route = obj.get("route").and_then(Value::as_str);
         if let Some(answer) = crate::eval_sg::evaluate(quantity, obj, route) {
             return answer;
@@ -125,7 +235,7 @@ pub fn evaluate(line: &str) -> Result<Value, EvalError> {
         .get("model")
         .ok_or_else(|| EvalError::Argument("missing \"model\"".into()))?;
     let spec: ModelSpec = serde_json::from_value(spec_value.clone())
-        .map_err(|e| EvalError::Model(format!("bad model spec: {e}")))?;
+        .map_err(|e| EvalError::Model(format!("bad model spec: {}", json_error_message(&e))))?;
     let model = spec.build()?;
     let quantity = obj
         .get("quantity")
@@ -140,11 +250,66 @@ pub fn evaluate(line: &str) -> Result<Value, EvalError> {
 }
 
 fn unsupported(model: &dyn Model, quantity: &str) -> EvalError {
+    if matches!(quantity, "lambda" | "g1" | "g2") {
+        if let Some(why) = model.spec().smith_limit() {
+            return EvalError::Unsupported(format!(
+                "{} does not support {quantity}: {why}",
+                model.family()
+            ));
+        }
+    }
     QueryError::Unsupported {
         family: model.family().to_string(),
         quantity: quantity.to_string(),
     }
     .into()
+}
+
+/// The argument keys each model quantity takes (besides `model`, `quantity`, `route`); None
+/// for an unknown quantity.
+pub fn arguments(quantity: &str) -> Option<&'static [&'static str]> {
+    Some(match quantity {
+        "d" | "pdf_wm" => &["m", "theta", "phi"],
+        "lambda" | "visible_moments" => &["w", "theta", "phi"],
+        "g1" => &["w", "theta", "phi", "m"],
+        "g2" => &[
+            "wo", "theta_o", "phi_o", "wi", "theta_i", "phi_i", "m", "masking",
+        ],
+        "p22" => &["p", "q"],
+        "p2" => &["q", "phi"],
+        "slope_moment" => &["k", "phi"],
+        "variance" => &["phi"],
+        "excess_kurtosis" => &[],
+        "sample_wm" => &["u"],
+        "sample_wm_visible" => &["wi", "theta_i", "phi_i", "u"],
+        "pdf_wm_visible" => &["wi", "theta_i", "phi_i", "m", "theta", "phi"],
+        _ => return None,
+    })
+}
+
+/// Rejects a key of `q` that is neither in `common` nor in `known`, naming it and the keys the
+/// quantity takes: a misspelled optional key (`"ph"`) must not silently answer for its default.
+pub(crate) fn check_keys(
+    q: &Map<String, Value>,
+    quantity: &str,
+    common: &[&str],
+    known: &[&str],
+) -> Result<(), EvalError> {
+    match q
+        .keys()
+        .find(|k| !common.contains(&k.as_str()) && !known.contains(&k.as_str()))
+    {
+        None => Ok(()),
+        Some(k) => {
+            let mut all: Vec<&str> = common.to_vec();
+            all.extend_from_slice(known);
+            let shown: String = k.chars().take(40).collect();
+            Err(EvalError::Argument(format!(
+                "unknown key {shown:?} for quantity {quantity} (known: {})",
+                all.join(", ")
+            )))
+        }
+    }
 }
 
 fn no_route(route: Option<&str>, quantity: &str) -> Result<(), EvalError> {

@@ -36,6 +36,42 @@ pub const QUANTITIES: [&str; 8] = [
     "asg_sg_convolution",
 ];
 
+/// The largest SG sharpness and ASG bandwidth accepted, 1e150: the closed forms form
+/// λ₁λ₂ and ‖λ₁p₁ + λ₂p₂‖², which overflow to ∞ (and then NaN, ∞ · 0) past ≈ 1.3e154; no
+/// lobe a renderer uses comes near (a mirror lobe is λ ≈ 1e4 … 1e6).
+pub const SHARPNESS_MAX: f64 = 1e150;
+
+/// The largest |amplitude| accepted, 1e150: products of two amplitudes stay finite (< 1e300),
+/// so an underflowing exponential never meets an infinite amplitude (0 · ∞ = NaN).
+pub const AMPLITUDE_MAX: f64 = 1e150;
+
+/// The argument keys each SG/ASG quantity takes (besides `quantity` and `route`); None for a
+/// quantity this module does not answer.
+pub fn arguments(quantity: &str) -> Option<&'static [&'static str]> {
+    Some(match quantity {
+        "sg_eval" => &["a", "v"],
+        "sg_inner" | "sg_product" => &["a", "b"],
+        "sg_integral" => &["a", "cap"],
+        "sg_warp" => &["a", "o"],
+        "asg_eval" => &["asg", "v"],
+        "asg_integral" => &["asg"],
+        "asg_sg_convolution" => &["asg", "sg", "v"],
+        _ => return None,
+    })
+}
+
+/// Checks a lobe parameter against its limit; the message names the field and the limit.
+fn within(owner: &str, key: &str, value: f64, limit: f64) -> Result<f64, EvalError> {
+    if value.abs() <= limit {
+        Ok(value)
+    } else {
+        Err(EvalError::Model(format!(
+            "\"{owner}\".\"{key}\" = {value:e} exceeds the limit {limit:e} (beyond it the closed \
+             forms overflow)"
+        )))
+    }
+}
+
 /// Answers `quantity` if it is an SG/ASG quantity (None otherwise), with the arguments in `q`
 /// and the route `route` (None: the default).
 pub fn evaluate(
@@ -236,7 +272,10 @@ fn sg(q: &Map<String, Value>, key: &str, need_axis: bool) -> Result<Sg, EvalErro
         None => 1.0,
         Some(_) => model_number(o, key, "amplitude")?,
     };
-    Ok(Sg::new(axis, sharpness, amplitude)?)
+    let sg = Sg::new(axis, sharpness, amplitude)?;
+    within(key, "sharpness", sharpness, SHARPNESS_MAX)?;
+    within(key, "amplitude", amplitude, AMPLITUDE_MAX)?;
+    Ok(sg)
 }
 
 /// The ASG `q["asg"]`.
@@ -258,6 +297,14 @@ fn asg(q: &Map<String, Value>) -> Result<Asg, EvalError> {
         None => 1.0,
         Some(_) => model_number(o, "asg", "amplitude")?,
     };
+    for b in bandwidths {
+        if b.is_finite() {
+            within("asg", "bandwidths", b, SHARPNESS_MAX)?;
+        }
+    }
+    if amplitude.is_finite() {
+        within("asg", "amplitude", amplitude, AMPLITUDE_MAX)?;
+    }
     Ok(Asg::new(
         frame("x")?,
         frame("y")?,

@@ -15,6 +15,19 @@ pub enum ParamError {
         /// The value given.
         value: f64,
     },
+    /// A roughness parameter is positive but outside the supported range (see
+    /// `model::ALPHA_MIN`, `model::ALPHA_MAX`).
+    #[error("{name} must be in [{min:e}, {max:e}], the supported roughness range (got {value:e})")]
+    AlphaOutOfRange {
+        /// The parameter's name (`alpha`, `alpha_x`, `alpha_y`).
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// The smallest supported roughness.
+        min: f64,
+        /// The largest supported roughness.
+        max: f64,
+    },
     /// The shape parameter γ is outside the model's domain.
     #[error("gamma must be {requirement} for {family} (got {value})")]
     GammaOutOfRange {

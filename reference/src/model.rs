@@ -274,12 +274,29 @@ pub(crate) fn scale_along(sx: f64, sy: f64, phi: f64) -> f64 {
     ((sx * c).powi(2) + (sy * s).powi(2)).sqrt()
 }
 
-/// Validates a roughness parameter: finite and > 0.
+/// The supported roughness range [`ALPHA_MIN`, `ALPHA_MAX`]. Outside it the closed forms lose
+/// their meaning in f64: at α = 1e308 the slope scale overflows (Λ = inf, `sample_wm` gives
+/// [0, 0, 0]), and below 1e-7 D(n) = 1/(πα²) exceeds 3e13 and every sampled normal rounds to n.
+/// Renderers use α in about [1e-4, 10]; the range leaves three orders of magnitude either side.
+pub const ALPHA_MIN: f64 = 1e-7;
+
+/// The largest supported roughness; see [`ALPHA_MIN`].
+pub const ALPHA_MAX: f64 = 1e4;
+
+/// Validates a roughness parameter: finite and > 0 ([`crate::ParamError::AlphaNotPositive`]),
+/// and within [`ALPHA_MIN`, `ALPHA_MAX`] ([`crate::ParamError::AlphaOutOfRange`]).
 pub(crate) fn check_alpha(name: &'static str, value: f64) -> Result<f64, crate::ParamError> {
-    if value > 0.0 && value.is_finite() {
-        Ok(value)
-    } else {
+    if !(value > 0.0 && value.is_finite()) {
         Err(crate::ParamError::AlphaNotPositive { name, value })
+    } else if !(ALPHA_MIN..=ALPHA_MAX).contains(&value) {
+        Err(crate::ParamError::AlphaOutOfRange {
+            name,
+            value,
+            min: ALPHA_MIN,
+            max: ALPHA_MAX,
+        })
+    } else {
+        Ok(value)
     }
 }
 

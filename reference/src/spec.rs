@@ -157,6 +157,26 @@ impl ModelSpec {
         }
     }
 
+    /// Why the model has no Smith Λ (and so no G1 or G2), if that follows from its parameters:
+    /// for the Student-t members with γ ≤ 3/2 (and D^G(B, C) with C ≤ 3/2) the mean slope
+    /// diverges and Λ = ∞ at every incidence (seed 001 eq 18: the slope integral behind Λ,
+    /// ((γ−1)σ² + μ²)^{3/2−γ}/(3−2γ), diverges for γ ≤ 3/2).
+    /// The message names the field and the limit.
+    pub fn smith_limit(&self) -> Option<String> {
+        let (field, value) = match *self {
+            ModelSpec::Std { gamma, .. } | ModelSpec::HyperCauchy { gamma, .. } => ("gamma", gamma),
+            ModelSpec::StudentGeneral { c, .. } => ("c", c),
+            _ => return None,
+        };
+        (value <= 1.5).then(|| {
+            format!(
+                "{} {field} = {value} has no Smith Λ: Λ diverges for {field} ≤ 3/2 (the mean \
+                 slope is infinite); masking needs {field} > 3/2",
+                self.family()
+            )
+        })
+    }
+
     /// Validates the parameters and builds the model.
     pub fn build(&self) -> Result<Box<dyn Model>, ParamError> {
         use crate::ndf::student::Member;
@@ -237,22 +257,42 @@ mod gamma_serde {
         }
     }
 
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-        #[derive(Deserialize)]
-        #[serde(untagged)]
-        enum NumberOrString {
-            Number(f64),
-            Text(String),
+    /// A visitor rather than an untagged enum, so that a bad γ is reported as such (serde's
+    /// untagged enums report only "data did not match any variant of untagged enum …").
+    struct GammaVisitor;
+
+    impl serde::de::Visitor<'_> for GammaVisitor {
+        type Value = f64;
+
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("gamma as a number or the string \"inf\"")
         }
-        match NumberOrString::deserialize(d)? {
-            NumberOrString::Number(x) => Ok(x),
-            NumberOrString::Text(t) if matches!(t.as_str(), "inf" | "infinity" | "Infinity") => {
+
+        fn visit_f64<E: serde::de::Error>(self, x: f64) -> Result<f64, E> {
+            Ok(x)
+        }
+
+        fn visit_u64<E: serde::de::Error>(self, x: u64) -> Result<f64, E> {
+            Ok(x as f64)
+        }
+
+        fn visit_i64<E: serde::de::Error>(self, x: i64) -> Result<f64, E> {
+            Ok(x as f64)
+        }
+
+        fn visit_str<E: serde::de::Error>(self, t: &str) -> Result<f64, E> {
+            if matches!(t, "inf" | "infinity" | "Infinity") {
                 Ok(f64::INFINITY)
+            } else {
+                Err(E::custom(format!(
+                    "gamma must be a number or \"inf\" (got {t:?})"
+                )))
             }
-            NumberOrString::Text(t) => Err(serde::de::Error::custom(format!(
-                "gamma must be a number or \"inf\" (got {t:?})"
-            ))),
         }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        d.deserialize_any(GammaVisitor)
     }
 }
 

@@ -165,6 +165,7 @@ fn the_report_does_not_depend_on_the_thread_count() {
         profile: Profile::Quick,
         seed: 5,
         out: None,
+        ..Default::default()
     };
     let strip = |records: Vec<CheckRecord>| -> Vec<Value> {
         records

@@ -28,7 +28,7 @@ use std::path::PathBuf;
 pub use crate::subject::{lobe_width, theta_kinks};
 
 /// How hard an audit looks: the size of the case grids and of the statistical samples.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Profile {
     /// The CI gate for one model: the quick grids, 10⁶ chi-square samples, no document-level

@@ -1,0 +1,514 @@
+//! `mfh chi2`: the chi-square test of a model's sampler from the command line ([`crate::chi2_run`]
+//! validates and runs it), with text or JSON output and optional observed/expected tables (JSON)
+//! and heat maps (PNG).
+
+use super::{resolve_seed, SamplingArg, EXIT_BAD_INPUT, EXIT_FAIL, EXIT_PASS};
+use crate::chi2_run::{self, Chi2Request};
+use crate::oracle::chi2::{Chi2Result, Verdict};
+use clap::Args;
+use serde_json::json;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The options of `mfh chi2`.
+#[derive(Debug, Args)]
+pub struct Chi2Args {
+    /// The model spec as JSON text, e.g. '{"family":"ggx","alpha":0.3}'.
+    #[arg(long)]
+    pub model: String,
+    /// Samples to draw: at least 5 per cell of the grid (10·R²), at most 2^32.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub samples: u64,
+    /// Grid resolution R: R cos θ-rows × 2R φ-columns, 1 ≤ R ≤ 512.
+    #[arg(long, default_value_t = 32)]
+    pub resolution: usize,
+    /// Seed of the random streams (default: MFH_SEED, else a fixed seed).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Significance level, in (0, 1).
+    #[arg(long, default_value_t = 1e-4)]
+    pub alpha: f64,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// Write observed and expected count tables (JSON) and heat maps of observed, expected
+    /// and (O − E)/√E (PNG) into this folder.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// What to sample: normals (`sample_wm`) or visible normals (`sample_wm_visible` at
+    /// the incidence).
+    #[arg(long, value_enum, default_value = "normals")]
+    pub sampling: SamplingArg,
+    /// The incidence θi in radians, in [0, π/2) (visible normals only; default 0.5).
+    #[arg(long, allow_negative_numbers = true)]
+    pub incidence: Option<f64>,
+    /// The incidence azimuth φi in radians (visible normals only; default 0).
+    #[arg(long, allow_negative_numbers = true)]
+    pub azimuth: Option<f64>,
+    /// No progress bar (it is shown only when standard error is a terminal anyway).
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Runs `mfh chi2`; returns the exit status (0 pass, 1 fail, 2 bad input).
+pub fn run(args: Chi2Args, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32 {
+    let bad = |stderr: &mut dyn Write, message: String| {
+        let _ = writeln!(stderr, "mfh chi2: {message}");
+        EXIT_BAD_INPUT
+    };
+    let seed = match resolve_seed(args.seed) {
+        Ok(seed) => seed,
+        Err(e) => return bad(stderr, e),
+    };
+    let request = Chi2Request {
+        model: args.model.clone(),
+        samples: args.samples,
+        resolution: args.resolution,
+        seed,
+        alpha: args.alpha,
+        sampling: args.sampling.kind(),
+        incidence: args.incidence,
+        azimuth: args.azimuth,
+    };
+    let plan = match chi2_run::validate(&request) {
+        Ok(plan) => plan,
+        Err(e) => return bad(stderr, e.to_string()),
+    };
+    let result = run_with_progress(&plan, args.quiet);
+    let mut artefacts = Vec::new();
+    if let Some(dir) = &args.out {
+        match write_artefacts(dir, &result) {
+            Ok(paths) => artefacts = paths,
+            Err(e) => {
+                return bad(
+                    stderr,
+                    format!(
+                        "cannot write tables and heat maps to {}: {e}",
+                        dir.display()
+                    ),
+                )
+            }
+        }
+    }
+    let artefacts: Vec<String> = artefacts.iter().map(|p| p.display().to_string()).collect();
+    let written = if args.json {
+        writeln!(stdout, "{}", chi2_run::record(&plan, &result, &artefacts))
+    } else {
+        let r = &result;
+        let spec_text = serde_json::to_string(&plan.model.spec()).unwrap_or_default();
+        let reason = r.reason.as_ref().map(|r| r.to_string());
+        writeln!(
+            stdout,
+            "model {spec_text}\n\
+             grid {} φ × {} cos θ cells, {} samples, seed {}\n\
+             statistic {:.4}, dof {}, p-value {:.6e}, pooled cells {}\n\
+             expected mass {:.12} (cubature error bound {:.2e} counts)\n\
+             sampling+binning {:.3e} samples/s ({:.3} s), expected-count integration {:.3} s\n\
+             verdict {} at α = {:e}{}\n{}\
+             reproduce: {}",
+            2 * r.resolution,
+            r.resolution,
+            r.samples,
+            r.seed,
+            r.statistic,
+            r.dof,
+            r.p_value,
+            r.pooled_cells,
+            r.expected_mass,
+            r.expected_error_bound,
+            r.samples_per_second(),
+            r.sampling_seconds,
+            r.integration_seconds,
+            if r.verdict == Verdict::Pass {
+                "pass"
+            } else {
+                "FAIL"
+            },
+            r.alpha,
+            reason.map(|r| format!(": {r}")).unwrap_or_default(),
+            artefacts
+                .iter()
+                .map(|a| format!("wrote {a}\n"))
+                .collect::<String>(),
+            chi2_run::reproduce_command(&plan),
+        )
+    };
+    if let Err(e) = written.and_then(|_| stdout.flush()) {
+        return bad(stderr, format!("cannot write output: {e}"));
+    }
+    match result.verdict {
+        Verdict::Pass => EXIT_PASS,
+        Verdict::Fail => EXIT_FAIL,
+    }
+}
+
+/// Runs the test with a progress bar of samples drawn (see [`super::progress`]); the bar
+/// reads a shared counter from a second thread, so the result is the same with or without it.
+fn run_with_progress(plan: &chi2_run::Chi2Plan, quiet: bool) -> Chi2Result {
+    use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+    use std::sync::Arc;
+    let bar = super::progress::Bar::new(plan.config.samples, "samples", quiet);
+    if !bar.enabled() {
+        return chi2_run::run(plan, None);
+    }
+    let counter = Arc::new(AtomicU64::new(0));
+    let finished = AtomicBool::new(false);
+    let result = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            while !finished.load(Ordering::Relaxed) {
+                let done = counter.load(Ordering::Relaxed).min(plan.config.samples);
+                let phase = if done + (1 << 16) >= plan.config.samples {
+                    ", integrating expected counts"
+                } else {
+                    ""
+                };
+                bar.update(done, phase.to_string());
+                std::thread::sleep(std::time::Duration::from_millis(100));
+            }
+        });
+        let result = chi2_run::run(plan, Some(counter.clone()));
+        finished.store(true, Ordering::Relaxed);
+        result
+    });
+    bar.finish();
+    result
+}
+
+/// Writes the observed and expected counts as JSON tables `chi2_observed.json` and
+/// `chi2_expected.json` (rows of cos θ, row 0 at the horizon; columns of φ from 0); returns the
+/// paths written.
+pub fn write_tables(dir: &Path, result: &Chi2Result) -> std::io::Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir)?;
+    let columns = 2 * result.resolution;
+    let layout = format!(
+        "rows: cos θ in [i/R, (i+1)/R), row 0 at the horizon; columns: φ in \
+         [2πj/{columns}, 2π(j+1)/{columns}); R = {}",
+        result.resolution
+    );
+    let observed: Vec<&[u64]> = result.observed.chunks(columns).collect();
+    let expected: Vec<&[f64]> = result.expected.chunks(columns).collect();
+    for (name, table) in [
+        ("chi2_observed.json", json!(observed)),
+        ("chi2_expected.json", json!(expected)),
+    ] {
+        let value = json!({
+            "generated_by": "mfh chi2",
+            "layout": layout,
+            "samples": result.samples,
+            "seed": result.seed,
+            "rows": result.resolution,
+            "columns": columns,
+            "counts": table,
+        });
+        std::fs::write(dir.join(name), format!("{value:#}\n"))?;
+    }
+    Ok(vec![
+        dir.join("chi2_observed.json"),
+        dir.join("chi2_expected.json"),
+    ])
+}
+
+/// The heat maps of a result, written as PNG into `dir`: observed counts and expected counts on
+/// one shared linear scale (0 to the largest count of either), and the signed difference
+/// (O − E)/√E on a diverging scale (blue below, red above, ±max(4, largest |residual|); grey
+/// where E = O = 0, magenta where samples fell in a cell of zero expected count). Grid rows are
+/// cos θ from the horizon (bottom) to the pole (top), columns φ from 0 (left) to 2π (right),
+/// each cell [`crate::heatmap::cell_pixels`] pixels square. Returns the paths written.
+pub fn write_heat_maps(
+    dir: &Path,
+    result: &Chi2Result,
+) -> Result<Vec<PathBuf>, crate::heatmap::HeatMapError> {
+    use crate::heatmap::{write_png, HeatMap, Scale};
+    std::fs::create_dir_all(dir)?;
+    let (rows, columns) = (result.resolution, 2 * result.resolution);
+    let observed: Vec<f64> = result.observed.iter().map(|&o| o as f64).collect();
+    let max = observed
+        .iter()
+        .chain(&result.expected)
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, f64::max);
+    let difference: Vec<f64> = observed
+        .iter()
+        .zip(&result.expected)
+        .map(|(&o, &e)| match (o, e) {
+            (o, e) if e > 0.0 => (o - e) / e.sqrt(),
+            (o, _) if o > 0.0 => f64::INFINITY,
+            _ => f64::NAN,
+        })
+        .collect();
+    let limit = difference
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(4.0f64, |a, v| a.max(v.abs()));
+    let layout = format!(
+        "{rows} cos θ rows (horizon at the bottom, pole at the top) × {columns} φ columns \
+         (φ = 0 at the left); {} samples, seed {}",
+        result.samples, result.seed
+    );
+    let maps = [
+        (
+            "chi2_observed.png",
+            &observed,
+            Scale::Sequential { max },
+            format!(
+                "observed counts, linear scale 0 (dark violet) to {max:.6e} (yellow); {layout}"
+            ),
+        ),
+        (
+            "chi2_expected.png",
+            &result.expected,
+            Scale::Sequential { max },
+            format!(
+                "expected counts, linear scale 0 (dark violet) to {max:.6e} (yellow); {layout}"
+            ),
+        ),
+        (
+            "chi2_difference.png",
+            &difference,
+            Scale::Diverging { limit },
+            format!(
+                "(observed − expected)/√expected, linear scale −{limit:.3} (blue) to +{limit:.3} \
+                 (red), 0 white; grey: no samples and none expected; magenta: samples where \
+                 none are expected; {layout}"
+            ),
+        ),
+    ];
+    let mut paths = Vec::new();
+    for (name, values, scale, description) in maps {
+        let path = dir.join(name);
+        let map = HeatMap {
+            rows,
+            columns,
+            values,
+            scale,
+        };
+        write_png(&path, &map, &description)?;
+        paths.push(path);
+    }
+    Ok(paths)
+}
+
+/// Writes the tables ([`write_tables`]) and the heat maps ([`write_heat_maps`]) into `dir`;
+/// returns the paths written.
+pub fn write_artefacts(
+    dir: &Path,
+    result: &Chi2Result,
+) -> Result<Vec<PathBuf>, crate::heatmap::HeatMapError> {
+    let mut paths = write_tables(dir, result)?;
+    paths.extend(write_heat_maps(dir, result)?);
+    Ok(paths)
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::cli::run;
+
+    fn run_args(args: &[&str]) -> (i32, String, String) {
+        let (mut out, mut err) = (Vec::new(), Vec::new());
+        let code = run(
+            std::iter::once("mfh").chain(args.iter().copied()),
+            &mut std::io::empty(),
+            &mut out,
+            &mut err,
+        );
+        (
+            code,
+            String::from_utf8(out).unwrap(),
+            String::from_utf8(err).unwrap(),
+        )
+    }
+
+    #[test]
+    fn chi2_cli_visible_normals_at_an_incidence() {
+        let (code, out, err) = run_args(&[
+            "chi2",
+            "--model",
+            r#"{"family":"beckmann","alpha_x":0.3,"alpha_y":0.15}"#,
+            "--sampling",
+            "visible",
+            "--incidence",
+            "1.2",
+            "--azimuth",
+            "0.3",
+            "--samples",
+            "200000",
+            "--resolution",
+            "8",
+            "--json",
+        ]);
+        assert_eq!(code, 0, "{out}{err}");
+        let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+        assert_eq!(v["verdict"], "pass");
+        assert_eq!(v["sampling"], "visible");
+        assert_eq!(v["incidence"]["theta"], 1.2);
+        // A model without a visible sampler, and an incidence below the horizon: bad input.
+        for args in [
+            vec![
+                "chi2",
+                "--model",
+                r#"{"family":"std","gamma":3,"alpha":0.3}"#,
+            ],
+            vec![
+                "chi2",
+                "--model",
+                r#"{"family":"ggx","alpha":0.3}"#,
+                "--incidence",
+                "2",
+            ],
+        ] {
+            let mut args = args;
+            args.extend(["--sampling", "visible"]);
+            let (code, _, err) = run_args(&args);
+            assert_eq!(code, 2, "{err}");
+        }
+    }
+
+    #[test]
+    fn chi2_cli_json_pass_and_tables() {
+        let dir = std::env::temp_dir().join(format!("mfh-chi2-cli-{}", std::process::id()));
+        let (code, out, err) = run_args(&[
+            "chi2",
+            "--model",
+            r#"{"family":"ggx","alpha":0.3}"#,
+            "--samples",
+            "200000",
+            "--resolution",
+            "8",
+            "--seed",
+            "3",
+            "--json",
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{out}{err}");
+        let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+        assert_eq!(v["verdict"], "pass");
+        assert_eq!(v["samples"], 200000);
+        assert_eq!(v["dof"], 127);
+        for key in [
+            "statistic",
+            "p_value",
+            "samples_per_second",
+            "pooled_cells",
+            "expected_mass",
+            "expected_error_bound",
+            "integration_seconds",
+        ] {
+            assert!(v[key].is_number(), "{key}: {v}");
+        }
+        let table: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("chi2_observed.json")).unwrap())
+                .unwrap();
+        assert_eq!(table["counts"].as_array().unwrap().len(), 8);
+        assert_eq!(table["counts"][0].as_array().unwrap().len(), 16);
+        assert!(dir.join("chi2_expected.json").exists());
+        // The heat maps: valid PNGs of 16 φ × 8 cos θ cells, 16 px each (256 × 128), listed.
+        let listed: Vec<&str> = v["artefacts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|a| a.as_str())
+            .collect();
+        assert_eq!(listed.len(), 5, "{listed:?}");
+        for name in [
+            "chi2_observed.png",
+            "chi2_expected.png",
+            "chi2_difference.png",
+        ] {
+            let path = dir.join(name);
+            assert!(listed.contains(&path.to_str().unwrap()), "{listed:?}");
+            let bytes = std::fs::read(&path).unwrap();
+            assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{name}");
+            let reader = png::Decoder::new(std::io::Cursor::new(bytes))
+                .read_info()
+                .unwrap();
+            let info = reader.info();
+            assert_eq!((info.width, info.height), (256, 128), "{name}");
+            assert_eq!(info.color_type, png::ColorType::Rgb);
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Issue 12's measured bad inputs: each is exit 2 with a message naming the option and
+    /// its limit, before any allocation or sampling.
+    #[test]
+    fn chi2_cli_bad_input_names_the_option_and_the_limit() {
+        let ggx = r#"{"family":"ggx","alpha":0.3}"#;
+        for (args, names) in [
+            (
+                vec!["--resolution", "18446744073709551615"],
+                vec!["--resolution", "512"],
+            ),
+            (vec!["--resolution", "100000"], vec!["--resolution", "512"]),
+            (vec!["--resolution", "10000"], vec!["--resolution", "512"]),
+            (
+                vec!["--samples", "1000000000000000"],
+                vec!["--samples", "4294967296"],
+            ),
+            (vec!["--samples", "1"], vec!["--samples", "at least 10240"]),
+            (
+                vec!["--sampling", "visible", "--azimuth", "nan"],
+                vec!["--azimuth", "finite"],
+            ),
+            (
+                vec!["--incidence", "0.3"],
+                vec!["--incidence", "--sampling visible"],
+            ),
+            (
+                vec!["--azimuth", "0.3"],
+                vec!["--azimuth", "--sampling visible"],
+            ),
+        ] {
+            let mut all = vec!["chi2", "--model", ggx];
+            all.extend(args.iter().copied());
+            let (code, out, err) = run_args(&all);
+            assert_eq!(code, 2, "{args:?}: {out}{err}");
+            assert!(out.is_empty(), "{args:?}: {out}");
+            for n in names {
+                assert!(err.contains(n), "{args:?}: {err:?} lacks {n:?}");
+            }
+            assert!(err.lines().count() == 1 && err.len() < 300, "{err}");
+        }
+        // `--samples 1e15` is not an integer: clap's own bad-input error, exit 2.
+        let (code, _, err) = run_args(&["chi2", "--model", ggx, "--samples", "1e15"]);
+        assert_eq!(code, 2);
+        assert!(err.contains("--samples"), "{err}");
+    }
+
+    #[test]
+    fn chi2_cli_text_and_bad_input() {
+        let (code, out, _) = run_args(&[
+            "chi2",
+            "--model",
+            r#"{"family":"beckmann","alpha":0.5}"#,
+            "--samples",
+            "100000",
+            "--resolution",
+            "5",
+        ]);
+        assert_eq!(code, 0, "{out}");
+        assert!(
+            out.contains("verdict pass") && out.contains("samples/s"),
+            "{out}"
+        );
+        assert!(out.contains("reproduce: mfh chi2"), "{out}");
+        let (code, _, err) = run_args(&["chi2", "--model", "{\"family\":\"ggx\"}"]);
+        assert_eq!(code, 2, "{err}");
+        let blend = r#"{"family":"blend","x":{"family":"ggx","alpha":0.3},"y":{"family":"beckmann","alpha":0.2}}"#;
+        let (code, _, err) = run_args(&["chi2", "--model", blend]);
+        assert_eq!(code, 2);
+        assert!(err.contains("no normal sampler"), "{err}");
+        let (code, _, _) = run_args(&["chi2", "--model", "not json"]);
+        assert_eq!(code, 2);
+        let (code, _, _) = run_args(&[
+            "chi2",
+            "--model",
+            r#"{"family":"ggx","alpha":0.3}"#,
+            "--resolution",
+            "0",
+        ]);
+        assert_eq!(code, 2);
+    }
+}

@@ -1,0 +1,166 @@
+//! The clap command line of `mfh`, callable in-process (the tests crate drives it this way): one
+//! file per command (`audit`, `plan`, `chi2`, `eval`), each parsing its options, calling the
+//! library and mapping its errors to exit codes. The library knows nothing of clap.
+//!
+//! Exit codes: [`EXIT_PASS`] 0 success, [`EXIT_FAIL`] 1 failed checks, [`EXIT_BAD_INPUT`] 2 bad
+//! input.
+
+pub mod audit;
+pub mod chi2;
+pub mod eval;
+pub mod plan;
+pub mod progress;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use std::ffi::OsString;
+use std::io::{BufRead, Write};
+
+/// Exit status when everything passed (or, for `eval`, every query was answered).
+pub const EXIT_PASS: i32 = 0;
+
+/// Exit status when a check failed.
+pub const EXIT_FAIL: i32 = 1;
+
+/// Exit status for bad input (unreadable files, malformed queries, invalid parameters).
+pub const EXIT_BAD_INPUT: i32 = 2;
+
+/// mfh — verification and conformance harness for microfacet BSDF mathematics.
+#[derive(Debug, Parser)]
+#[command(name = "mfh", version, about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The audit profile as the command line spells it; [`ProfileArg::profile`] maps it to the
+/// library's [`crate::check::Profile`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ProfileArg {
+    /// A few cases per property, 2·10⁵ samples per sampler.
+    Quick,
+    /// More incidence angles and 2·10⁶ samples per sampler.
+    Standard,
+    /// Dense grids and 2·10⁷ samples per sampler.
+    Thorough,
+}
+
+impl ProfileArg {
+    /// The library profile.
+    pub fn profile(self) -> crate::check::Profile {
+        use crate::check::Profile;
+        match self {
+            ProfileArg::Quick => Profile::Quick,
+            ProfileArg::Standard => Profile::Standard,
+            ProfileArg::Thorough => Profile::Thorough,
+        }
+    }
+}
+
+/// What `mfh chi2` samples, as the command line spells it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SamplingArg {
+    /// `sample_wm` against `pdf_wm` = D(m)(m·n).
+    Normals,
+    /// `sample_wm_visible(wi, ·)` against `pdf_wm_visible(wi, ·)` at the incidence.
+    Visible,
+}
+
+impl SamplingArg {
+    /// The library's sampling kind.
+    pub fn kind(self) -> crate::chi2_run::SamplingKind {
+        use crate::chi2_run::SamplingKind;
+        match self {
+            SamplingArg::Normals => SamplingKind::Normals,
+            SamplingArg::Visible => SamplingKind::Visible,
+        }
+    }
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Evaluate closed forms: JSON-lines queries in, one JSON line per query out, in order.
+    ///
+    /// Each query is an object such as
+    /// {"model":{"family":"std","gamma":2.5,"alpha":0.3},"quantity":"lambda","theta":1.2}.
+    /// Exit status 2 if any line failed (its answer is an error line; the others are answered).
+    Eval(eval::EvalArgs),
+    /// Audit a scene: plan the checks its materials and effects call for, run them against
+    /// independent oracles, print a summary, write report.json and junit.xml into --out.
+    ///
+    /// Exit status 0 if every check passes (expected failures included), 1 if one fails, 2 on
+    /// bad input.
+    Audit(audit::AuditArgs),
+    /// Print the plan of a scene: one JSON line per check, with the reason it is planned.
+    Plan(plan::PlanArgs),
+    /// Chi-square test of a model's normal sampler (sample_wm) against its pdf (pdf_wm) over
+    /// a grid of R cos θ-rows × 2R φ-columns of the upper hemisphere.
+    ///
+    /// Exit status 0 if the test passes, 1 if it fails, 2 on bad input.
+    Chi2(chi2::Chi2Args),
+}
+
+/// Runs the command line `args` (including the program name) with the given streams and
+/// returns the exit status.
+pub fn run<I, T>(
+    args: I,
+    stdin: &mut dyn BufRead,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> i32
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { EXIT_BAD_INPUT } else { 0 };
+            let text = e.render().to_string();
+            let _ = if e.use_stderr() {
+                stderr.write_all(text.as_bytes())
+            } else {
+                stdout.write_all(text.as_bytes())
+            };
+            return code;
+        }
+    };
+    match cli.command {
+        Command::Audit(args) => audit::run(args, stdout, stderr),
+        Command::Plan(args) => plan::run(args, stdout, stderr),
+        Command::Chi2(args) => chi2::run(args, stdout, stderr),
+        Command::Eval(args) => eval::run(args, stdin, stdout, stderr),
+    }
+}
+
+/// The scene at `path`, or the embedded default scene.
+pub(crate) fn load_scene(
+    path: Option<&std::path::Path>,
+) -> Result<crate::scene::Scene, crate::scene::SceneError> {
+    match path {
+        Some(p) => crate::scene::Scene::load(p),
+        None => Ok(crate::scene::Scene::default_scene()),
+    }
+}
+
+/// How a scene is named in messages: its path, or `<default scene>`.
+pub(crate) fn scene_origin(path: Option<&std::path::Path>) -> String {
+    path.map(|p| p.display().to_string())
+        .unwrap_or_else(|| "<default scene>".to_string())
+}
+
+/// The seed from the option, else `MFH_SEED`, else the default; an unparsable `MFH_SEED` is bad
+/// input.
+pub fn resolve_seed(seed: Option<u64>) -> Result<u64, String> {
+    if let Some(s) = seed {
+        return Ok(s);
+    }
+    match std::env::var("MFH_SEED") {
+        Ok(text) => text
+            .trim()
+            .parse()
+            .map_err(|_| format!("MFH_SEED={text:?} is not an unsigned integer")),
+        Err(_) => Ok(crate::oracle::chi2::DEFAULT_SEED),
+    }
+}
