@@ -37,6 +37,8 @@ pub struct Cli {
 /// library's [`crate::check::Profile`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ProfileArg {
+    /// One model in CI: the quick grids, 10⁶ chi-square samples, no document-level checks.
+    Ci,
     /// A few cases per property, 2·10⁵ samples per sampler.
     Quick,
     /// More incidence angles and 2·10⁶ samples per sampler.
@@ -50,6 +52,7 @@ impl ProfileArg {
     pub fn profile(self) -> crate::check::Profile {
         use crate::check::Profile;
         match self {
+            ProfileArg::Ci => Profile::Ci,
             ProfileArg::Quick => Profile::Quick,
             ProfileArg::Standard => Profile::Standard,
             ProfileArg::Thorough => Profile::Thorough,
