@@ -86,7 +86,7 @@ pub enum Command {
         #[arg(long)]
         json: bool,
         /// Write observed and expected count tables (JSON) and heat maps of observed, expected
-        /// and (O − E)/√E (PNG) into this folder.
+        /// and (O − E)/√E (SVG) into this folder.
         #[arg(long)]
         out: Option<PathBuf>,
         /// What to sample: normals (`sample_wm`) or visible normals (`sample_wm_visible` at
@@ -400,7 +400,7 @@ mod tests {
         assert_eq!(table["counts"].as_array().unwrap().len(), 8);
         assert_eq!(table["counts"][0].as_array().unwrap().len(), 16);
         assert!(dir.join("chi2_expected.json").exists());
-        // The heat maps: valid PNGs of 16 φ × 8 cos θ cells, 16 px each (256 × 128), listed.
+        // The heat maps: SVGs with axes in θ and φ, a colour bar and the model, listed.
         let listed: Vec<&str> = v["artefacts"]
             .as_array()
             .unwrap()
@@ -409,20 +409,19 @@ mod tests {
             .collect();
         assert_eq!(listed.len(), 5, "{listed:?}");
         for name in [
-            "chi2_observed.png",
-            "chi2_expected.png",
-            "chi2_difference.png",
+            "chi2_observed.svg",
+            "chi2_expected.svg",
+            "chi2_difference.svg",
         ] {
             let path = dir.join(name);
             assert!(listed.contains(&path.to_str().unwrap()), "{listed:?}");
-            let bytes = std::fs::read(&path).unwrap();
-            assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{name}");
-            let reader = png::Decoder::new(std::io::Cursor::new(bytes))
-                .read_info()
-                .unwrap();
-            let info = reader.info();
-            assert_eq!((info.width, info.height), (256, 128), "{name}");
-            assert_eq!(info.color_type, png::ColorType::Rgb);
+            let svg = std::fs::read_to_string(&path).unwrap();
+            assert!(svg.starts_with("<svg"), "{name}");
+            for text in ["θ (degrees)", "φ (degrees)", "ggx alpha=0.3"] {
+                assert!(svg.contains(text), "{name}: {text}");
+            }
+            // 16 φ × 8 cos θ cells and the colour bar's 64 steps.
+            assert!(svg.matches("<rect").count() >= 128 + 64, "{name}");
         }
         let _ = std::fs::remove_dir_all(&dir);
     }

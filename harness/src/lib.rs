@@ -9,7 +9,6 @@ pub mod chi2_command;
 pub mod cli;
 pub mod eval;
 pub mod eval_sg;
-pub mod heatmap;
 pub mod oracle;
 pub mod plan;
 pub mod record;
