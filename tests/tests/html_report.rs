@@ -168,8 +168,10 @@ fn the_audit_writes_a_report_html_that_chromium_renders() {
         assert!(html.contains(section), "report.html lacks {section:?}");
     }
     let images = html.matches("<img ").count();
-    // Per material: Λ and G1 (2); GGX: 3 chi-square maps and 2 KS plots; 2 limits; 1 Pareto.
-    assert!(images >= 2 + 2 + 3 + 2 + 2 + 1, "{images} images");
+    // Per material Λ and G1 (2 + 2); GGX: 3 chi-square maps and 2 KS plots; 2 limits (D and
+    // Λ); 1 Pareto plot.
+    let expected = 2 + 2 + 3 + 2 + 2 + 1;
+    assert_eq!(images, expected, "images in report.html");
     // report.json lists the chi-square artefacts (and holds no tables); they exist.
     let report: Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();

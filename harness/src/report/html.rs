@@ -6,7 +6,7 @@
 //! time per check.
 
 use super::artefacts::{case_name, chi2_heat_maps, model_name, record_title};
-use super::plot::{line_svg, stacked_svg, LinePlot, PlotError, Series};
+use super::plot::{line_svg, stacked_svg, Corner, LinePlot, PlotError, Series};
 use crate::audit::AuditReport;
 use crate::record::{CheckRecord, Measured, RecordData, Verdict};
 use base64::Engine as _;
@@ -126,7 +126,10 @@ fn data_plots(r: &CheckRecord) -> Result<String, PlotError> {
                 "θ (radians)"
             };
             let plot = LinePlot {
-                title: format!("KS {marginal} marginal · {title}"),
+                title: format!(
+                    "KS {marginal} marginal · {} · {samples} samples",
+                    model_name(&r.model)
+                ),
                 x_label: unit.into(),
                 y_label: "CDF".into(),
                 x_log: false,
@@ -150,6 +153,7 @@ fn data_plots(r: &CheckRecord) -> Result<String, PlotError> {
                     },
                 ],
                 h_lines: vec![],
+                legend: Corner::LowerRight,
             };
             let diff = LinePlot {
                 title: "empirical − model CDF (D_N is the largest |difference| over all samples)"
@@ -172,6 +176,7 @@ fn data_plots(r: &CheckRecord) -> Result<String, PlotError> {
                     .value
                     .map(|d| vec![(d, "+D_N".to_string()), (-d, "−D_N".to_string())])
                     .unwrap_or_default(),
+                legend: Corner::UpperRight,
             };
             Ok(img(&stacked_svg(&plot, &diff)?, &format!("{} KS", r.check)))
         }
@@ -187,6 +192,7 @@ fn data_plots(r: &CheckRecord) -> Result<String, PlotError> {
                     x.iter().copied().zip(y.iter().copied()).collect(),
                 )],
                 h_lines: vec![],
+                legend: Corner::UpperRight,
             };
             Ok(img(&line_svg(&plot)?, label))
         }
@@ -274,6 +280,11 @@ fn smith_plots(records: &[&CheckRecord], material: &str) -> Result<Option<String
             y_log: name == "Λ",
             series: values,
             h_lines: vec![],
+            legend: if name == "Λ" {
+                Corner::UpperLeft
+            } else {
+                Corner::LowerLeft
+            },
         };
         let bottom = LinePlot {
             title: format!("relative error of {name} (exact zeros left out)"),
@@ -286,6 +297,7 @@ fn smith_plots(records: &[&CheckRecord], material: &str) -> Result<Option<String
                 .filter(|_| name == "Λ")
                 .map(|(v, n)| vec![(v, format!("tolerance {n}"))])
                 .unwrap_or_default(),
+            legend: Corner::UpperRight,
         };
         html.push_str(&img(&stacked_svg(&top, &bottom)?, &top.title));
     }
@@ -358,6 +370,7 @@ fn limit_plot(r: &CheckRecord) -> Result<Option<String>, PlotError> {
         y_log: true,
         series,
         h_lines: vec![],
+        legend: Corner::UpperRight,
     };
     Ok(Some(img(&line_svg(&plot)?, &plot.title)))
 }

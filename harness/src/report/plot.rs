@@ -64,6 +64,33 @@ pub struct LinePlot {
     pub series: Vec<Series>,
     /// Horizontal reference lines (y, label), e.g. a tolerance.
     pub h_lines: Vec<(f64, String)>,
+    /// Where the legend goes (the corner the curves leave free).
+    pub legend: Corner,
+}
+
+/// A corner of a plot, for its legend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Corner {
+    /// Upper left.
+    UpperLeft,
+    /// Upper right.
+    #[default]
+    UpperRight,
+    /// Lower left.
+    LowerLeft,
+    /// Lower right.
+    LowerRight,
+}
+
+impl Corner {
+    fn position(self) -> SeriesLabelPosition {
+        match self {
+            Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
+            Corner::UpperRight => SeriesLabelPosition::UpperRight,
+            Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
+            Corner::LowerRight => SeriesLabelPosition::LowerRight,
+        }
+    }
 }
 
 /// Size of one plot, pixels.
@@ -234,7 +261,7 @@ fn draw_lines(area: &DrawingArea<SVGBackend<'_>, Shift>, plot: &LinePlot) -> Res
     if !plot.series.is_empty() || !h_lines.is_empty() {
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(plot.legend.position())
             .background_style(WHITE.mix(0.85))
             .border_style(RGBColor(160, 160, 160))
             .label_font(("sans-serif", 12))
@@ -614,6 +641,7 @@ mod tests {
                 vec![(0.1, 1e-16), (0.5, 0.0), (1.0, 1e-12)],
             )],
             h_lines: vec![(1e-10, "tolerance".into())],
+            legend: Corner::UpperLeft,
         };
         let svg = line_svg(&plot).unwrap();
         assert!(
