@@ -32,7 +32,8 @@ pub enum Command {
         input: Option<PathBuf>,
     },
     /// Audit a scene: plan the checks its materials and effects call for, run them against
-    /// independent oracles, print a summary, write report.json and junit.xml into --out.
+    /// independent oracles, print a summary, write report.json, junit.xml, the chi-square and
+    /// KS artefacts and report.html into --out.
     ///
     /// Exit status 0 if every check passes (expected failures included), 1 if one fails, 2 on
     /// bad input.

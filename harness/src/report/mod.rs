@@ -61,10 +61,11 @@ pub fn on_disk(report: &AuditReport, dir: &Path) -> AuditReport {
     out
 }
 
-/// Writes every file sink into `dir` (created if needed) and returns the paths written, in
-/// order: `report.json` first (so that nothing measured is lost if a later sink fails), then
-/// `junit.xml`, the artefact files of records that carry data, and `report.html` (which also
-/// shows `cost.json` if `dir` holds one).
+/// Writes every file sink into `dir` (created if needed), in order: `report.json` first (so
+/// that nothing measured is lost if a later sink fails), then `junit.xml`, the artefact files
+/// of records that carry data (listed in report.json), and `report.html` (which also shows
+/// `cost.json` if `dir` holds one). Returns the files and artefact folders written (not every
+/// artefact file: report.json lists those).
 pub fn write_all(report: &AuditReport, dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
     std::fs::create_dir_all(dir).map_err(|source| ReportError::CreateFolder {
         path: dir.to_path_buf(),
@@ -92,7 +93,16 @@ pub fn write_all(report: &AuditReport, dir: &Path) -> Result<Vec<PathBuf>, Repor
                 record: artefacts::record_title(r),
                 source,
             })?;
-            written.extend(paths);
+            if let Some(top) = paths
+                .first()
+                .and_then(|p| p.strip_prefix(dir).ok())
+                .and_then(|p| p.components().next())
+                .map(|c| dir.join(c))
+            {
+                if !written.contains(&top) {
+                    written.push(top);
+                }
+            }
         }
     }
     let cost = std::fs::read_to_string(dir.join("cost.json")).ok();
