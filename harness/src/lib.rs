@@ -15,7 +15,6 @@ pub mod cli;
 pub mod eval;
 pub mod eval_sg;
 pub mod gate;
-pub mod heatmap;
 pub mod messages;
 pub mod oracle;
 pub mod plan;

@@ -158,8 +158,61 @@ pub struct CheckRecord {
     pub source: String,
     /// The closed forms this record exercises (`family/quantity/route`), for the coverage registry.
     pub covers: Vec<String>,
-    /// Paths of artefacts written for this record (heat maps, tables).
+    /// Paths of artefacts written for this record (heat maps, tables), by the sinks.
     pub artefacts: Vec<String>,
+    /// Data the check measured beyond one number (a chi-square table, a KS marginal), for the
+    /// sinks to write as artefacts and plot. Checks fill it and do no I/O; the file sinks
+    /// write it into artefact files and leave it out of `report.json` (which lists the paths).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub data: Option<RecordData>,
+}
+
+/// The data a check measured beyond one number: what the sinks (`crate::report`) write as
+/// artefact files and draw as plots.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum RecordData {
+    /// The observed and expected counts of a chi-square test over the (φ, cos θ) grid of the
+    /// upper hemisphere: `rows` cos θ-rows (row 0 at the horizon, cos θ ∈ [i/R, (i+1)/R)) ×
+    /// `columns` = 2R φ-columns (φ ∈ [2πj/2R, 2π(j+1)/2R)), row-major.
+    Chi2Table {
+        /// cos θ-rows R.
+        rows: usize,
+        /// φ-columns 2R.
+        columns: usize,
+        /// Samples drawn.
+        samples: u64,
+        /// The seed of the random streams.
+        seed: u64,
+        /// Observed counts per cell.
+        observed: Vec<u64>,
+        /// Expected counts per cell (pdf mass × samples).
+        expected: Vec<f64>,
+    },
+    /// A Kolmogorov–Smirnov marginal: the model's CDF and an empirical CDF at `x`.
+    KsMarginal {
+        /// The marginal (`cos_theta` or `phi`).
+        marginal: String,
+        /// Points of the marginal's range.
+        x: Vec<f64>,
+        /// The model's CDF at `x` (the oracle's table).
+        model_cdf: Vec<f64>,
+        /// The empirical CDF at `x`.
+        empirical_cdf: Vec<f64>,
+        /// Samples behind the empirical CDF.
+        samples: u64,
+        /// The seed of those samples.
+        seed: u64,
+    },
+    /// A curve y(x), e.g. an error against θ.
+    Curve {
+        /// What the curve shows.
+        label: String,
+        /// The abscissae.
+        x: Vec<f64>,
+        /// The ordinates.
+        y: Vec<f64>,
+    },
 }
 
 impl CheckRecord {
@@ -182,6 +235,7 @@ impl CheckRecord {
             source: source.to_string(),
             covers: Vec::new(),
             artefacts: Vec::new(),
+            data: None,
         }
     }
 

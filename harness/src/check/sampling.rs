@@ -198,21 +198,25 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
 
 /// Fills a chi-square record from the test's result: a sanity failure (samples outside the
 /// domain, pdf mass off, samples in zero-pdf cells) fails outright; otherwise the p-value,
-/// provisionally judged at the unshared α (the audit re-decides with the Šidák level). Writes
-/// the observed and expected tables (and, when it fails, the heat maps) when the run has an
-/// output folder.
+/// provisionally judged at the unshared α (the audit re-decides with the Šidák level). The
+/// observed and expected tables go into the record's data (no I/O here: the sinks write them
+/// and their heat maps into `out/chi2/<model and case>/`).
 fn fill_chi2(
     r: &mut CheckRecord,
     result: &crate::oracle::chi2::Chi2Result,
-    ctx: &super::RunContext,
+    _ctx: &super::RunContext,
     samples: u64,
 ) {
     r.cost.samples = samples;
     r.tolerance = Some(applied(&STATISTICAL_ALPHA));
-    if let Some(dir) = &ctx.out {
-        let sub = dir.join("chi2").join(folder_name(&r.model, &r.case));
-        write_chi2_artefacts(r, &sub, result);
-    }
+    r.data = Some(crate::record::RecordData::Chi2Table {
+        rows: result.resolution,
+        columns: 2 * result.resolution,
+        samples: result.samples,
+        seed: result.seed,
+        observed: result.observed.clone(),
+        expected: result.expected.clone(),
+    });
     match &result.reason {
         Some(reason) if !matches!(reason, crate::oracle::chi2::Failure::Rejected { .. }) => {
             r.verdict = Verdict::Fail;
@@ -695,10 +699,80 @@ fn plan_ks<'a>(
                 };
                 let result = ks_test_sampler(sampler, marginal, &hints, &config);
                 fill_ks(&mut r, &result);
+                r.data = ks_marginal_data(sampler, marginal, &hints, &config, &result);
                 r
             })
         }),
     }
+}
+
+/// Points of the KS marginal curves in a record's data.
+const KS_CURVE_POINTS: usize = 256;
+
+/// The KS marginal's curves for the report: the model's CDF (the oracle's table, rebuilt) and
+/// the empirical CDF of the very samples the test drew (redrawn from the same streams: chunk c
+/// of [`crate::oracle::chi2::CHUNK`] samples from `stream(seed, c)`, two uniforms a sample, as
+/// `oracle::ks` draws them), at [`KS_CURVE_POINTS`] points of the marginal's range. `None`
+/// after a sanity failure (no statistic to show). The D_N of these samples against this table
+/// equals the record's statistic (tested below), so the plot shows what the test judged.
+fn ks_marginal_data(
+    sampler: &dyn mfh_reference::NormalSampler,
+    marginal: Marginal,
+    hints: &LobeHints<'_>,
+    config: &KsConfig,
+    result: &ks::KsResult,
+) -> Option<crate::record::RecordData> {
+    if matches!(&result.reason, Some(reason) if !matches!(reason, ks::Failure::Rejected { .. })) {
+        return None;
+    }
+    let values = ks_redraw(sampler, marginal, config);
+    let table = ks::marginal_cdf(&|m| sampler.pdf_wm(m), marginal, hints);
+    let [lo, hi] = marginal.range();
+    let n = values.len().max(1) as f64;
+    let x: Vec<f64> = (0..KS_CURVE_POINTS)
+        .map(|i| lo + (hi - lo) * i as f64 / (KS_CURVE_POINTS - 1) as f64)
+        .collect();
+    let empirical_cdf = x
+        .iter()
+        .map(|&t| values.partition_point(|&v| v <= t) as f64 / n)
+        .collect();
+    let model_cdf = x.iter().map(|&t| table.cdf(t)).collect();
+    Some(crate::record::RecordData::KsMarginal {
+        marginal: marginal.name().to_string(),
+        x,
+        model_cdf,
+        empirical_cdf,
+        samples: config.samples,
+        seed: config.seed,
+    })
+}
+
+/// The sorted values of the marginal of the samples a KS test with `config` drew (see
+/// [`ks_marginal_data`]).
+fn ks_redraw(
+    sampler: &dyn mfh_reference::NormalSampler,
+    marginal: Marginal,
+    config: &KsConfig,
+) -> Vec<f64> {
+    use crate::oracle::chi2::{stream, CHUNK};
+    use crate::oracle::monte_carlo::uniform;
+    use rayon::prelude::*;
+    let chunks: Vec<Vec<f64>> = (0..config.samples.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|chunk| {
+            let mut rng = stream(config.seed, chunk);
+            let end = ((chunk + 1) * CHUNK).min(config.samples);
+            (chunk * CHUNK..end)
+                .map(|_| {
+                    let u = [uniform(&mut rng), uniform(&mut rng)];
+                    marginal.value(sampler.sample_wm(u))
+                })
+                .collect()
+        })
+        .collect();
+    let mut values = chunks.concat();
+    values.par_sort_unstable_by(f64::total_cmp);
+    values
 }
 
 /// Fills a `sampling.ks_marginals` record from a KS result.
@@ -745,60 +819,6 @@ fn fill_ks(r: &mut CheckRecord, result: &ks::KsResult) {
                 Verdict::Fail
             };
         }
-    }
-}
-
-/// A file-name-safe folder name for a model and case: their compact JSON with every run of
-/// characters outside `[A-Za-z0-9.-]` turned into one `_`; past 120 characters, the first 111
-/// and 8 hex digits of a hash (FNV-1a) of the whole, so that long names stay distinct.
-pub fn folder_name(model: &Value, case: &Value) -> String {
-    let text = format!("{model}_{case}");
-    let mut out = String::new();
-    for c in text.chars() {
-        if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
-            out.push(c);
-        } else if !out.ends_with('_') {
-            out.push('_');
-        }
-    }
-    let mut out = out.trim_matches('_').to_string();
-    if out.len() > 120 {
-        let hash = text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-        });
-        out = format!("{}_{:08x}", &out[..111], hash >> 32);
-    }
-    if out.is_empty() {
-        "case".to_string()
-    } else {
-        out
-    }
-}
-
-/// Writes a chi-square result's tables into `dir`, and its heat maps when it fails at the
-/// uncorrected level α (a superset of the audit's failures at the Šidák level, so every chi-square
-/// check the audit fails has its maps) or on a sanity failure; lists what was written in the
-/// record's artefacts. A write error is noted in the artefacts, not fatal.
-fn write_chi2_artefacts(
-    r: &mut CheckRecord,
-    dir: &std::path::Path,
-    result: &crate::oracle::chi2::Chi2Result,
-) {
-    let written = crate::chi2_command::write_tables(dir, result)
-        .map_err(crate::heatmap::HeatMapError::from)
-        .and_then(|mut paths| {
-            if result.verdict == crate::oracle::chi2::Verdict::Fail {
-                paths.extend(crate::chi2_command::write_heat_maps(dir, result)?);
-            }
-            Ok(paths)
-        });
-    match written {
-        Ok(paths) => r
-            .artefacts
-            .extend(paths.iter().map(|p| p.display().to_string())),
-        Err(e) => r
-            .artefacts
-            .push(format!("(could not write to {}: {e})", dir.display())),
     }
 }
 
@@ -899,6 +919,47 @@ mod tests {
     }
 
     #[test]
+    fn the_ks_curves_show_the_samples_the_test_judged() {
+        let (_, m) = model(r#"{"family":"ggx","alpha_x":0.1,"alpha_y":0.4}"#);
+        let sampler = m.as_sampler().unwrap();
+        for marginal in [Marginal::CosTheta, Marginal::Phi] {
+            let hints = LobeHints {
+                width: 0.1f64.atan(),
+                theta_kinks: &[],
+            };
+            let config = KsConfig {
+                samples: 100_000,
+                seed: 11,
+                alpha: STATISTICAL_ALPHA.value,
+            };
+            let result = ks_test_sampler(sampler, marginal, &hints, &config);
+            let values = ks_redraw(sampler, marginal, &config);
+            let table = ks::marginal_cdf(&|w| sampler.pdf_wm(w), marginal, &hints);
+            let (d, at) = ks::ks_statistic(&values, &|x| table.cdf(x));
+            assert_eq!((d, at), (result.statistic, result.at), "{marginal:?}");
+            let Some(crate::record::RecordData::KsMarginal {
+                x,
+                model_cdf,
+                empirical_cdf,
+                ..
+            }) = ks_marginal_data(sampler, marginal, &hints, &config, &result)
+            else {
+                panic!("no KS data");
+            };
+            assert_eq!(x.len(), KS_CURVE_POINTS);
+            assert_eq!((model_cdf[0], empirical_cdf[0]), (0.0, 0.0));
+            assert!((model_cdf[KS_CURVE_POINTS - 1] - 1.0).abs() < 1e-6);
+            assert_eq!(empirical_cdf[KS_CURVE_POINTS - 1], 1.0);
+            let worst = model_cdf
+                .iter()
+                .zip(&empirical_cdf)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(worst <= d, "{worst} > D_N = {d}");
+        }
+    }
+
+    #[test]
     fn a_wrong_visible_density_fails_the_chi_square() {
         let (_, a) = model(r#"{"family":"ggx","alpha":0.3}"#);
         let (_, b) = model(r#"{"family":"ggx","alpha":0.33}"#);
@@ -923,27 +984,5 @@ mod tests {
         let s = a.model.as_sampler().unwrap();
         let r = chi2_test(&|u| s.sample_wm(u), &|m| va.pdf_wm_visible(wi, m), &config);
         assert_eq!(r.verdict, crate::oracle::chi2::Verdict::Fail);
-    }
-
-    #[test]
-    fn folder_names_are_safe_and_distinct() {
-        let name = folder_name(
-            &json!({"family": "ggx", "alpha": 0.3}),
-            &json!({"samples": 10}),
-        );
-        assert_eq!(name, "alpha_0.3_family_ggx_samples_10");
-        let long = |v: f64| {
-            folder_name(
-                &json!({"family": "piecewise_linear", "x": {"theta": [0.0, 0.5, 1.0, 1.5],
-                        "value": [1.0, 0.6, 0.1, 0.0]}, "y": {"theta": [0.0, 0.3, 0.9, 1.5],
-                        "value": [2.0, 0.8, 0.05, v]}}),
-                &json!({"samples": 200000, "resolution": 16}),
-            )
-        };
-        let (a, b) = (long(0.0), long(1e-3));
-        assert!(a.len() == 120 && b.len() == 120 && a != b, "{a} {b}");
-        assert!(a
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || "._-".contains(c)));
     }
 }

@@ -77,7 +77,8 @@ pub fn run(args: Chi2Args, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
     let result = run_with_progress(&plan, args.quiet);
     let mut artefacts = Vec::new();
     if let Some(dir) = &args.out {
-        match write_artefacts(dir, &result) {
+        let name = crate::report::artefacts::model_name(&serde_json::json!(plan.model.spec()));
+        match write_artefacts(dir, &name, &result) {
             Ok(paths) => artefacts = paths,
             Err(e) => {
                 return bad(
@@ -175,130 +176,25 @@ fn run_with_progress(plan: &chi2_run::Chi2Plan, quiet: bool) -> Chi2Result {
 }
 
 /// Writes the observed and expected counts as JSON tables `chi2_observed.json` and
-/// `chi2_expected.json` (rows of cos θ, row 0 at the horizon; columns of φ from 0); returns the
-/// paths written.
-pub fn write_tables(dir: &Path, result: &Chi2Result) -> std::io::Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)?;
-    let columns = 2 * result.resolution;
-    let layout = format!(
-        "rows: cos θ in [i/R, (i+1)/R), row 0 at the horizon; columns: φ in \
-         [2πj/{columns}, 2π(j+1)/{columns}); R = {}",
-        result.resolution
-    );
-    let observed: Vec<&[u64]> = result.observed.chunks(columns).collect();
-    let expected: Vec<&[f64]> = result.expected.chunks(columns).collect();
-    for (name, table) in [
-        ("chi2_observed.json", json!(observed)),
-        ("chi2_expected.json", json!(expected)),
-    ] {
-        let value = json!({
-            "generated_by": "mfh chi2",
-            "layout": layout,
-            "samples": result.samples,
-            "seed": result.seed,
-            "rows": result.resolution,
-            "columns": columns,
-            "counts": table,
-        });
-        std::fs::write(dir.join(name), format!("{value:#}\n"))?;
-    }
-    Ok(vec![
-        dir.join("chi2_observed.json"),
-        dir.join("chi2_expected.json"),
-    ])
-}
-
-/// The heat maps of a result, written as PNG into `dir`: observed counts and expected counts on
-/// one shared linear scale (0 to the largest count of either), and the signed difference
-/// (O − E)/√E on a diverging scale (blue below, red above, ±max(4, largest |residual|); grey
-/// where E = O = 0, magenta where samples fell in a cell of zero expected count). Grid rows are
-/// cos θ from the horizon (bottom) to the pole (top), columns φ from 0 (left) to 2π (right),
-/// each cell [`crate::heatmap::cell_pixels`] pixels square. Returns the paths written.
-pub fn write_heat_maps(
-    dir: &Path,
-    result: &Chi2Result,
-) -> Result<Vec<PathBuf>, crate::heatmap::HeatMapError> {
-    use crate::heatmap::{write_png, HeatMap, Scale};
-    std::fs::create_dir_all(dir)?;
-    let (rows, columns) = (result.resolution, 2 * result.resolution);
-    let observed: Vec<f64> = result.observed.iter().map(|&o| o as f64).collect();
-    let max = observed
-        .iter()
-        .chain(&result.expected)
-        .copied()
-        .filter(|v| v.is_finite())
-        .fold(0.0f64, f64::max);
-    let difference: Vec<f64> = observed
-        .iter()
-        .zip(&result.expected)
-        .map(|(&o, &e)| match (o, e) {
-            (o, e) if e > 0.0 => (o - e) / e.sqrt(),
-            (o, _) if o > 0.0 => f64::INFINITY,
-            _ => f64::NAN,
-        })
-        .collect();
-    let limit = difference
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .fold(4.0f64, |a, v| a.max(v.abs()));
-    let layout = format!(
-        "{rows} cos θ rows (horizon at the bottom, pole at the top) × {columns} φ columns \
-         (φ = 0 at the left); {} samples, seed {}",
-        result.samples, result.seed
-    );
-    let maps = [
-        (
-            "chi2_observed.png",
-            &observed,
-            Scale::Sequential { max },
-            format!(
-                "observed counts, linear scale 0 (dark violet) to {max:.6e} (yellow); {layout}"
-            ),
-        ),
-        (
-            "chi2_expected.png",
-            &result.expected,
-            Scale::Sequential { max },
-            format!(
-                "expected counts, linear scale 0 (dark violet) to {max:.6e} (yellow); {layout}"
-            ),
-        ),
-        (
-            "chi2_difference.png",
-            &difference,
-            Scale::Diverging { limit },
-            format!(
-                "(observed − expected)/√expected, linear scale −{limit:.3} (blue) to +{limit:.3} \
-                 (red), 0 white; grey: no samples and none expected; magenta: samples where \
-                 none are expected; {layout}"
-            ),
-        ),
-    ];
-    let mut paths = Vec::new();
-    for (name, values, scale, description) in maps {
-        let path = dir.join(name);
-        let map = HeatMap {
-            rows,
-            columns,
-            values,
-            scale,
-        };
-        write_png(&path, &map, &description)?;
-        paths.push(path);
-    }
-    Ok(paths)
-}
-
-/// Writes the tables ([`write_tables`]) and the heat maps ([`write_heat_maps`]) into `dir`;
-/// returns the paths written.
+/// `chi2_expected.json` (rows of cos θ, row 0 at the horizon; columns of φ from 0) and the heat
+/// maps `chi2_observed.svg`, `chi2_expected.svg`, `chi2_difference.svg` (axes in θ and φ, a
+/// colour bar, titled with the model; see [`crate::report::artefacts`], which writes the same
+/// files for `mfh audit`); returns the paths written.
 pub fn write_artefacts(
     dir: &Path,
+    model: &str,
     result: &Chi2Result,
-) -> Result<Vec<PathBuf>, crate::heatmap::HeatMapError> {
-    let mut paths = write_tables(dir, result)?;
-    paths.extend(write_heat_maps(dir, result)?);
-    Ok(paths)
+) -> Result<Vec<PathBuf>, crate::report::artefacts::ArtefactError> {
+    let data = crate::record::RecordData::Chi2Table {
+        rows: result.resolution,
+        columns: 2 * result.resolution,
+        samples: result.samples,
+        seed: result.seed,
+        observed: result.observed.clone(),
+        expected: result.expected.clone(),
+    };
+    let title = format!("mfh chi2 · {model} · {} samples", result.samples);
+    crate::report::artefacts::write_record_data(dir, &title, "mfh chi2", &data)
 }
 
 #[cfg(test)]
@@ -404,7 +300,7 @@ mod tests {
         assert_eq!(table["counts"].as_array().unwrap().len(), 8);
         assert_eq!(table["counts"][0].as_array().unwrap().len(), 16);
         assert!(dir.join("chi2_expected.json").exists());
-        // The heat maps: valid PNGs of 16 φ × 8 cos θ cells, 16 px each (256 × 128), listed.
+        // The heat maps: SVGs with axes in θ and φ, a colour bar and the model, listed.
         let listed: Vec<&str> = v["artefacts"]
             .as_array()
             .unwrap()
@@ -413,20 +309,19 @@ mod tests {
             .collect();
         assert_eq!(listed.len(), 5, "{listed:?}");
         for name in [
-            "chi2_observed.png",
-            "chi2_expected.png",
-            "chi2_difference.png",
+            "chi2_observed.svg",
+            "chi2_expected.svg",
+            "chi2_difference.svg",
         ] {
             let path = dir.join(name);
             assert!(listed.contains(&path.to_str().unwrap()), "{listed:?}");
-            let bytes = std::fs::read(&path).unwrap();
-            assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{name}");
-            let reader = png::Decoder::new(std::io::Cursor::new(bytes))
-                .read_info()
-                .unwrap();
-            let info = reader.info();
-            assert_eq!((info.width, info.height), (256, 128), "{name}");
-            assert_eq!(info.color_type, png::ColorType::Rgb);
+            let svg = std::fs::read_to_string(&path).unwrap();
+            assert!(svg.starts_with("<svg"), "{name}");
+            for text in ["θ (degrees)", "φ (degrees)", "ggx alpha=0.3"] {
+                assert!(svg.contains(text), "{name}: {text}");
+            }
+            // 16 φ × 8 cos θ cells and the colour bar's 64 steps.
+            assert!(svg.matches("<rect").count() >= 128 + 64, "{name}");
         }
         let _ = std::fs::remove_dir_all(&dir);
     }

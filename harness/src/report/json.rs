@@ -4,9 +4,19 @@
 use crate::audit::AuditReport;
 use std::path::Path;
 
-/// Serializes the report as pretty JSON. Non-finite numbers (an infinite error) become null.
+/// Serializes the report as pretty JSON, without the records' data (tables and curves go to
+/// artefact files, see [`super::on_disk`]). Non-finite numbers (an infinite error) become null.
 pub fn to_string(report: &AuditReport) -> String {
-    serde_json::to_string_pretty(report).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    let result = if report.records.iter().any(|r| r.data.is_some()) {
+        let mut lean = report.clone();
+        for r in &mut lean.records {
+            r.data = None;
+        }
+        serde_json::to_string_pretty(&lean)
+    } else {
+        serde_json::to_string_pretty(report)
+    };
+    result.unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
 }
 
 /// Writes `report.json`.

@@ -1,18 +1,112 @@
-//! Sinks of an audit report: the terminal summary, `report.json`, JUnit XML.
+//! Sinks of an audit report: the terminal summary, `report.json`, JUnit XML, the artefact
+//! files of records that carry data (chi-square tables and heat maps, KS curves) and the
+//! self-contained `report.html`. Checks do no I/O: everything written is written here.
 
+pub mod artefacts;
+pub mod html;
 pub mod json;
 pub mod junit;
+pub mod plot;
 pub mod terminal;
 
 use crate::audit::AuditReport;
 use std::path::{Path, PathBuf};
 
-/// Writes every file sink into `dir` (created if needed); returns the paths written.
-pub fn write_all(report: &AuditReport, dir: &Path) -> std::io::Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)?;
-    let json_path = dir.join("report.json");
-    json::write(report, &json_path)?;
-    let junit_path = dir.join("junit.xml");
-    std::fs::write(&junit_path, junit::render(report))?;
-    Ok(vec![json_path, junit_path])
+/// Why the report could not be written; names the path (or the plot) and the cause.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    /// The output folder could not be created.
+    #[error("cannot create the output folder {path}: {source}")]
+    CreateFolder {
+        /// The folder.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// A file could not be written.
+    #[error("cannot write {path}: {source}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// An artefact (a record's tables or heat maps) could not be written or drawn.
+    #[error("artefacts of {record}: {source}")]
+    Artefact {
+        /// The record (check, model, case).
+        record: String,
+        /// The error.
+        source: artefacts::ArtefactError,
+    },
+    /// The HTML report could not be rendered (report.json was written before).
+    #[error("cannot render report.html: {0}")]
+    Render(#[from] plot::PlotError),
+}
+
+/// The report as `report.json` holds it: each record with data gets the paths of its artefact
+/// files (in `dir`) and loses the data itself (large tables live in those files).
+pub fn on_disk(report: &AuditReport, dir: &Path) -> AuditReport {
+    let mut out = report.clone();
+    for r in &mut out.records {
+        if let (Some(folder), Some(data)) = (artefacts::relative_folder(r), r.data.as_ref()) {
+            r.artefacts.extend(
+                artefacts::file_names(data)
+                    .iter()
+                    .map(|name| dir.join(&folder).join(name).display().to_string()),
+            );
+        }
+        r.data = None;
+    }
+    out
+}
+
+/// Writes every file sink into `dir` (created if needed), in order: `report.json` first (so
+/// that nothing measured is lost if a later sink fails), then `junit.xml`, the artefact files
+/// of records that carry data (listed in report.json), and `report.html` (which also shows
+/// `cost.json` if `dir` holds one). Returns the files and artefact folders written (not every
+/// artefact file: report.json lists those).
+pub fn write_all(report: &AuditReport, dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
+    std::fs::create_dir_all(dir).map_err(|source| ReportError::CreateFolder {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let write = |path: PathBuf, text: String| {
+        std::fs::write(&path, text)
+            .map(|_| path.clone())
+            .map_err(|source| ReportError::Write { path, source })
+    };
+    let mut written = vec![write(
+        dir.join("report.json"),
+        json::to_string(&on_disk(report, dir)) + "\n",
+    )?];
+    written.push(write(dir.join("junit.xml"), junit::render(report))?);
+    for r in &report.records {
+        if let (Some(folder), Some(data)) = (artefacts::relative_folder(r), r.data.as_ref()) {
+            let paths = artefacts::write_record_data(
+                &dir.join(folder),
+                &artefacts::record_title(r),
+                "mfh audit",
+                data,
+            )
+            .map_err(|source| ReportError::Artefact {
+                record: artefacts::record_title(r),
+                source,
+            })?;
+            if let Some(top) = paths
+                .first()
+                .and_then(|p| p.strip_prefix(dir).ok())
+                .and_then(|p| p.components().next())
+                .map(|c| dir.join(c))
+            {
+                if !written.contains(&top) {
+                    written.push(top);
+                }
+            }
+        }
+    }
+    let cost = std::fs::read_to_string(dir.join("cost.json")).ok();
+    let page = html::render(report, cost.as_deref())?;
+    written.push(write(dir.join("report.html"), page)?);
+    Ok(written)
 }

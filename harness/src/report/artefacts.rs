@@ -1,0 +1,343 @@
+//! Artefact files of records that carry data ([`RecordData`]): the chi-square count tables
+//! (`chi2_observed.json`, `chi2_expected.json`) and heat maps (`chi2_observed.svg`,
+//! `chi2_expected.svg`, `chi2_difference.svg`) in `out/chi2/<model and case>/`, the KS
+//! marginal curves in `out/ks/<model and case>/ks_marginal.json`. The same functions serve
+//! `mfh audit` and `mfh chi2 --out`.
+
+use super::plot::{heat_map_svg, ColourScale, HeatMap, PlotError};
+use crate::record::{CheckRecord, RecordData};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+
+/// A file-name-safe folder name for a model and case: their compact JSON with every run of
+/// characters outside `[A-Za-z0-9.-]` turned into one `_`; past 120 characters, the first 111
+/// and 8 hex digits of a hash (FNV-1a) of the whole, so that long names stay distinct.
+pub fn folder_name(model: &Value, case: &Value) -> String {
+    let text = format!("{model}_{case}");
+    let mut out = String::new();
+    for c in text.chars() {
+        if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
+            out.push(c);
+        } else if !out.ends_with('_') {
+            out.push('_');
+        }
+    }
+    let mut out = out.trim_matches('_').to_string();
+    if out.len() > 120 {
+        let hash = text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+        });
+        out = format!("{}_{:08x}", &out[..111], hash >> 32);
+    }
+    if out.is_empty() {
+        "case".to_string()
+    } else {
+        out
+    }
+}
+
+/// A short human name of a model spec: its family, then its parameters (`ggx alpha=0.3`);
+/// arrays and objects stay compact JSON.
+pub fn model_name(model: &Value) -> String {
+    let Some(map) = model.as_object() else {
+        return if model.is_null() {
+            "(no model)".into()
+        } else {
+            model.to_string()
+        };
+    };
+    let mut out = map
+        .get("family")
+        .and_then(Value::as_str)
+        .unwrap_or("?")
+        .to_string();
+    for (k, v) in map.iter().filter(|(k, _)| *k != "family") {
+        out.push_str(&format!(" {k}={v}"));
+    }
+    out
+}
+
+/// A short human name of a case: `key value` pairs.
+pub fn case_name(case: &Value) -> String {
+    match case.as_object() {
+        Some(map) => map
+            .iter()
+            .map(|(k, v)| match v {
+                Value::String(s) => format!("{k} {s}"),
+                _ => format!("{k} {v}"),
+            })
+            .collect::<Vec<_>>()
+            .join(", "),
+        None => case.to_string(),
+    }
+}
+
+/// The folder (relative to the output folder) a record's artefacts go to, if it has data.
+pub fn relative_folder(record: &CheckRecord) -> Option<PathBuf> {
+    let kind = match record.data.as_ref()? {
+        RecordData::Chi2Table { .. } => "chi2",
+        RecordData::KsMarginal { .. } => "ks",
+        RecordData::Curve { .. } => "curves",
+    };
+    Some(Path::new(kind).join(folder_name(&record.model, &record.case)))
+}
+
+/// The file names a record's data is written to (in [`relative_folder`]).
+pub fn file_names(data: &RecordData) -> &'static [&'static str] {
+    match data {
+        RecordData::Chi2Table { .. } => &[
+            "chi2_observed.json",
+            "chi2_expected.json",
+            "chi2_observed.svg",
+            "chi2_expected.svg",
+            "chi2_difference.svg",
+        ],
+        RecordData::KsMarginal { .. } => &["ks_marginal.json"],
+        RecordData::Curve { .. } => &["curve.json"],
+    }
+}
+
+/// The three chi-square heat maps (observed, expected, (O − E)/√E) as (file name, SVG), titled
+/// `title` plus what each shows. Observed and expected share one linear scale (0 to the
+/// largest count of either); the difference is diverging, ±max(4, largest |residual|), grey
+/// where E = O = 0, magenta where samples fell in a cell of zero expected count.
+pub fn chi2_heat_maps(
+    title: &str,
+    rows: usize,
+    columns: usize,
+    observed: &[u64],
+    expected: &[f64],
+) -> Result<Vec<(&'static str, String)>, PlotError> {
+    let observed: Vec<f64> = observed.iter().map(|&o| o as f64).collect();
+    let max = observed
+        .iter()
+        .chain(expected)
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, f64::max);
+    let difference: Vec<f64> = observed
+        .iter()
+        .zip(expected)
+        .map(|(&o, &e)| match (o, e) {
+            (o, e) if e > 0.0 => (o - e) / e.sqrt(),
+            (o, _) if o > 0.0 => f64::INFINITY,
+            _ => f64::NAN,
+        })
+        .collect();
+    let limit = difference
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(4.0f64, |a, v| a.max(v.abs()));
+    let counts = ColourScale::Sequential { min: 0.0, max };
+    let maps = [
+        (
+            "chi2_observed.svg",
+            "observed counts",
+            "counts",
+            &observed,
+            counts,
+        ),
+        (
+            "chi2_expected.svg",
+            "expected counts",
+            "counts",
+            &expected.to_vec(),
+            counts,
+        ),
+        (
+            "chi2_difference.svg",
+            "(O − E)/√E",
+            "(O − E)/√E",
+            &difference,
+            ColourScale::Diverging { limit },
+        ),
+    ];
+    maps.into_iter()
+        .map(|(name, what, quantity, values, scale)| {
+            let title = format!("{title} — {what}");
+            let svg = heat_map_svg(&HeatMap {
+                title: &title,
+                quantity,
+                rows,
+                columns,
+                values,
+                scale,
+            })?;
+            Ok((name, svg))
+        })
+        .collect()
+}
+
+/// The count tables as JSON text: (`chi2_observed.json`, `chi2_expected.json`), rows of cos θ
+/// (row 0 at the horizon), columns of φ from 0.
+pub fn chi2_tables(
+    generated_by: &str,
+    rows: usize,
+    columns: usize,
+    samples: u64,
+    seed: u64,
+    observed: &[u64],
+    expected: &[f64],
+) -> [(&'static str, String); 2] {
+    let layout = format!(
+        "rows: cos θ in [i/R, (i+1)/R), row 0 at the horizon; columns: φ in \
+         [2πj/{columns}, 2π(j+1)/{columns}); R = {rows}"
+    );
+    let table = |counts: Value| {
+        let value = json!({
+            "generated_by": generated_by,
+            "layout": layout,
+            "samples": samples,
+            "seed": seed,
+            "rows": rows,
+            "columns": columns,
+            "counts": counts,
+        });
+        format!("{value:#}\n")
+    };
+    let o: Vec<&[u64]> = observed.chunks(columns.max(1)).collect();
+    let e: Vec<&[f64]> = expected.chunks(columns.max(1)).collect();
+    [
+        ("chi2_observed.json", table(json!(o))),
+        ("chi2_expected.json", table(json!(e))),
+    ]
+}
+
+/// Why an artefact could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum ArtefactError {
+    /// A plot could not be drawn.
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+    /// A file or folder could not be written.
+    #[error("cannot write {path}: {source}")]
+    Io {
+        /// The path.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+}
+
+fn write_file(path: PathBuf, contents: &str) -> Result<PathBuf, ArtefactError> {
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent).map_err(|source| ArtefactError::Io {
+            path: parent.to_path_buf(),
+            source,
+        })?;
+    }
+    std::fs::write(&path, contents).map_err(|source| ArtefactError::Io {
+        path: path.clone(),
+        source,
+    })?;
+    Ok(path)
+}
+
+/// Writes the files of one record's data into `folder`; returns the paths written (in
+/// [`file_names`] order).
+pub fn write_record_data(
+    folder: &Path,
+    title: &str,
+    generated_by: &str,
+    data: &RecordData,
+) -> Result<Vec<PathBuf>, ArtefactError> {
+    let mut files: Vec<(&str, String)> = Vec::new();
+    match data {
+        RecordData::Chi2Table {
+            rows,
+            columns,
+            samples,
+            seed,
+            observed,
+            expected,
+        } => {
+            files.extend(chi2_tables(
+                generated_by,
+                *rows,
+                *columns,
+                *samples,
+                *seed,
+                observed,
+                expected,
+            ));
+            files.extend(chi2_heat_maps(title, *rows, *columns, observed, expected)?);
+        }
+        RecordData::KsMarginal { .. } => {
+            files.push(("ks_marginal.json", format!("{:#}\n", json!(data))));
+        }
+        RecordData::Curve { .. } => files.push(("curve.json", format!("{:#}\n", json!(data)))),
+    }
+    files
+        .into_iter()
+        .map(|(name, text)| write_file(folder.join(name), &text))
+        .collect()
+}
+
+/// The title of a record's plots: check, model and case.
+pub fn record_title(record: &CheckRecord) -> String {
+    format!(
+        "{} · {} · {}",
+        record.check,
+        model_name(&record.model),
+        case_name(&record.case)
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn folder_names_are_safe_and_distinct() {
+        let name = folder_name(
+            &json!({"family": "ggx", "alpha": 0.3}),
+            &json!({"samples": 10}),
+        );
+        assert_eq!(name, "alpha_0.3_family_ggx_samples_10");
+        let long = |v: f64| {
+            folder_name(
+                &json!({"family": "piecewise_linear", "x": {"theta": [0.0, 0.5, 1.0, 1.5],
+                        "value": [1.0, 0.6, 0.1, 0.0]}, "y": {"theta": [0.0, 0.3, 0.9, 1.5],
+                        "value": [2.0, 0.8, 0.05, v]}}),
+                &json!({"samples": 200000, "resolution": 16}),
+            )
+        };
+        let (a, b) = (long(0.0), long(1e-3));
+        assert!(a.len() == 120 && b.len() == 120 && a != b, "{a} {b}");
+        assert!(a
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "._-".contains(c)));
+    }
+
+    #[test]
+    fn a_chi2_table_is_written_as_tables_and_three_heat_maps() {
+        let dir = std::env::temp_dir().join(format!("mfh-artefacts-{}", std::process::id()));
+        let data = RecordData::Chi2Table {
+            rows: 2,
+            columns: 4,
+            samples: 12,
+            seed: 5,
+            observed: vec![0, 1, 2, 3, 0, 1, 2, 3],
+            expected: vec![0.0, 1.5, 1.5, 3.0, 0.5, 1.0, 2.0, 2.5],
+        };
+        let paths = write_record_data(&dir, "ggx alpha=0.3", "test", &data).unwrap();
+        assert_eq!(paths.len(), 5);
+        for (p, name) in paths.iter().zip(file_names(&data)) {
+            assert!(p.ends_with(name), "{p:?}");
+            let text = std::fs::read_to_string(p).unwrap();
+            if name.ends_with(".svg") {
+                assert!(text.starts_with("<svg") && text.contains("ggx alpha=0.3"));
+            } else {
+                let v: Value = serde_json::from_str(&text).unwrap();
+                assert_eq!(v["counts"].as_array().unwrap().len(), 2);
+                assert_eq!(v["counts"][0].as_array().unwrap().len(), 4);
+            }
+        }
+        // A folder under a regular file cannot be created: a typed error naming the path.
+        let blocked = dir.join("chi2_observed.json").join("x");
+        let e = write_record_data(&blocked, "t", "test", &data).unwrap_err();
+        assert!(e.to_string().contains("chi2_observed.json"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

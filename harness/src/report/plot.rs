@@ -1,0 +1,683 @@
+//! Plots as SVG text, drawn with `plotters` (its SVG backend writes text as `<text>` elements,
+//! so the viewer draws the glyphs: no fonts and no system libraries are needed here). Generic:
+//! line plots with optional log axes (stacked in pairs: a quantity over the relative error
+//! below), heat maps of a (φ, θ) grid with a colour bar, and accuracy-versus-time scatter plots
+//! with the Pareto frontier highlighted ([`pareto_svg`], which `mfh cost` calls).
+//!
+//! Log axes are drawn as linear axes over log10 of the data with tick labels `10^k`: one
+//! coordinate type for every plot, and non-positive or non-finite values are left out (and
+//! counted in the caption) instead of breaking the scale.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+
+/// Why a plot could not be drawn.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("cannot draw the plot \"{title}\": {message}")]
+pub struct PlotError {
+    /// The plot's title.
+    pub title: String,
+    /// What went wrong (the drawing backend's error).
+    pub message: String,
+}
+
+/// One curve (or set of points) of a line plot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// The legend entry.
+    pub label: String,
+    /// The points (x, y).
+    pub points: Vec<(f64, f64)>,
+    /// Draw markers at the points (and no line when `line` is false).
+    pub markers: bool,
+    /// Join the points with a line.
+    pub line: bool,
+}
+
+impl Series {
+    /// A line with markers.
+    pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            label: label.into(),
+            points,
+            markers: true,
+            line: true,
+        }
+    }
+}
+
+/// A line plot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinePlot {
+    /// The caption.
+    pub title: String,
+    /// The x axis' label.
+    pub x_label: String,
+    /// The y axis' label.
+    pub y_label: String,
+    /// log10 x axis.
+    pub x_log: bool,
+    /// log10 y axis.
+    pub y_log: bool,
+    /// The curves.
+    pub series: Vec<Series>,
+    /// Horizontal reference lines (y, label), e.g. a tolerance.
+    pub h_lines: Vec<(f64, String)>,
+    /// Where the legend goes (the corner the curves leave free).
+    pub legend: Corner,
+}
+
+/// A corner of a plot, for its legend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Corner {
+    /// Upper left.
+    UpperLeft,
+    /// Upper right.
+    #[default]
+    UpperRight,
+    /// Lower left.
+    LowerLeft,
+    /// Lower right.
+    LowerRight,
+}
+
+impl Corner {
+    fn position(self) -> SeriesLabelPosition {
+        match self {
+            Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
+            Corner::UpperRight => SeriesLabelPosition::UpperRight,
+            Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
+            Corner::LowerRight => SeriesLabelPosition::LowerRight,
+        }
+    }
+}
+
+/// Size of one plot, pixels.
+pub const WIDTH: u32 = 640;
+/// Height of one line plot, pixels.
+pub const HEIGHT: u32 = 300;
+
+/// Series colours (colour-blind-safe palette of Okabe and Ito).
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(86, 180, 233),
+    RGBColor(230, 159, 0),
+    RGBColor(0, 0, 0),
+    RGBColor(240, 228, 66),
+];
+
+fn plot_error<E: std::fmt::Debug>(title: &str) -> impl Fn(E) -> PlotError + '_ {
+    move |e| PlotError {
+        title: title.to_string(),
+        message: format!("{e:?}"),
+    }
+}
+
+/// The data coordinate of a value on an axis (log10 on a log axis; None where it cannot be
+/// drawn).
+fn axis_value(v: f64, log: bool) -> Option<f64> {
+    if !v.is_finite() || (log && v <= 0.0) {
+        None
+    } else if log {
+        Some(v.log10())
+    } else {
+        Some(v)
+    }
+}
+
+/// A range around the values, padded; a unit range where there are none.
+fn padded_range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    if !(lo <= hi) {
+        return (0.0, 1.0);
+    }
+    let span = hi - lo;
+    let pad = if span > 0.0 {
+        0.05 * span
+    } else if log {
+        0.5
+    } else {
+        0.5 * lo.abs().max(1e-300)
+    };
+    (lo - pad, hi + pad)
+}
+
+fn tick_label(v: f64, log: bool) -> String {
+    if log {
+        let k = v.round();
+        if (v - k).abs() < 1e-9 {
+            format!("1e{k}")
+        } else {
+            format!("{:.1e}", 10f64.powf(v))
+        }
+    } else if v == 0.0 {
+        "0".into()
+    } else if v.abs() >= 1e4 || v.abs() < 1e-3 {
+        format!("{v:.1e}")
+    } else {
+        format!("{}", (v * 1e4).round() / 1e4)
+    }
+}
+
+/// Draws a line plot into an area.
+fn draw_lines(area: &DrawingArea<SVGBackend<'_>, Shift>, plot: &LinePlot) -> Result<(), PlotError> {
+    let err = plot_error(&plot.title);
+    let mut dropped = 0usize;
+    let series: Vec<Vec<(f64, f64)>> = plot
+        .series
+        .iter()
+        .map(|s| {
+            s.points
+                .iter()
+                .filter_map(|&(x, y)| {
+                    let p = axis_value(x, plot.x_log).zip(axis_value(y, plot.y_log));
+                    if p.is_none() {
+                        dropped += 1;
+                    }
+                    p
+                })
+                .collect()
+        })
+        .collect();
+    let h_lines: Vec<(f64, &str)> = plot
+        .h_lines
+        .iter()
+        .filter_map(|(y, l)| axis_value(*y, plot.y_log).map(|y| (y, l.as_str())))
+        .collect();
+    let x_range = padded_range(series.iter().flatten().map(|p| p.0), plot.x_log);
+    let y_range = padded_range(
+        series
+            .iter()
+            .flatten()
+            .map(|p| p.1)
+            .chain(h_lines.iter().map(|h| h.0)),
+        plot.y_log,
+    );
+    let caption = if dropped > 0 {
+        format!(
+            "{} ({dropped} point(s) ≤ 0 or not finite left out)",
+            plot.title
+        )
+    } else {
+        plot.title.clone()
+    };
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 15))
+        .margin(8)
+        .x_label_area_size(36)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
+        .map_err(&err)?;
+    let (x_log, y_log) = (plot.x_log, plot.y_log);
+    chart
+        .configure_mesh()
+        .x_desc(plot.x_label.as_str())
+        .y_desc(plot.y_label.as_str())
+        .x_label_formatter(&|v| tick_label(*v, x_log))
+        .y_label_formatter(&|v| tick_label(*v, y_log))
+        .light_line_style(RGBColor(235, 235, 235))
+        .label_style(("sans-serif", 12))
+        .draw()
+        .map_err(&err)?;
+    for (i, (s, points)) in plot.series.iter().zip(&series).enumerate() {
+        let colour = PALETTE[i % PALETTE.len()];
+        let style = ShapeStyle::from(&colour).stroke_width(2);
+        if s.line {
+            chart
+                .draw_series(LineSeries::new(points.iter().copied(), style))
+                .map_err(&err)?
+                .label(s.label.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+        }
+        if s.markers {
+            let anno = chart
+                .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                .map_err(&err)?;
+            if !s.line {
+                anno.label(s.label.as_str())
+                    .legend(move |(x, y)| Circle::new((x + 9, y), 3, colour.filled()));
+            }
+        }
+    }
+    for (y, label) in &h_lines {
+        let style = ShapeStyle::from(&RGBColor(200, 0, 0)).stroke_width(1);
+        chart
+            .draw_series(DashedLineSeries::new(
+                vec![(x_range.0, *y), (x_range.1, *y)],
+                6,
+                4,
+                style,
+            ))
+            .map_err(&err)?
+            .label(*label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+    }
+    if !plot.series.is_empty() || !h_lines.is_empty() {
+        chart
+            .configure_series_labels()
+            .position(plot.legend.position())
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(160, 160, 160))
+            .label_font(("sans-serif", 12))
+            .draw()
+            .map_err(&err)?;
+    }
+    Ok(())
+}
+
+/// A line plot as SVG.
+pub fn line_svg(plot: &LinePlot) -> Result<String, PlotError> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (WIDTH, HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error(&plot.title))?;
+        draw_lines(&root, plot)?;
+        root.present().map_err(plot_error(&plot.title))?;
+    }
+    Ok(svg)
+}
+
+/// Two line plots stacked in one SVG (e.g. Λ against the oracle above, the relative error on a
+/// log axis below).
+pub fn stacked_svg(top: &LinePlot, bottom: &LinePlot) -> Result<String, PlotError> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (WIDTH, 2 * HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error(&top.title))?;
+        let (a, b) = root.split_vertically(HEIGHT);
+        draw_lines(&a, top)?;
+        draw_lines(&b, bottom)?;
+        root.present().map_err(plot_error(&top.title))?;
+    }
+    Ok(svg)
+}
+
+/// How heat-map values map to colours.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ColourScale {
+    /// Linear from `min` (dark violet) to `max` (yellow), viridis-like.
+    Sequential {
+        /// The value drawn darkest.
+        min: f64,
+        /// The value drawn brightest.
+        max: f64,
+    },
+    /// Linear from −`limit` (blue) through 0 (white) to +`limit` (red), clipped beyond.
+    Diverging {
+        /// The magnitude drawn in the fullest colour.
+        limit: f64,
+    },
+}
+
+const VIRIDIS: [[f64; 3]; 9] = [
+    [68.0, 1.0, 84.0],
+    [71.0, 44.0, 122.0],
+    [59.0, 81.0, 139.0],
+    [44.0, 113.0, 142.0],
+    [33.0, 144.0, 141.0],
+    [39.0, 173.0, 129.0],
+    [92.0, 200.0, 99.0],
+    [170.0, 220.0, 50.0],
+    [253.0, 231.0, 37.0],
+];
+const BLUE: [f64; 3] = [33.0, 102.0, 172.0];
+const PALE: [f64; 3] = [247.0, 247.0, 247.0];
+const RED: [f64; 3] = [178.0, 24.0, 43.0];
+/// Cells with no samples and none expected (NaN).
+pub const NAN_COLOUR: RGBColor = RGBColor(150, 150, 150);
+/// Cells with samples where none are expected (±∞).
+pub const INFINITE_COLOUR: RGBColor = RGBColor(255, 0, 255);
+
+fn mix(a: [f64; 3], b: [f64; 3], t: f64) -> RGBColor {
+    let c = |i: usize| (a[i] + (b[i] - a[i]) * t).round().clamp(0.0, 255.0) as u8;
+    RGBColor(c(0), c(1), c(2))
+}
+
+/// The colour of a value under a scale (NaN grey, ±∞ magenta).
+pub fn colour(value: f64, scale: ColourScale) -> RGBColor {
+    if value.is_nan() {
+        return NAN_COLOUR;
+    }
+    if value.is_infinite() {
+        return INFINITE_COLOUR;
+    }
+    match scale {
+        ColourScale::Sequential { min, max } => {
+            let t = if max > min {
+                ((value - min) / (max - min)).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let x = t * (VIRIDIS.len() - 1) as f64;
+            let i = (x as usize).min(VIRIDIS.len() - 2);
+            mix(VIRIDIS[i], VIRIDIS[i + 1], x - i as f64)
+        }
+        ColourScale::Diverging { limit } => {
+            let t = if limit > 0.0 {
+                (value / limit).clamp(-1.0, 1.0)
+            } else {
+                0.0
+            };
+            if t < 0.0 {
+                mix(PALE, BLUE, -t)
+            } else {
+                mix(PALE, RED, t)
+            }
+        }
+    }
+}
+
+/// A heat map over the hemisphere's (φ, cos θ) grid: `rows` cos θ-rows (row 0 at the horizon,
+/// cos θ ∈ [i/R, (i+1)/R)) × `columns` φ-columns over [0, 2π), row-major. Drawn with φ in
+/// degrees across and θ in degrees down (cells of equal solid angle: rows are uneven in θ).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeatMap<'a> {
+    /// The caption (name the model and the case).
+    pub title: &'a str,
+    /// What the colours show (the colour bar's label).
+    pub quantity: &'a str,
+    /// cos θ-rows.
+    pub rows: usize,
+    /// φ-columns.
+    pub columns: usize,
+    /// The values (NaN grey, ±∞ magenta).
+    pub values: &'a [f64],
+    /// The colour scale.
+    pub scale: ColourScale,
+}
+
+/// Height of a heat map, pixels.
+pub const HEAT_MAP_HEIGHT: u32 = 320;
+
+/// A heat map with axes in φ and θ and a colour bar, as SVG.
+pub fn heat_map_svg(map: &HeatMap<'_>) -> Result<String, PlotError> {
+    let err = plot_error(map.title);
+    if map.rows == 0 || map.columns == 0 || map.values.len() != map.rows * map.columns {
+        return Err(PlotError {
+            title: map.title.to_string(),
+            message: format!(
+                "{} values for a {} × {} grid",
+                map.values.len(),
+                map.rows,
+                map.columns
+            ),
+        });
+    }
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (WIDTH, HEAT_MAP_HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(&err)?;
+        let (main, bar) = root.split_horizontally(WIDTH - 110);
+        let mut chart = ChartBuilder::on(&main)
+            .caption(map.title, ("sans-serif", 14))
+            .margin(8)
+            .x_label_area_size(36)
+            .y_label_area_size(48)
+            .build_cartesian_2d(0.0..360.0, 90.0..0.0)
+            .map_err(&err)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("φ (degrees)")
+            .y_desc("θ (degrees)")
+            .x_labels(9)
+            .y_labels(7)
+            .label_style(("sans-serif", 12))
+            .draw()
+            .map_err(&err)?;
+        let (rows, columns) = (map.rows as f64, map.columns as f64);
+        let theta = |c: f64| c.clamp(0.0, 1.0).acos().to_degrees();
+        chart
+            .draw_series(map.values.iter().enumerate().map(|(k, &v)| {
+                let (i, j) = ((k / map.columns) as f64, (k % map.columns) as f64);
+                Rectangle::new(
+                    [
+                        (360.0 * j / columns, theta(i / rows)),
+                        (360.0 * (j + 1.0) / columns, theta((i + 1.0) / rows)),
+                    ],
+                    colour(v, map.scale).filled(),
+                )
+            }))
+            .map_err(&err)?;
+        let (lo, hi) = match map.scale {
+            ColourScale::Sequential { min, max } => (min, if max > min { max } else { min + 1.0 }),
+            ColourScale::Diverging { limit } => {
+                let l = if limit > 0.0 { limit } else { 1.0 };
+                (-l, l)
+            }
+        };
+        let mut scale_chart = ChartBuilder::on(&bar)
+            .margin_top(30)
+            .margin_bottom(44)
+            .margin_right(8)
+            .y_label_area_size(62)
+            .caption(map.quantity, ("sans-serif", 11))
+            .build_cartesian_2d(0.0..1.0, lo..hi)
+            .map_err(&err)?;
+        scale_chart
+            .configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_labels(6)
+            .y_label_formatter(&|v| tick_label(*v, false))
+            .label_style(("sans-serif", 11))
+            .draw()
+            .map_err(&err)?;
+        let steps = 64;
+        scale_chart
+            .draw_series((0..steps).map(|s| {
+                let a = lo + (hi - lo) * s as f64 / steps as f64;
+                let b = lo + (hi - lo) * (s + 1) as f64 / steps as f64;
+                Rectangle::new(
+                    [(0.0, a), (1.0, b)],
+                    colour(0.5 * (a + b), map.scale).filled(),
+                )
+            }))
+            .map_err(&err)?;
+        root.present().map_err(&err)?;
+    }
+    Ok(svg)
+}
+
+/// The indices of the Pareto frontier of (time, error) points: those no other point beats in
+/// both (≤ in both and < in one), sorted by time. Points with a non-finite or negative
+/// coordinate are never on it.
+pub fn pareto_frontier(points: &[(f64, f64)]) -> Vec<usize> {
+    let ok = |p: &(f64, f64)| p.0.is_finite() && p.1.is_finite() && p.0 >= 0.0 && p.1 >= 0.0;
+    let mut front: Vec<usize> = (0..points.len())
+        .filter(|&i| ok(&points[i]))
+        .filter(|&i| {
+            let (t, e) = points[i];
+            !points
+                .iter()
+                .any(|q| ok(q) && q.0 <= t && q.1 <= e && (q.0 < t || q.1 < e))
+        })
+        .collect();
+    front.sort_by(|&a, &b| points[a].0.total_cmp(&points[b].0));
+    front
+}
+
+/// Accuracy against time: every route a point (time per evaluation on x, max error on y, both
+/// log10), labelled with its route; the Pareto frontier (no route both faster and more
+/// accurate) joined and drawn in red. Always returns an SVG: if drawing fails, one that says
+/// why. Errors of exactly 0 are drawn at the smallest positive error (or 1e-17) and marked "=0".
+pub fn pareto_svg(title: &str, points: &[(String, f64, f64)]) -> String {
+    match try_pareto(title, points) {
+        Ok(svg) => svg,
+        Err(e) => {
+            let mut svg = String::new();
+            let _ = write!(
+                svg,
+                "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{WIDTH}\" height=\"40\">\
+                 <text x=\"8\" y=\"24\" font-family=\"sans-serif\" font-size=\"13\">{}</text></svg>",
+                super::html::escape(&e.to_string())
+            );
+            svg
+        }
+    }
+}
+
+fn try_pareto(title: &str, points: &[(String, f64, f64)]) -> Result<String, PlotError> {
+    let err = plot_error(title);
+    let floor = points
+        .iter()
+        .map(|p| p.2)
+        .filter(|e| *e > 0.0 && e.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let floor = if floor.is_finite() { floor } else { 1e-17 };
+    let shown: Vec<(f64, f64)> = points
+        .iter()
+        .map(|p| (p.1, if p.2 == 0.0 { floor } else { p.2 }))
+        .collect();
+    let front = pareto_frontier(&shown);
+    let logged: Vec<Option<(f64, f64)>> = shown
+        .iter()
+        .map(|&(t, e)| axis_value(t, true).zip(axis_value(e, true)))
+        .collect();
+    let x_range = padded_range(logged.iter().flatten().map(|p| p.0), true);
+    let y_range = padded_range(logged.iter().flatten().map(|p| p.1), true);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (WIDTH, 380)).into_drawing_area();
+        root.fill(&WHITE).map_err(&err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 15))
+            .margin(10)
+            .x_label_area_size(36)
+            .y_label_area_size(64)
+            .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
+            .map_err(&err)?;
+        chart
+            .configure_mesh()
+            .x_desc("seconds per evaluation")
+            .y_desc("max error")
+            .x_label_formatter(&|v| tick_label(*v, true))
+            .y_label_formatter(&|v| tick_label(*v, true))
+            .light_line_style(RGBColor(235, 235, 235))
+            .label_style(("sans-serif", 12))
+            .draw()
+            .map_err(&err)?;
+        let red = RGBColor(200, 0, 0);
+        let front_points: Vec<(f64, f64)> = front.iter().filter_map(|&i| logged[i]).collect();
+        chart
+            .draw_series(LineSeries::new(
+                front_points.iter().copied(),
+                ShapeStyle::from(&red).stroke_width(2),
+            ))
+            .map_err(&err)?
+            .label("Pareto frontier")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], red));
+        for (i, p) in logged.iter().enumerate() {
+            let Some(p) = *p else { continue };
+            let on = front.contains(&i);
+            let c = if on { red } else { RGBColor(90, 90, 90) };
+            let mut label = points[i].0.clone();
+            if points[i].2 == 0.0 {
+                label.push_str(" (=0)");
+            }
+            chart
+                .draw_series([EmptyElement::at(p)
+                    + Circle::new((0, 0), 4, c.filled())
+                    + Text::new(label, (6, -12), ("sans-serif", 11).into_font().color(&c))])
+                .map_err(&err)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(160, 160, 160))
+            .draw()
+            .map_err(&err)?;
+        root.present().map_err(&err)?;
+    }
+    Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_frontier_keeps_exactly_the_undominated_points() {
+        let points = [
+            (1.0, 1e-3),
+            (2.0, 1e-6),
+            (3.0, 1e-6),
+            (0.5, 1e-2),
+            (2.5, 1e-1),
+        ];
+        assert_eq!(pareto_frontier(&points), vec![3, 0, 1]);
+        assert_eq!(pareto_frontier(&[(f64::NAN, 1.0), (1.0, 1.0)]), vec![1]);
+    }
+
+    #[test]
+    fn plots_are_svg_with_their_titles_and_every_point() {
+        let svg = pareto_svg(
+            "STD Λ",
+            &[
+                ("stable".into(), 1e-7, 1e-15),
+                ("2f1".into(), 1e-6, 1e-13),
+                ("table1".into(), 5e-8, 0.0),
+            ],
+        );
+        assert!(svg.starts_with("<svg") && svg.contains("STD Λ"), "{svg}");
+        for route in ["stable", "2f1", "table1 (=0)", "Pareto frontier"] {
+            assert!(svg.contains(route), "{route}");
+        }
+        let plot = LinePlot {
+            title: "Λ".into(),
+            x_label: "θ".into(),
+            y_label: "relative error".into(),
+            x_log: false,
+            y_log: true,
+            series: vec![Series::new(
+                "route a",
+                vec![(0.1, 1e-16), (0.5, 0.0), (1.0, 1e-12)],
+            )],
+            h_lines: vec![(1e-10, "tolerance".into())],
+            legend: Corner::UpperLeft,
+        };
+        let svg = line_svg(&plot).unwrap();
+        assert!(
+            svg.contains("1 point(s) ≤ 0 or not finite left out"),
+            "{svg}"
+        );
+        assert!(svg.contains("route a") && svg.contains("tolerance"));
+        let values = [1.0, 2.0, f64::NAN, f64::INFINITY, -3.0, 0.5];
+        let map = HeatMap {
+            title: "ggx α = 0.3, observed",
+            quantity: "counts",
+            rows: 2,
+            columns: 3,
+            values: &values,
+            scale: ColourScale::Diverging { limit: 4.0 },
+        };
+        let svg = heat_map_svg(&map).unwrap();
+        assert!(svg.contains("θ (degrees)") && svg.contains("φ (degrees)"));
+        let bad = HeatMap {
+            values: &values[..5],
+            ..map
+        };
+        assert!(heat_map_svg(&bad).is_err());
+    }
+
+    #[test]
+    fn colours_follow_their_scales() {
+        let s = ColourScale::Sequential { min: 0.0, max: 2.0 };
+        assert_eq!(colour(0.0, s), RGBColor(68, 1, 84));
+        assert_eq!(colour(2.0, s), RGBColor(253, 231, 37));
+        assert_eq!(colour(5.0, s), RGBColor(253, 231, 37));
+        let d = ColourScale::Diverging { limit: 4.0 };
+        assert_eq!(colour(0.0, d), RGBColor(247, 247, 247));
+        assert_eq!(colour(-4.0, d), RGBColor(33, 102, 172));
+        assert_eq!(colour(9.0, d), RGBColor(178, 24, 43));
+        assert_eq!(colour(f64::NAN, d), NAN_COLOUR);
+        assert_eq!(colour(f64::NEG_INFINITY, d), INFINITE_COLOUR);
+    }
+}
