@@ -5,6 +5,7 @@ pub mod chi2;
 pub mod cubature;
 pub mod domain;
 pub mod ks;
+pub mod lobe;
 pub mod monte_carlo;
 pub mod precise;
 pub mod quadrature;
