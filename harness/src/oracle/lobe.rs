@@ -392,20 +392,34 @@ impl Lobe {
         self.widest / self.narrowest
     }
 
-    /// Polar cut points strictly inside (0, `theta_max`), with 0 and `theta_max` added: every
-    /// scale from the narrowest to the widest × {10⁻³ … 10²} (and the geometric steps of 3
-    /// between them), and the mode ± its θ half-width × {0.3 … 64}. Sorted, without points
+    /// Polar cut points strictly inside (0, `theta_max`), with 0 and `theta_max` added: the
+    /// narrowest scale × {10⁻³ … 1}, geometric steps of at most 3 up to the widest, the widest ×
+    /// {1 … 10²}, and the mode ± its θ half-width × {0.3 … 64}. Sorted, without points
     /// closer than 1e-3 relative.
     pub fn polar_cuts(&self, theta_max: f64) -> Vec<f64> {
         let mut cuts = vec![0.0, theta_max];
-        let mut scale = self.narrowest;
-        loop {
-            cuts.extend(SCALE_MULTIPLES.iter().map(|k| k * scale));
-            if scale >= self.widest {
-                break;
-            }
-            scale = (scale * 3.0).min(self.widest);
+        // Below the narrowest scale and above the widest, the former fixed multiples; between
+        // them geometric steps of at most 3 (not every multiple of every scale: each cut costs
+        // every inner integral a piece).
+        cuts.extend(
+            SCALE_MULTIPLES
+                .iter()
+                .filter(|&&k| k <= 1.0)
+                .map(|k| k * self.narrowest),
+        );
+        let steps = (self.widest / self.narrowest).ln() / 3f64.ln();
+        let steps = steps.ceil().max(0.0) as usize;
+        for i in 1..steps {
+            cuts.push(
+                self.narrowest * (self.widest / self.narrowest).powf(i as f64 / steps as f64),
+            );
         }
+        cuts.extend(
+            SCALE_MULTIPLES
+                .iter()
+                .filter(|&&k| k >= 1.0)
+                .map(|k| k * self.widest),
+        );
         if let Some(m) = self.mode {
             cuts.push(m.theta);
             for k in MODE_MULTIPLES {

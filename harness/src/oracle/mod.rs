@@ -22,3 +22,6 @@ pub struct Estimate {
     /// Integrand evaluations spent.
     pub evaluations: u64,
 }
+
+#[cfg(test)]
+mod sweep_tests;
