@@ -1,7 +1,41 @@
 //! Adaptive cubature over rectangles with an error bound: the tensor product of the
 //! Gauss–Kronrod G7/K15 pair, bisected into quadrants until the estimate meets the tolerance.
 
-use mfh_reference::special::gauss_kronrod::{WG, WGK, XGK};
+// The G7/K15 pair written here, not imported from `mfh_reference::special::gauss_kronrod`:
+// an oracle owes nothing to the code it checks (issue 11). Values: QUADPACK's `dqk15`
+// (Piessens, de Doncker-Kapenga, Überhuber, Kahaner 1983, "QUADPACK", Springer, §2.2;
+// the netlib source lists them to 33 digits), rounded to f64. `tests::rule_degrees` checks them
+// by the degrees they integrate exactly (K15: 22, G7: 13) and by the known moments.
+
+/// K15 abscissae on [−1, 1], descending; the odd-indexed ones are the G7 nodes.
+const XGK: [f64; 8] = [
+    0.991_455_371_120_812_6,
+    0.949_107_912_342_758_5,
+    0.864_864_423_359_769_1,
+    0.741_531_185_599_394_5,
+    0.586_087_235_467_691_1,
+    0.405_845_151_377_397_2,
+    0.207_784_955_007_898_48,
+    0.0,
+];
+/// K15 weights of the abscissae [`XGK`].
+const WGK: [f64; 8] = [
+    0.022_935_322_010_529_224,
+    0.063_092_092_629_978_56,
+    0.104_790_010_322_250_19,
+    0.140_653_259_715_525_92,
+    0.169_004_726_639_267_9,
+    0.190_350_578_064_785_42,
+    0.204_432_940_075_298_89,
+    0.209_482_141_084_727_82,
+];
+/// G7 weights of the abscissae XGK[1], XGK[3], XGK[5], XGK[7].
+const WG: [f64; 4] = [
+    0.129_484_966_168_869_7,
+    0.279_705_391_489_276_64,
+    0.381_830_050_505_118_9,
+    0.417_959_183_673_469_4,
+];
 
 /// The deepest quadrant bisection; past it the estimate is accepted with its error.
 pub const MAX_DEPTH: u32 = 10;
@@ -111,6 +145,37 @@ mod tests {
             absolute: t,
             relative: 0.0,
         }
+    }
+
+    #[test]
+    fn rule_degrees() {
+        // ∫_{-1}^{1} x^k = 2/(k+1) for even k: K15 is exact to degree 22 (3·7 + 1), G7 to 13.
+        let (x, wk, wg) = rule(-1.0, 1.0);
+        for k in (0..=30).step_by(2) {
+            let exact = 2.0 / (k as f64 + 1.0);
+            let kronrod: f64 = (0..15).map(|i| wk[i] * x[i].powi(k)).sum();
+            let gauss: f64 = (0..15).map(|i| wg[i] * x[i].powi(k)).sum();
+            if k <= 22 {
+                assert!((kronrod - exact).abs() < 4e-16, "K15 degree {k}: {kronrod}");
+            } else {
+                assert!(
+                    (kronrod - exact).abs() > 1e-12,
+                    "K15 is not exact at degree {k}"
+                );
+            }
+            if k <= 13 {
+                assert!((gauss - exact).abs() < 4e-16, "G7 degree {k}: {gauss}");
+            } else {
+                assert!(
+                    (gauss - exact).abs() > 1e-9,
+                    "G7 is not exact at degree {k}"
+                );
+            }
+        }
+        // Odd moments vanish by symmetry; the G7 nodes are the K15 odd-indexed ones.
+        let odd: f64 = (0..15).map(|i| wk[i] * x[i].powi(7)).sum();
+        assert!(odd.abs() < 1e-16);
+        assert_eq!((0..15).filter(|&i| wg[i] != 0.0).count(), 7);
     }
 
     #[test]

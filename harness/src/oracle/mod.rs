@@ -5,6 +5,7 @@ pub mod chi2;
 pub mod cubature;
 pub mod domain;
 pub mod ks;
+pub mod lobe;
 pub mod monte_carlo;
 pub mod precise;
 pub mod quadrature;
@@ -21,3 +22,6 @@ pub struct Estimate {
     /// Integrand evaluations spent.
     pub evaluations: u64,
 }
+
+#[cfg(test)]
+mod sweep_tests;

@@ -7,6 +7,7 @@
 //! rule family so that it shares no failure mode with them, and tanh–sinh is robust to the
 //! integrable end-point singularities of heavy-tailed slope densities.
 
+use super::lobe::Lobe;
 use super::Estimate;
 use mfh_reference::Vec3;
 use std::cell::Cell;
@@ -288,8 +289,6 @@ pub fn integrate_cap_polar(
     cuts: Option<Cuts<'_>>,
     accuracy: Accuracy,
 ) -> Estimate {
-    let evaluations = Cell::new(0u64);
-    let inner_error = Cell::new(0.0f64);
     let mut polar_cuts = vec![0.0];
     for k in [1e-3, 1e-2, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0] {
         let t = width * k;
@@ -297,6 +296,44 @@ pub fn integrate_cap_polar(
             polar_cuts.push(t);
         }
     }
+    let tau = std::f64::consts::TAU;
+    let phi_points = [0.0, 0.25 * tau, 0.5 * tau, 0.75 * tau, tau];
+    cap_polar(f, theta_max, &polar_cuts, &phi_points, cuts, accuracy)
+}
+
+/// [`integrate_cap_polar`] with the polar and azimuthal cuts of a measured lobe
+/// ([`Lobe::polar_cuts`], [`Lobe::azimuth_cuts`]) instead of a width: the lobe's every scale,
+/// its anisotropy and an off-axis mode are cut at, so that its peak is resolved however narrow.
+pub fn integrate_cap_polar_lobe(
+    f: &dyn Fn(f64, f64) -> f64,
+    theta_max: f64,
+    lobe: &Lobe,
+    cuts: Option<Cuts<'_>>,
+    accuracy: Accuracy,
+) -> Estimate {
+    let polar = lobe.polar_cuts(theta_max);
+    cap_polar(
+        f,
+        theta_max,
+        &polar[..polar.len() - 1],
+        &lobe.azimuth_cuts(),
+        cuts,
+        accuracy,
+    )
+}
+
+/// ∫ over the cap with the polar cuts `polar_cuts` (from 0, without `theta_max`) and the
+/// azimuthal cuts `phi_cuts` (from 0 to 2π), plus the integrand's own `cuts`.
+fn cap_polar(
+    f: &dyn Fn(f64, f64) -> f64,
+    theta_max: f64,
+    polar_cuts: &[f64],
+    phi_cuts: &[f64],
+    cuts: Option<Cuts<'_>>,
+    accuracy: Accuracy,
+) -> Estimate {
+    let evaluations = Cell::new(0u64);
+    let inner_error = Cell::new(0.0f64);
     // The inner integrals are asked for a little more than the outer one, but not below
     // round-off (the double-exponential error estimate cannot certify less than ~1e-15).
     let inner_accuracy = Accuracy {
@@ -304,7 +341,7 @@ pub fn integrate_cap_polar(
         absolute: 0.05 * accuracy.absolute / std::f64::consts::TAU,
     };
     let inner = |phi: f64| {
-        let mut points = polar_cuts.clone();
+        let mut points = polar_cuts.to_vec();
         if let Some(c) = cuts {
             points.extend(
                 (c.theta)(phi)
@@ -332,7 +369,7 @@ pub fn integrate_cap_polar(
         e.value
     };
     let tau = std::f64::consts::TAU;
-    let mut phi_points: Vec<f64> = vec![0.0, 0.25 * tau, 0.5 * tau, 0.75 * tau, tau];
+    let mut phi_points: Vec<f64> = phi_cuts.to_vec();
     if let Some(c) = cuts {
         phi_points.extend(c.phi.iter().copied().filter(|p| *p > 0.0 && *p < tau));
     }
@@ -368,6 +405,36 @@ pub fn integrate_hemisphere_polar(
 ) -> Estimate {
     integrate_cap_polar(f, std::f64::consts::FRAC_PI_2, width, cuts, accuracy)
 }
+
+/// ∫ f(m) dm over the upper hemisphere (n = +z), cut where the measured `lobe` varies
+/// ([`integrate_cap_polar_lobe`]): normalization and furnace integrals of a lobe of any width.
+pub fn integrate_hemisphere_lobe(
+    f: &dyn Fn(Vec3) -> f64,
+    lobe: &Lobe,
+    cuts: Option<Cuts<'_>>,
+    accuracy: Accuracy,
+) -> Estimate {
+    integrate_cap_polar_lobe(
+        &|theta, phi| f(direction(&IDENTITY, theta, phi)),
+        std::f64::consts::FRAC_PI_2,
+        lobe,
+        cuts,
+        accuracy,
+    )
+}
+
+/// [`integrate_hemisphere_lobe`] for an integrand of (θ, φ) about +z, φ from +x.
+pub fn integrate_hemisphere_polar_lobe(
+    f: &dyn Fn(f64, f64) -> f64,
+    lobe: &Lobe,
+    cuts: Option<Cuts<'_>>,
+    accuracy: Accuracy,
+) -> Estimate {
+    integrate_cap_polar_lobe(f, std::f64::consts::FRAC_PI_2, lobe, cuts, accuracy)
+}
+
+/// The frame about +z.
+const IDENTITY: [Vec3; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 /// ∫ f(m) dm over the upper hemisphere (n = +z), for an f peaked at the normal with width `width`.
 pub fn integrate_hemisphere(

@@ -1,0 +1,295 @@
+use super::*;
+use mfh_reference::ndf::Ggx;
+use mfh_reference::{Model, ModelSpec};
+use std::f64::consts::PI;
+
+fn model(json: &str) -> Box<dyn Model> {
+    serde_json::from_str::<ModelSpec>(json)
+        .unwrap()
+        .build()
+        .unwrap()
+}
+
+fn config(samples: u64, seed: u64) -> KsConfig {
+    KsConfig {
+        samples,
+        seed,
+        alpha: 1e-4,
+    }
+}
+
+fn hints(width: f64) -> LobeHints<'static> {
+    LobeHints {
+        width,
+        theta_kinks: &[],
+    }
+}
+
+fn report(name: &str, r: &KsResult) {
+    eprintln!(
+        "{name} {:?}: D = {:.3e}, λ = {:.3}, p = {:.4}, knots {}, table bound {:.1e}, \
+         mass {:.12}, {} pdf evaluations, table {:.3} s, sampling {:.3} s",
+        r.marginal,
+        r.statistic,
+        r.lambda,
+        r.p_value,
+        r.knots,
+        r.table_error_bound,
+        r.pdf_mass,
+        r.evaluations,
+        r.table_seconds,
+        r.sampling_seconds
+    );
+}
+
+#[test]
+fn ks_kolmogorov_distribution_values() {
+    // P(K ≤ 1) = 0.730000328322645…; the critical values of K at 0.05, 0.01 and 0.001
+    // (the 99-term series in double precision, solved by bisection).
+    assert!((kolmogorov_q(1.0) - 0.269_999_671_677_354_56).abs() < 1e-14);
+    for (lambda, p) in [
+        (1.358_098_639_322_550_5, 0.05),
+        (1.627_623_611_518_950_2, 0.01),
+        (1.949_474_603_504_375, 0.001),
+    ] {
+        assert!((kolmogorov_q(lambda) / p - 1.0).abs() < 1e-9, "{lambda}");
+    }
+    // The two series agree across their switch point.
+    let series_small = |l: f64| {
+        let y = (-PI * PI / (8.0 * l * l)).exp();
+        1.0 - (TAU.sqrt() / l) * [1, 9, 25, 49, 81].iter().map(|&k| y.powi(k)).sum::<f64>()
+    };
+    let series_large = |l: f64| {
+        let x = (-2.0 * l * l).exp();
+        2.0 * (1..=10)
+            .map(|k: i32| f64::from(if k % 2 == 1 { 1 } else { -1 }) * x.powi(k * k))
+            .sum::<f64>()
+    };
+    for l in [0.9, 1.1, 1.18, 1.3, 1.6] {
+        assert!((series_small(l) - series_large(l)).abs() < 1e-15, "{l}");
+    }
+    assert_eq!(kolmogorov_q(0.0), 1.0);
+    assert_eq!(kolmogorov_q(-1.0), 1.0);
+    assert!(kolmogorov_q(f64::NAN).is_nan());
+    assert!(kolmogorov_q(0.1) > 0.999_999_999);
+    assert!(kolmogorov_q(10.0) < 1e-80 && kolmogorov_q(10.0) > 0.0);
+    // Stephens' λ at N = 10⁶: ≈ √N·D.
+    assert!((stephens_lambda(1e-3, 1_000_000) - 1.000_120_11).abs() < 1e-12);
+}
+
+#[test]
+fn ks_cdf_tables_match_closed_forms() {
+    // Uniform on the hemisphere: F_θ = 1 − cos θ, F_φ = φ/2π.
+    let uniform = |m: Vec3| if m[2] >= 0.0 { 1.0 / TAU } else { 0.0 };
+    let t = marginal_cdf(&uniform, Marginal::CosTheta, &hints(0.3));
+    let p = marginal_cdf(&uniform, Marginal::Phi, &hints(0.3));
+    for x in [0.0, 1e-3, 0.1, 0.7, 1.2, 1.5, FRAC_PI_2] {
+        assert!((t.cdf(x) - (1.0 - x.cos())).abs() < 1e-10, "{x}");
+        assert!((p.cdf(4.0 * x) - 4.0 * x / TAU).abs() < 1e-10, "{x}");
+    }
+    // GGX: P(θ ≤ t) = tan²t / (α² + tan²t); anisotropic: P(φ ≤ p) = atan((α_x/α_y) tan p)/2π
+    // on the first quadrant.
+    for alpha in [0.3, 0.05] {
+        let g = Ggx::new(alpha, alpha).unwrap();
+        let t = marginal_cdf(&|m| g.pdf_wm(m), Marginal::CosTheta, &hints(alpha.atan()));
+        let mut worst = 0.0f64;
+        for i in 0..=1000 {
+            let x = FRAC_PI_2 * f64::from(i) / 1000.0;
+            let tan2 = x.tan().powi(2);
+            let want = if i == 1000 {
+                1.0
+            } else {
+                tan2 / (alpha * alpha + tan2)
+            };
+            worst = worst.max((t.cdf(x) - want).abs());
+        }
+        eprintln!(
+            "GGX α = {alpha}: {} knots, bound {:.2e}, worst {worst:.2e}, {} evaluations",
+            t.knots(),
+            t.error_bound(),
+            t.evaluations
+        );
+        assert!(worst < 1e-8 && worst <= t.error_bound().max(1e-12) * 10.0);
+        assert!(t.error_bound() < 1e-7);
+    }
+    let g = Ggx::new(0.1, 0.4).unwrap();
+    let p = marginal_cdf(&|m| g.pdf_wm(m), Marginal::Phi, &hints(0.1f64.atan()));
+    for i in 0..=100 {
+        let x = 0.5 * PI * f64::from(i) / 100.0;
+        let want = if i == 100 {
+            0.25
+        } else {
+            (0.25 * x.tan()).atan() / TAU
+        };
+        assert!((p.cdf(x) - want).abs() < 1e-8, "{x}: {} {want}", p.cdf(x));
+    }
+    assert!(p.error_bound() < 1e-7 && (p.total() - 1.0).abs() < 1e-9);
+}
+
+fn passes(json: &str, samples: u64) {
+    let m = model(json);
+    let s = m.as_sampler().unwrap();
+    let spec = serde_json::to_value(m.spec()).unwrap();
+    let width = crate::check::lobe_width(&spec);
+    for marginal in [Marginal::CosTheta, Marginal::Phi] {
+        let r = ks_test_sampler(s, marginal, &hints(width), &config(samples, 7));
+        report(json, &r);
+        assert_eq!(r.verdict, Verdict::Pass, "{:?}", r.reason);
+        assert!(r.p_value > 1e-3, "{r:?}");
+    }
+}
+
+#[test]
+fn ks_correct_samplers_pass() {
+    passes(r#"{"family":"ggx","alpha":0.3}"#, 1_000_000);
+    passes(r#"{"family":"ggx","alpha_x":0.1,"alpha_y":0.4}"#, 1_000_000);
+    passes(r#"{"family":"beckmann","alpha":0.3}"#, 1_000_000);
+}
+
+#[test]
+fn ks_defects_of_one_percent_fail() {
+    // The sampler of α·1.02 against the pdf of α: D ≈ 0.02·max 2F(1 − F) = 0.01.
+    let sampler = Ggx::new(0.306, 0.306).unwrap();
+    let pdf = Ggx::new(0.3, 0.3).unwrap();
+    let h = hints(0.3f64.atan());
+    let r = ks_test(
+        &|u| sampler.sample_wm(u),
+        &|m| pdf.pdf_wm(m),
+        Marginal::CosTheta,
+        &h,
+        &config(1_000_000, 7),
+    );
+    report("α·1.02", &r);
+    assert_eq!(r.verdict, Verdict::Fail);
+    assert!(r.p_value < 1e-12, "{r:?}");
+    assert!(matches!(r.reason, Some(Failure::Rejected { .. })));
+    // φ = 2π·(1.01 u₁ mod 1) (GGX maps u₁ to the azimuth): 1 % of the azimuths wrapped
+    // back onto [0, 0.02π].
+    let g = Ggx::new(0.3, 0.3).unwrap();
+    let stretched = |u: [f64; 2]| g.sample_wm([(1.01 * u[0]).fract(), u[1]]);
+    let r = ks_test(
+        &stretched,
+        &|m| g.pdf_wm(m),
+        Marginal::Phi,
+        &h,
+        &config(1_000_000, 7),
+    );
+    report("φ stretched 1 %", &r);
+    assert!(r.p_value < 1e-12, "{r:?}");
+    // The θ marginal of the φ defect is right: that test passes.
+    let r = ks_test(
+        &stretched,
+        &|m| g.pdf_wm(m),
+        Marginal::CosTheta,
+        &h,
+        &config(1_000_000, 7),
+    );
+    assert_eq!(r.verdict, Verdict::Pass, "{r:?}");
+}
+
+#[test]
+fn ks_sanity_failures() {
+    let g = Ggx::new(0.3, 0.3).unwrap();
+    let h = hints(0.3);
+    let flipped = |u: [f64; 2]| {
+        let m = g.sample_wm(u);
+        if u[0] < 0.01 {
+            [m[0], m[1], -m[2]]
+        } else {
+            m
+        }
+    };
+    let r = ks_test(
+        &flipped,
+        &|m| g.pdf_wm(m),
+        Marginal::Phi,
+        &h,
+        &config(10_000, 3),
+    );
+    assert!(matches!(
+        r.reason,
+        Some(Failure::OutsideDomain {
+            error: DomainError::BelowHorizon(_),
+            ..
+        })
+    ));
+    let half = ks_test(
+        &|u| g.sample_wm(u),
+        &|m| 0.5 * g.pdf_wm(m),
+        Marginal::CosTheta,
+        &h,
+        &config(10_000, 3),
+    );
+    assert!(
+        matches!(half.reason, Some(Failure::MassOff { .. })),
+        "{half:?}"
+    );
+    let negative = ks_test(
+        &|u| g.sample_wm(u),
+        &|m| -g.pdf_wm(m),
+        Marginal::CosTheta,
+        &h,
+        &config(10_000, 3),
+    );
+    assert!(
+        matches!(negative.reason, Some(Failure::InvalidDensity { .. })),
+        "{negative:?}"
+    );
+    // The double-exponential rule reads a NaN integrand as 0: a NaN pdf has mass 0.
+    let nan = ks_test(
+        &|u| g.sample_wm(u),
+        &|_| f64::NAN,
+        Marginal::CosTheta,
+        &h,
+        &config(10_000, 3),
+    );
+    assert!(
+        matches!(nan.reason, Some(Failure::MassOff { .. })),
+        "{nan:?}"
+    );
+    assert_eq!(nan.verdict, Verdict::Fail);
+}
+
+#[test]
+fn ks_results_do_not_depend_on_thread_count() {
+    let g = Ggx::new(0.1, 0.4).unwrap();
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let mut r =
+                    ks_test_sampler(&g, Marginal::Phi, &hints(0.1), &config(3 * CHUNK + 77, 5));
+                r.sampling_seconds = 0.0;
+                r.table_seconds = 0.0;
+                r
+            })
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one, two);
+    let other = ks_test_sampler(&g, Marginal::Phi, &hints(0.1), &config(3 * CHUNK + 77, 6));
+    assert_ne!(one.statistic, other.statistic);
+}
+
+#[test]
+fn ks_p_values_of_a_correct_sampler_spread_over_seeds() {
+    let g = Ggx::new(0.3, 0.3).unwrap();
+    let h = hints(0.3f64.atan());
+    let table = marginal_cdf(&|m| g.pdf_wm(m), Marginal::CosTheta, &h);
+    let p: Vec<f64> = (0..12u64)
+        .map(|seed| {
+            let mut d = draw(&|u| g.sample_wm(u), Marginal::CosTheta, 50_000, seed);
+            d.values.sort_unstable_by(f64::total_cmp);
+            ks_p_value(ks_statistic(&d.values, &|x| table.cdf(x)).0, 50_000)
+        })
+        .collect();
+    eprintln!("p-values over 12 seeds: {p:.3?}");
+    let mean = p.iter().sum::<f64>() / p.len() as f64;
+    assert!((0.25..0.75).contains(&mean), "{p:?}");
+    assert!(p.iter().all(|&p| p > 1e-3), "{p:?}");
+    assert!(
+        p.iter().any(|&p| p < 0.5) && p.iter().any(|&p| p > 0.5),
+        "{p:?}"
+    );
+}
