@@ -12,6 +12,7 @@ pub mod eval_sg;
 pub mod heatmap;
 pub mod oracle;
 pub mod plan;
+pub mod random;
 pub mod record;
 pub mod report;
 pub mod scene;

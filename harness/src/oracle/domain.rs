@@ -320,7 +320,7 @@ mod tests {
     fn cell_finder_agrees_with_atan2_binning() {
         let mut state: u64 = 7;
         let mut uniform = || {
-            state = crate::oracle::chi2::splitmix64(state);
+            state = crate::random::splitmix64(state);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         for resolution in [1, 2, 3, 7, 64, 1000] {
@@ -407,7 +407,7 @@ mod tests {
     fn cell_finder_matches_previous_finder_and_atan2_on_adversarial_directions() {
         let mut state: u64 = 11;
         let mut uniform = || {
-            state = crate::oracle::chi2::splitmix64(state);
+            state = crate::random::splitmix64(state);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         // Debug text: errors carrying NaN compare unequal with ==.

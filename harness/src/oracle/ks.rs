@@ -43,11 +43,11 @@
 //!    ([`kolmogorov_q`], [`ks_p_value`]). No well-kept crate provides the Kolmogorov
 //!    distribution (statrs 0.18 does not), so its two classical series are summed here.
 
-use crate::oracle::chi2::{stream, Verdict, CHUNK, MASS_TOLERANCE};
+use crate::oracle::chi2::{Verdict, CHUNK, MASS_TOLERANCE};
 use crate::oracle::domain::{validate, DomainError};
-use crate::oracle::monte_carlo::uniform;
 use crate::oracle::quadrature::{integrate_pieces, Accuracy};
 use crate::oracle::Estimate;
+use crate::random::{stream, uniform};
 use mfh_reference::geometry::{from_spherical, Vec3};
 use mfh_reference::NormalSampler;
 use rayon::prelude::*;
