@@ -206,6 +206,34 @@ impl CellFinder {
         Ok(row * self.grid.columns() + self.column(m[0], m[1]))
     }
 
+    /// The cells of a block of directions: `cells[i]` is the cell of `m[i]` as
+    /// [`CellFinder::cell_of`] finds it; returns whether every direction was in the domain
+    /// (if not, the cells of those outside are unspecified: callers redo the block one by
+    /// one for the errors). The loop has no data-dependent exit, so the processor overlaps
+    /// the directions' latency chains.
+    ///
+    /// # Panics
+    /// If `m` and `cells` differ in length.
+    #[inline]
+    pub fn cells_of(&self, m: &[Vec3], cells: &mut [usize]) -> bool {
+        assert_eq!(
+            m.len(),
+            cells.len(),
+            "cells_of: m and cells differ in length"
+        );
+        let mut inside = true;
+        for (cell, &m) in cells.iter_mut().zip(m) {
+            match self.cell_of(m) {
+                Ok(c) => *cell = c,
+                Err(_) => {
+                    inside = false;
+                    *cell = 0;
+                }
+            }
+        }
+        inside
+    }
+
     /// Why `m`, rejected by the squared-length test, is outside the domain.
     #[cold]
     #[inline(never)]
