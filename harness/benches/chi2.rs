@@ -1,46 +1,105 @@
-//! Criterion benchmark of the chi-square oracle: samples/s of GGX α = 0.3 normal sampling and
-//! binning into the 128 × 64-cell (φ × cos θ) grid, against the bare sampling loop.
+//! Criterion benchmark of the chi-square oracle's observed counts (issue 15's harness-overhead
+//! target: sampling + binning ≤ 1.15 × the bare sampler loop): samples/s of GGX α = 0.3 normal
+//! sampling binned into the 128 × 64-cell (φ × cos θ) grid by `observe_batch`, against the bare
+//! loop — the same chunks, the same random streams drawn in the same blocks, the same sampler,
+//! no binning — for
+//!
+//! - `vectorized`: the reference `Ggx`, whose `sample_wm_batch` is vectorized;
+//! - `scalar_user`: a wrapper that implements only `sample_wm` (a renderer's own sampler),
+//!   drawn through the default `sample_wm_batch` (a loop over the scalar method);
+//!
+//! each on 1 thread and on every thread of the machine. Run: `cargo bench -p mfh-harness
+//! --bench chi2` (`-- --quick` for a fast pass).
 
 use criterion::{black_box, Criterion, Throughput};
-use mfh_harness::oracle::chi2::{observe, stream};
+use mfh_harness::oracle::chi2::{observe_batch, CHUNK};
 use mfh_harness::oracle::domain::HemisphereGrid;
+use mfh_harness::random::stream;
+use mfh_reference::geometry::Vec3;
 use mfh_reference::ndf::Ggx;
-use mfh_reference::NormalSampler;
-use rand_core::RngCore;
+use mfh_reference::{Ndf, NormalSampler};
+use rayon::prelude::*;
 
-const SAMPLES: u64 = 1 << 20;
+/// 2²² samples: 64 chunks, enough for two threads to share evenly.
+const SAMPLES: u64 = 1 << 22;
+/// The block size of `observe_batch`.
+const BATCH: usize = 256;
 
-fn uniform(rng: &mut impl RngCore) -> f64 {
-    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+/// A sampler with only the scalar method: what a renderer author plugs in.
+struct ScalarUser(Ggx);
+
+impl Ndf for ScalarUser {
+    fn d(&self, m: Vec3) -> f64 {
+        self.0.d(m)
+    }
+}
+
+impl NormalSampler for ScalarUser {
+    fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
+        self.0.sample_wm(u)
+    }
+}
+
+/// The bare loop: `observe_batch`'s chunks, streams and blocks, summing m_z instead of binning.
+fn bare(sampler: &dyn NormalSampler, samples: u64, seed: u64) -> f64 {
+    (0..samples.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|chunk| {
+            let mut rng = stream(seed, chunk);
+            let (mut u, mut m) = ([[0.0; 2]; BATCH], [[0.0; 3]; BATCH]);
+            let end = ((chunk + 1) * CHUNK).min(samples);
+            let mut first = chunk * CHUNK;
+            let mut sum = 0.0;
+            while first < end {
+                let n = (end - first).min(BATCH as u64) as usize;
+                rng.fill_pairs(&mut u[..n]);
+                sampler.sample_wm_batch(&u[..n], &mut m[..n]);
+                sum += m[..n].iter().map(|m| m[2]).sum::<f64>();
+                first += n as u64;
+            }
+            sum
+        })
+        .sum()
 }
 
 fn chi2_sampling(c: &mut Criterion) {
     let ggx = Ggx::new(0.3, 0.3).expect("valid roughness");
+    let user = ScalarUser(ggx.clone());
     let grid = HemisphereGrid::new(64).expect("resolution ≥ 1");
-    let single = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("thread pool");
+    let threads = rayon::current_num_threads();
+    let pools: Vec<(usize, rayon::ThreadPool)> = [1, threads]
+        .into_iter()
+        .map(|n| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .expect("thread pool");
+            (n, pool)
+        })
+        .collect();
     let mut group = c.benchmark_group("chi2_ggx_0.3");
     group.throughput(Throughput::Elements(SAMPLES));
     group.sample_size(10);
-    group.bench_function("bare_sampling_1_thread", |b| {
-        b.iter(|| {
-            let mut rng = stream(1, 0);
-            let mut sum = 0.0;
-            for _ in 0..SAMPLES {
-                let m = ggx.sample_wm([uniform(&mut rng), uniform(&mut rng)]);
-                sum += m[2];
-            }
-            black_box(sum)
-        })
-    });
-    group.bench_function("sample_and_bin_128x64_1_thread", |b| {
-        b.iter(|| single.install(|| black_box(observe(&|u| ggx.sample_wm(u), grid, SAMPLES, 1))))
-    });
-    group.bench_function("sample_and_bin_128x64_all_threads", |b| {
-        b.iter(|| black_box(observe(&|u| ggx.sample_wm(u), grid, SAMPLES, 1)))
-    });
+    let samplers: [(&str, &dyn NormalSampler); 2] = [("vectorized", &ggx), ("scalar_user", &user)];
+    for (name, sampler) in samplers {
+        for (n, pool) in &pools {
+            group.bench_function(format!("{name}/bare_{n}_threads"), |b| {
+                b.iter(|| pool.install(|| black_box(bare(sampler, SAMPLES, 1))))
+            });
+            group.bench_function(format!("{name}/sample_and_bin_128x64_{n}_threads"), |b| {
+                b.iter(|| {
+                    pool.install(|| {
+                        black_box(observe_batch(
+                            &|u: &[[f64; 2]], m: &mut [Vec3]| sampler.sample_wm_batch(u, m),
+                            grid,
+                            SAMPLES,
+                            1,
+                        ))
+                    })
+                })
+            });
+        }
+    }
     group.finish();
 }
 

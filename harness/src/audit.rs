@@ -3,8 +3,9 @@
 //! call as a CI gate (`audit_scene(..)?.assert_pass()`).
 
 use crate::check::{PlannedCheck, Profile, RunContext};
-use crate::oracle::chi2::{sidak_alpha, splitmix64, DEFAULT_SEED};
+use crate::oracle::chi2::{sidak_alpha, DEFAULT_SEED};
 use crate::plan::plan;
+use crate::random::splitmix64;
 use crate::record::{CheckRecord, Measured, Verdict, SCHEMA_VERSION};
 use crate::scene::Scene;
 use crate::tolerance::STATISTICAL_ALPHA;

@@ -18,6 +18,7 @@ pub mod gate;
 pub mod messages;
 pub mod oracle;
 pub mod plan;
+pub mod random;
 pub mod record;
 pub mod report;
 pub mod scene;

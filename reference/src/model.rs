@@ -57,6 +57,19 @@ pub trait Ndf: Send + Sync {
     fn as_visible_moments(&self) -> Option<&dyn VisibleSlopeMoments> {
         None
     }
+
+    /// `out[i] = self.d(m[i])` for every i: a batch capability for throughput (the default
+    /// loops over [`Ndf::d`]; models may override it with a vectorized form that agrees with
+    /// `d` to the number of ulps they document).
+    ///
+    /// # Panics
+    /// If `m` and `out` differ in length.
+    fn d_batch(&self, m: &[Vec3], out: &mut [f64]) {
+        assert_eq!(m.len(), out.len(), "d_batch: m and out differ in length");
+        for (o, &m) in out.iter_mut().zip(m) {
+            *o = self.d(m);
+        }
+    }
 }
 
 /// A reference to a model is the model (so that `Arc<&M>` and `Box<dyn Model>` audit as `M`).
@@ -65,6 +78,9 @@ macro_rules! delegate_ndf {
         impl<T: Ndf + ?Sized> Ndf for $ptr {
             fn d(&self, m: Vec3) -> f64 {
                 (**self).d(m)
+            }
+            fn d_batch(&self, m: &[Vec3], out: &mut [f64]) {
+                (**self).d_batch(m, out)
             }
             fn as_smith(&self) -> Option<&dyn Smith> {
                 (**self).as_smith()
@@ -140,6 +156,21 @@ pub trait Smith: Ndf {
             }
         }
     }
+
+    /// `out[i] = self.lambda(w[i])` for every i (the default loops over [`Smith::lambda`]).
+    ///
+    /// # Panics
+    /// If `w` and `out` differ in length.
+    fn lambda_batch(&self, w: &[Vec3], out: &mut [f64]) {
+        assert_eq!(
+            w.len(),
+            out.len(),
+            "lambda_batch: w and out differ in length"
+        );
+        for (o, &w) in out.iter_mut().zip(w) {
+            *o = self.lambda(w);
+        }
+    }
 }
 
 /// Importance sampling of microfacet normals with pdf D(m)(m·n).
@@ -153,6 +184,40 @@ pub trait NormalSampler: Ndf {
             0.0
         } else {
             self.d(m) * m[2]
+        }
+    }
+
+    /// `out[i] = self.sample_wm(u[i])` for every i: the batch capability the chi-square oracle
+    /// draws through (the default loops over [`NormalSampler::sample_wm`], so a model that
+    /// implements only the scalar method needs nothing more). A vectorized override must agree
+    /// with `sample_wm` to the number of ulps it documents (the reference models: bit for bit).
+    ///
+    /// # Panics
+    /// If `u` and `out` differ in length.
+    fn sample_wm_batch(&self, u: &[[f64; 2]], out: &mut [Vec3]) {
+        assert_eq!(
+            u.len(),
+            out.len(),
+            "sample_wm_batch: u and out differ in length"
+        );
+        for (o, &u) in out.iter_mut().zip(u) {
+            *o = self.sample_wm(u);
+        }
+    }
+
+    /// `out[i] = self.pdf_wm(m[i])` for every i (the default loops over
+    /// [`NormalSampler::pdf_wm`]).
+    ///
+    /// # Panics
+    /// If `m` and `out` differ in length.
+    fn pdf_wm_batch(&self, m: &[Vec3], out: &mut [f64]) {
+        assert_eq!(
+            m.len(),
+            out.len(),
+            "pdf_wm_batch: m and out differ in length"
+        );
+        for (o, &m) in out.iter_mut().zip(m) {
+            *o = self.pdf_wm(m);
         }
     }
 }

@@ -754,8 +754,8 @@ fn ks_redraw(
     marginal: Marginal,
     config: &KsConfig,
 ) -> Vec<f64> {
-    use crate::oracle::chi2::{stream, CHUNK};
-    use crate::oracle::monte_carlo::uniform;
+    use crate::oracle::chi2::CHUNK;
+    use crate::random::{stream, uniform};
     use rayon::prelude::*;
     let chunks: Vec<Vec<f64>> = (0..config.samples.div_ceil(CHUNK))
         .into_par_iter()

@@ -3,12 +3,13 @@
 //!
 //! Procedure:
 //!
-//! 1. **Observed counts.** `samples` normals are drawn with `u` from a PCG-64 MCG stream (the
-//!    multiplicative PCG, one 128-bit multiply per draw) per fixed chunk of [`CHUNK`] sample
-//!    indices, seeded from (seed, chunk index) through SplitMix64, and binned into the
-//!    [`HemisphereGrid`] of the given resolution (R z-rows × 2R φ-columns) by a
-//!    [`CellFinder`] (no atan2 per sample), in parallel (rayon). Counts are integers summed
-//!    per chunk, so they are identical whatever the thread count or scheduling.
+//! 1. **Observed counts.** `samples` normals are drawn with `u` from the counter-based stream
+//!    ([`crate::random`]: ChaCha8 keyed by the seed, stream id = chunk index) of each fixed
+//!    chunk of [`CHUNK`] sample indices, in blocks (uniforms → the model's batch sampler →
+//!    cells), and binned into the [`HemisphereGrid`] of the given resolution (R z-rows × 2R
+//!    φ-columns) by a [`CellFinder`] (no atan2 per sample), in parallel (rayon). Counts are
+//!    integers summed per chunk, so they are identical whatever the thread count or
+//!    scheduling, and the batch path counts what the scalar path counts.
 //! 2. **Expected counts.** The pdf's lobe is measured from the pdf alone
 //!    ([`crate::oracle::lobe`]); every cell is integrated in (φ, θ), cut where the lobe varies,
 //!    by adaptive G7/K15 product cubature ([`crate::oracle::cubature`]) with a per-cell error
@@ -26,12 +27,10 @@
 use crate::oracle::cubature::{integrate_rectangle, Tolerance};
 use crate::oracle::domain::{CellFinder, DomainError, HemisphereGrid};
 use crate::oracle::lobe::{self, Lobe};
-use crate::oracle::monte_carlo::uniform;
 use crate::oracle::Estimate;
+use crate::random::stream;
 use mfh_reference::geometry::Vec3;
 use mfh_reference::NormalSampler;
-use rand_core::SeedableRng;
-use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use std::f64::consts::FRAC_PI_2;
 use std::time::Instant;
@@ -202,25 +201,41 @@ pub struct Expected {
     pub evaluations: u64,
 }
 
-/// SplitMix64's finalizer: a bijective mix of 64 bits.
-#[inline]
-pub fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-/// The random stream of chunk `chunk` under `seed`.
-pub fn stream(seed: u64, chunk: u64) -> Pcg64Mcg {
-    Pcg64Mcg::seed_from_u64(splitmix64(splitmix64(seed) ^ chunk))
-}
-
 /// Draws `samples` normals with `sample` and bins them into `grid`, in parallel, with a result
-/// independent of the thread count.
+/// independent of the thread count (the scalar form of [`observe_batch`]: the same counts).
 pub fn observe<S>(sample: &S, grid: HemisphereGrid, samples: u64, seed: u64) -> Observed
 where
     S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
+{
+    observe_batch(
+        &|u: &[[f64; 2]], m: &mut [Vec3]| scalar_batch(sample, u, m),
+        grid,
+        samples,
+        seed,
+    )
+}
+
+/// `m[i] = sample(u[i])`: a scalar sampler as a batch sampler.
+#[inline]
+fn scalar_batch<S>(sample: &S, u: &[[f64; 2]], m: &mut [Vec3])
+where
+    S: Fn([f64; 2]) -> Vec3 + ?Sized,
+{
+    for (m, &u) in m.iter_mut().zip(u) {
+        *m = sample(u);
+    }
+}
+
+/// Draws `samples` normals with the batch sampler `sample` (`sample(u, m)` sets `m[i]` to the
+/// normal of `u[i]`, e.g. [`NormalSampler::sample_wm_batch`]) and bins them into `grid`, in
+/// parallel: per chunk of [`CHUNK`] samples, its stream's uniforms in blocks of [`BATCH`]
+/// pairs ([`crate::random::Stream::fill_pairs`]) → the batch sampler → the block's cells
+/// ([`CellFinder::cells_of`]) → the thread's histogram; the threads' histograms are summed
+/// once at the end. Integer counts: the same whatever the thread count, and the same as
+/// [`observe`] with the scalar form of the sampler.
+pub fn observe_batch<S>(sample: &S, grid: HemisphereGrid, samples: u64, seed: u64) -> Observed
+where
+    S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
 {
     let chunks = samples.div_ceil(CHUNK);
     let finder = CellFinder::new(grid);
@@ -232,23 +247,28 @@ where
                 let mut rng = stream(seed, chunk);
                 let start = chunk * CHUNK;
                 let end = (start + CHUNK).min(samples);
-                // Sampled in batches, then binned: the binning loop's iterations are
-                // independent, so the processor overlaps their latency chains (estimate →
-                // table load → side tests) instead of waiting for each behind a sample.
-                let mut batch = [[0.0; 3]; BATCH];
+                let mut u = [[0.0; 2]; BATCH];
+                let mut m = [[0.0; 3]; BATCH];
+                let mut cells = [0usize; BATCH];
                 let mut first = start;
                 while first < end {
                     let n = (end - first).min(BATCH as u64) as usize;
-                    for m in &mut batch[..n] {
-                        *m = sample([uniform(&mut rng), uniform(&mut rng)]);
-                    }
-                    for (index, &m) in (first..).zip(&batch[..n]) {
-                        match finder.cell_of(m) {
-                            Ok(cell) => acc.counts[cell] += 1,
-                            Err(error) => {
-                                acc.outside += 1;
-                                if acc.first_outside.is_none_or(|(i, _)| index < i) {
-                                    acc.first_outside = Some((index, error));
+                    rng.fill_pairs(&mut u[..n]);
+                    sample(&u[..n], &mut m[..n]);
+                    if finder.cells_of(&m[..n], &mut cells[..n]) {
+                        for &cell in &cells[..n] {
+                            acc.counts[cell] += 1;
+                        }
+                    } else {
+                        // A direction outside the domain in this block (rare): one by one.
+                        for (index, &m) in (first..).zip(&m[..n]) {
+                            match finder.cell_of(m) {
+                                Ok(cell) => acc.counts[cell] += 1,
+                                Err(error) => {
+                                    acc.outside += 1;
+                                    if acc.first_outside.is_none_or(|(i, _)| index < i) {
+                                        acc.first_outside = Some((index, error));
+                                    }
                                 }
                             }
                         }
@@ -417,7 +437,13 @@ where
     S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
-    chi2_test_in(sample, pdf, config, cell_relative, None)
+    chi2_test_batch_in(
+        &|u: &[[f64; 2]], m: &mut [Vec3]| scalar_batch(sample, u, m),
+        pdf,
+        config,
+        cell_relative,
+        None,
+    )
 }
 
 /// [`chi2_test_to`] with the expected counts integrated about a given lobe (e.g. measured once
@@ -433,9 +459,46 @@ where
     S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
+    chi2_test_batch_in(
+        &|u: &[[f64; 2]], m: &mut [Vec3]| scalar_batch(sample, u, m),
+        pdf,
+        config,
+        cell_relative,
+        lobe,
+    )
+}
+
+/// [`chi2_test_to`] with a batch sampler (`sample(u, m)` sets `m[i]` to the normal of `u[i]`,
+/// as [`observe_batch`] takes it): the same result as the scalar form of the sampler.
+pub fn chi2_test_batch_to<S, P>(
+    sample: &S,
+    pdf: &P,
+    config: &Chi2Config,
+    cell_relative: f64,
+) -> Chi2Result
+where
+    S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
+    P: Fn(Vec3) -> f64 + Sync + ?Sized,
+{
+    chi2_test_batch_in(sample, pdf, config, cell_relative, None)
+}
+
+/// The chi-square test with a batch sampler and, optionally, the lobe the expected counts are
+/// integrated about.
+pub fn chi2_test_batch_in<S, P>(
+    sample: &S,
+    pdf: &P,
+    config: &Chi2Config,
+    cell_relative: f64,
+    lobe: Option<&Lobe>,
+) -> Chi2Result
+where
+    S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
+    P: Fn(Vec3) -> f64 + Sync + ?Sized,
+{
     let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
     let t = Instant::now();
-    let observed = observe(sample, grid, config.samples, config.seed);
+    let observed = observe_batch(sample, grid, config.samples, config.seed);
     let sampling_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let expected = match lobe {
@@ -489,8 +552,15 @@ where
 }
 
 /// Tests a model's `sample_wm` against its own `pdf_wm`.
+/// Draws through [`NormalSampler::sample_wm_batch`] (the scalar method for models that do not
+/// override it): the same counts as through `sample_wm`.
 pub fn chi2_test_sampler(sampler: &dyn NormalSampler, config: &Chi2Config) -> Chi2Result {
-    chi2_test(&|u| sampler.sample_wm(u), &|m| sampler.pdf_wm(m), config)
+    chi2_test_batch_to(
+        &|u: &[[f64; 2]], m: &mut [Vec3]| sampler.sample_wm_batch(u, m),
+        &|m| sampler.pdf_wm(m),
+        config,
+        CELL_RELATIVE_TOLERANCE,
+    )
 }
 
 /// The sanity failures, in order: samples outside the domain, invalid or off mass, samples in
@@ -762,6 +832,48 @@ mod tests {
             one,
             observe(&|u| s.sample_wm(u), grid, 5 * CHUNK + 123, 100)
         );
+    }
+
+    #[test]
+    fn chi2_batch_counts_are_the_scalar_counts_whatever_the_thread_count() {
+        let grid = HemisphereGrid::new(16).unwrap();
+        let samples = 3 * CHUNK + 777;
+        for json in [
+            r#"{"family":"ggx","alpha":0.3}"#,
+            r#"{"family":"beckmann","alpha_x":0.1,"alpha_y":0.5}"#,
+            r#"{"family":"std","gamma":2.5,"alpha_x":0.1,"alpha_y":0.4}"#,
+            r#"{"family":"gtr","gamma":1.5,"alpha":0.3}"#,
+        ] {
+            let m = model(json);
+            let s = m.as_sampler().unwrap();
+            // The plainest reference: one pair, one scalar sample, one cell at a time.
+            let finder = CellFinder::new(grid);
+            let mut counts = vec![0u64; grid.cells()];
+            for chunk in 0..samples.div_ceil(CHUNK) {
+                let mut rng = stream(11, chunk);
+                for _ in chunk * CHUNK..((chunk + 1) * CHUNK).min(samples) {
+                    counts[finder.cell_of(s.sample_wm(rng.pair())).unwrap()] += 1;
+                }
+            }
+            let batch = |threads| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap()
+                    .install(|| {
+                        observe_batch(&|u, out| s.sample_wm_batch(u, out), grid, samples, 11)
+                    })
+            };
+            let (one, two) = (batch(1), batch(2));
+            assert_eq!(one.counts, counts, "{json}");
+            assert_eq!(one, two, "{json}");
+            assert_eq!(
+                one,
+                observe(&|u| s.sample_wm(u), grid, samples, 11),
+                "{json}"
+            );
+            assert_eq!((one.outside, one.first_outside), (0, None));
+        }
     }
 
     #[test]

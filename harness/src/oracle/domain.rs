@@ -206,6 +206,34 @@ impl CellFinder {
         Ok(row * self.grid.columns() + self.column(m[0], m[1]))
     }
 
+    /// The cells of a block of directions: `cells[i]` is the cell of `m[i]` as
+    /// [`CellFinder::cell_of`] finds it; returns whether every direction was in the domain
+    /// (if not, the cells of those outside are unspecified: callers redo the block one by
+    /// one for the errors). The loop has no data-dependent exit, so the processor overlaps
+    /// the directions' latency chains.
+    ///
+    /// # Panics
+    /// If `m` and `cells` differ in length.
+    #[inline]
+    pub fn cells_of(&self, m: &[Vec3], cells: &mut [usize]) -> bool {
+        assert_eq!(
+            m.len(),
+            cells.len(),
+            "cells_of: m and cells differ in length"
+        );
+        let mut inside = true;
+        for (cell, &m) in cells.iter_mut().zip(m) {
+            match self.cell_of(m) {
+                Ok(c) => *cell = c,
+                Err(_) => {
+                    inside = false;
+                    *cell = 0;
+                }
+            }
+        }
+        inside
+    }
+
     /// Why `m`, rejected by the squared-length test, is outside the domain.
     #[cold]
     #[inline(never)]
@@ -320,7 +348,7 @@ mod tests {
     fn cell_finder_agrees_with_atan2_binning() {
         let mut state: u64 = 7;
         let mut uniform = || {
-            state = crate::oracle::chi2::splitmix64(state);
+            state = crate::random::splitmix64(state);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         for resolution in [1, 2, 3, 7, 64, 1000] {
@@ -407,7 +435,7 @@ mod tests {
     fn cell_finder_matches_previous_finder_and_atan2_on_adversarial_directions() {
         let mut state: u64 = 11;
         let mut uniform = || {
-            state = crate::oracle::chi2::splitmix64(state);
+            state = crate::random::splitmix64(state);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         // Debug text: errors carrying NaN compare unequal with ==.

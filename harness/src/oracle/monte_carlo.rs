@@ -1,8 +1,7 @@
 //! Monte Carlo estimates with standard errors: seeded, counter-based streams (one per chunk of
 //! samples), reduced in chunk order, so that the estimate does not depend on the thread count.
 
-use super::chi2::stream;
-use rand_core::RngCore;
+use crate::random::{stream, uniform};
 use rayon::prelude::*;
 
 /// Samples per chunk: each chunk has its own random stream keyed by (seed, chunk index).
@@ -17,12 +16,6 @@ pub struct McEstimate {
     pub standard_error: f64,
     /// Samples drawn.
     pub samples: u64,
-}
-
-/// A uniform number in [0, 1) with 53 random bits.
-#[inline]
-pub fn uniform(rng: &mut impl RngCore) -> f64 {
-    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 /// Per-chunk running sums (count, mean, M2) merged by Chan et al.'s parallel update.

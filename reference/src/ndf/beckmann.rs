@@ -123,6 +123,23 @@ impl NormalSampler for Beckmann {
         let r = (-(-u[1]).ln_1p()).sqrt();
         normal_from_slopes(r * dx, r * dy)
     }
+
+    /// `sample_wm` over a batch: the azimuth, √ and normal vectorized, −ln(1 − u₂) by `ln_1p`
+    /// per element; bit for bit the scalar result (`ndf::batch`).
+    fn sample_wm_batch(&self, u: &[[f64; 2]], out: &mut [Vec3]) {
+        super::batch::sample_elliptic_batch(
+            self.alpha_x,
+            self.alpha_y,
+            u,
+            out,
+            |u1, r2| {
+                for (r2, &u1) in r2.iter_mut().zip(u1) {
+                    *r2 = -(-u1).ln_1p();
+                }
+            },
+            |u| self.sample_wm(u),
+        );
+    }
 }
 
 impl VisibleNormalSampler for Beckmann {

@@ -1,5 +1,6 @@
 //! Normal distribution functions, one model per file.
 
+mod batch;
 pub mod beckmann;
 pub mod blend;
 pub mod ggx;

@@ -292,6 +292,23 @@ impl NormalSampler for Student {
         let r = self.radius2(u[1]).sqrt();
         normal_from_slopes(r * dx, r * dy)
     }
+
+    /// `sample_wm` over a batch: the azimuth, √ and normal vectorized, the squared radius
+    /// (`ln_1p`, `exp_m1`) per element; bit for bit the scalar result (`ndf::batch`).
+    fn sample_wm_batch(&self, u: &[[f64; 2]], out: &mut [Vec3]) {
+        super::batch::sample_elliptic_batch(
+            self.sx,
+            self.sy,
+            u,
+            out,
+            |u1, r2| {
+                for (r2, &u1) in r2.iter_mut().zip(u1) {
+                    *r2 = self.radius2(u1);
+                }
+            },
+            |u| self.sample_wm(u),
+        );
+    }
 }
 
 impl SlopeDistribution for Student {

@@ -51,10 +51,10 @@ mod table;
 pub use kolmogorov::{kolmogorov_q, ks_p_value, stephens_lambda};
 pub use table::{marginal_cdf, marginal_cdf_lobe, CdfTable};
 
-use crate::oracle::chi2::{stream, Verdict, CHUNK, MASS_TOLERANCE};
+use crate::oracle::chi2::{Verdict, CHUNK, MASS_TOLERANCE};
 use crate::oracle::domain::{validate, DomainError};
 use crate::oracle::lobe::{self, Lobe};
-use crate::oracle::monte_carlo::uniform;
+use crate::random::{stream, uniform};
 use crate::oracle::quadrature::Accuracy;
 use mfh_reference::geometry::Vec3;
 use mfh_reference::NormalSampler;

@@ -1,0 +1,212 @@
+//! Randomness for every statistical oracle (chi-square, Kolmogorov–Smirnov, Monte Carlo) and
+//! for the audit's per-check seeds: one leaf module, built on `rand_chacha` (DESIGN.md's choice
+//! of the `rand` family).
+//!
+//! **Generator.** ChaCha with 8 rounds ([`rand_chacha::ChaCha8Rng`]): a counter-based generator,
+//! i.e. a keyed bijection of (key, stream, block counter). The key is expanded from the seed by
+//! SplitMix64 ([`key_of`]); the 64-bit stream id is the chunk index. So the stream of chunk
+//! `c` under seed `s` is the keystream of (key(s), c): streams of distinct chunks, or of
+//! distinct seeds, are distinct keystreams of a cipher — independent by construction, not by
+//! hoping that two seeded states do not overlap — and any position of a stream can be reached
+//! without drawing what precedes it ([`Stream::seek_pair`]).
+//!
+//! **Uniforms.** The i-th u64 of a stream (little-endian, 8 keystream bytes) gives the i-th
+//! uniform ([`to_unit`]: its top 53 bits times 2⁻⁵³, in [0, 1) on the grid k·2⁻⁵³); the i-th
+//! pair `u = [u₀, u₁]` is uniforms 2i and 2i + 1. Generating in blocks ([`Stream::fill_pairs`])
+//! and one at a time ([`uniform`]) give the same numbers (a test), so scalar and batch callers
+//! see the same samples.
+//!
+//! **Chunking.** Callers split their samples into fixed chunks (e.g. 2¹⁶ for the chi-square
+//! test), one stream per chunk, and reduce per-chunk results in chunk order or by integer
+//! sums: results are the same whatever the thread count.
+//!
+//! **Per-check seeds.** [`derive_seed`] mixes a seed with a label (e.g. a hash of a check's
+//! name) through SplitMix64's finalizer, a bijection of 64 bits.
+
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+
+/// One random stream: a ChaCha8 keystream keyed by a seed and numbered by a stream id.
+#[derive(Debug, Clone)]
+pub struct Stream(ChaCha8Rng);
+
+/// The pairs drawn per keystream read in [`Stream::fill_pairs`] (16 bytes each; 4 KiB).
+const FILL_PAIRS: usize = 256;
+
+impl Stream {
+    /// Stream `id` under `seed`, at its start.
+    pub fn new(seed: u64, id: u64) -> Self {
+        let mut rng = ChaCha8Rng::from_seed(key_of(seed));
+        rng.set_stream(id);
+        Self(rng)
+    }
+
+    /// The next uniform in [0, 1) (53 random bits).
+    #[inline]
+    pub fn uniform(&mut self) -> f64 {
+        to_unit(self.0.next_u64())
+    }
+
+    /// The next pair of uniforms.
+    #[inline]
+    pub fn pair(&mut self) -> [f64; 2] {
+        let u0 = self.uniform();
+        [u0, self.uniform()]
+    }
+
+    /// Fills `out` with the next `out.len()` pairs of uniforms: the same numbers as that many
+    /// calls of [`Stream::pair`], read from the keystream in blocks of 4 KiB and converted in
+    /// a loop the compiler vectorizes.
+    pub fn fill_pairs(&mut self, out: &mut [[f64; 2]]) {
+        let mut bytes = [0u8; 16 * FILL_PAIRS];
+        for block in out.chunks_mut(FILL_PAIRS) {
+            let bytes = &mut bytes[..16 * block.len()];
+            self.0.fill_bytes(bytes);
+            for (u, b) in block.iter_mut().zip(bytes.chunks_exact(16)) {
+                let (lo, hi) = b.split_at(8);
+                *u = [to_unit(le_u64(lo)), to_unit(le_u64(hi))];
+            }
+        }
+    }
+
+    /// Moves to pair `index` of the stream (pair i is uniforms 2i and 2i + 1): the next pair
+    /// drawn is the one the stream would give after `index` pairs from its start.
+    pub fn seek_pair(&mut self, index: u64) {
+        // 4 ChaCha words (u32) per pair.
+        self.0.set_word_pos(u128::from(index) * 4);
+    }
+}
+
+/// The u64 of 8 little-endian bytes.
+#[inline(always)]
+fn le_u64(b: &[u8]) -> u64 {
+    let mut a = [0u8; 8];
+    a.copy_from_slice(b);
+    u64::from_le_bytes(a)
+}
+
+impl RngCore for Stream {
+    fn next_u32(&mut self) -> u32 {
+        self.0.next_u32()
+    }
+
+    fn next_u64(&mut self) -> u64 {
+        self.0.next_u64()
+    }
+
+    fn fill_bytes(&mut self, dest: &mut [u8]) {
+        self.0.fill_bytes(dest)
+    }
+
+    fn try_fill_bytes(&mut self, dest: &mut [u8]) -> Result<(), rand_core::Error> {
+        self.0.try_fill_bytes(dest)
+    }
+}
+
+/// The random stream of chunk `chunk` under `seed` (see the module documentation).
+pub fn stream(seed: u64, chunk: u64) -> Stream {
+    Stream::new(seed, chunk)
+}
+
+/// A uniform number in [0, 1) with 53 random bits, from the next u64 of `rng`.
+#[inline]
+pub fn uniform(rng: &mut impl RngCore) -> f64 {
+    to_unit(rng.next_u64())
+}
+
+/// The top 53 bits of `x` times 2⁻⁵³: a uniform double in [0, 1) when `x` is uniform.
+#[inline(always)]
+pub fn to_unit(x: u64) -> f64 {
+    (x >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// SplitMix64's finalizer (Steele, Lea & Flood 2014): a bijective mix of 64 bits.
+#[inline]
+pub fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// A seed derived from `seed` and a `label` (e.g. a hash of a check's identity): distinct
+/// labels give unrelated seeds.
+pub fn derive_seed(seed: u64, label: u64) -> u64 {
+    splitmix64(seed ^ label)
+}
+
+/// The 256-bit ChaCha key of a seed: four successive SplitMix64 outputs from it
+/// (the generator's own seeding, state += golden gamma, then the finalizer).
+pub fn key_of(seed: u64) -> [u8; 32] {
+    let mut key = [0u8; 32];
+    let mut state = seed;
+    for word in key.chunks_exact_mut(8) {
+        word.copy_from_slice(&splitmix64(state).to_le_bytes());
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    }
+    key
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn block_and_scalar_draws_agree_and_seek_reaches_any_pair() {
+        let mut scalar = stream(42, 3);
+        let expected: Vec<[f64; 2]> = (0..1000).map(|_| scalar.pair()).collect();
+        // Blocks of awkward sizes, across the 256-pair fill blocks.
+        let mut block = stream(42, 3);
+        let mut got = vec![[0.0; 2]; 1000];
+        let (a, rest) = got.split_at_mut(7);
+        block.fill_pairs(a);
+        let (b, c) = rest.split_at_mut(300);
+        block.fill_pairs(b);
+        block.fill_pairs(c);
+        assert_eq!(got, expected);
+        // Scalar draws continue where the blocks stopped.
+        assert_eq!(block.pair(), scalar.pair());
+        let mut seek = stream(42, 3);
+        seek.seek_pair(123);
+        assert_eq!(seek.pair(), expected[123]);
+        // `uniform` on the RngCore is the same sequence.
+        let mut generic = stream(42, 3);
+        assert_eq!(uniform(&mut generic), expected[0][0]);
+        assert_eq!(uniform(&mut generic), expected[0][1]);
+    }
+
+    #[test]
+    fn streams_differ_by_seed_and_id_and_are_uniform() {
+        let first = |seed, id| stream(seed, id).pair();
+        assert_ne!(first(1, 0), first(1, 1));
+        assert_ne!(first(1, 0), first(2, 0));
+        assert_eq!(first(1, 0), first(1, 0));
+        // Mean and variance of 10⁶ uniforms: 1/2 ± 5σ (σ = √(1/12/n)) and 1/12 ± 5σ
+        // (σ = √(1/180/n)); the extreme values lie in [0, 1).
+        let n = 1_000_000usize;
+        let mut pairs = vec![[0.0; 2]; n / 2];
+        stream(9, 0).fill_pairs(&mut pairs);
+        let values: Vec<f64> = pairs.iter().flatten().copied().collect();
+        let mean = values.iter().sum::<f64>() / n as f64;
+        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+        assert!(
+            (mean - 0.5).abs() < 5.0 * (1.0 / 12.0 / n as f64).sqrt(),
+            "{mean}"
+        );
+        assert!(
+            (var - 1.0 / 12.0).abs() < 5.0 * (1.0 / 180.0 / n as f64).sqrt(),
+            "{var}"
+        );
+        assert!(values.iter().all(|&v| (0.0..1.0).contains(&v)));
+        assert_eq!(to_unit(u64::MAX), 1.0 - f64::EPSILON / 2.0);
+        assert_eq!(to_unit(0), 0.0);
+    }
+
+    #[test]
+    fn derived_seeds_and_keys() {
+        assert_ne!(derive_seed(1, 2), derive_seed(1, 3));
+        assert_ne!(key_of(1), key_of(2));
+        // SplitMix64's published first output from state 0 (after the gamma increment).
+        assert_eq!(splitmix64(0), 0xe220_a839_7b1d_cdaf);
+    }
+}

@@ -1,0 +1,227 @@
+//! Batch forms of the elliptic normal samplers (GGX, Beckmann, Student): the steps every one of
+//! them shares — (cos 2πu₀, sin 2πu₀) scaled by the axis scales, times the slope radius, and
+//! the normal of the slope — written as straight-line loops over fixed blocks that the compiler
+//! vectorizes (no branch, no call per element; SSE2 two-lane f64 on the baseline x86-64 target,
+//! wider where the build enables AVX2).
+//!
+//! **Bit for bit.** Every step performs the same IEEE operations in the same order as the
+//! scalar path (`geometry::sin_cos_turns` with musl's `__sin`/`__cos` kernels as ported by the
+//! `libm` crate, `model::elliptic_direction`, `geometry::normal_from_slopes`); +, −, ×, ÷ and √
+//! are correctly rounded in vector registers as in scalar ones and Rust does not contract or
+//! reassociate floating-point arithmetic, so the batch result is the scalar result exactly
+//! (0 ulps: the test `batch_samplers_agree_with_scalar_bit_for_bit`). Elements outside the
+//! fast path's domain (u₀ ∉ [0, 1), non-finite slopes: the scalar path's other branches) are
+//! recomputed by the scalar method. Hand-written because std has no vectorized sin/cos, and a
+//! SIMD math crate would not round as the scalar `libm` kernels do.
+
+use crate::geometry::Vec3;
+
+/// Elements per block: the temporaries live on the stack (5 × 64 doubles).
+const BLOCK: usize = 64;
+
+// musl `__sin` (k_sin.c) coefficients, bit patterns as in libm 0.2's `k_sin.rs`.
+const S1: f64 = f64::from_bits(0xbfc5_5555_5555_5549); // -1.66666666666666324348e-1
+const S2: f64 = f64::from_bits(0x3f81_1111_1110_f8a6); // 8.33333333332248946124e-3
+const S3: f64 = f64::from_bits(0xbf2a_01a0_19c1_61d5); // -1.98412698298579493134e-4
+const S4: f64 = f64::from_bits(0x3ec7_1de3_57b1_fe7d); // 2.75573137070700676789e-6
+const S5: f64 = f64::from_bits(0xbe5a_e5e6_8a2b_9ceb); // -2.50507602534068634195e-8
+const S6: f64 = f64::from_bits(0x3de5_d93a_5acf_d57c); // 1.58969099521155010221e-10
+                                                       // musl `__cos` (k_cos.c) coefficients, bit patterns as in libm 0.2's `k_cos.rs`.
+const C1: f64 = f64::from_bits(0x3fa5_5555_5555_554c); // 4.16666666666666019037e-2
+const C2: f64 = f64::from_bits(0xbf56_c16c_16c1_5177); // -1.38888888888741095749e-3
+const C3: f64 = f64::from_bits(0x3efa_01a0_19cb_1590); // 2.48015872894767294178e-5
+const C4: f64 = f64::from_bits(0xbe92_7e4f_809c_52ad); // -2.75573143513906633035e-7
+const C5: f64 = f64::from_bits(0x3e21_ee9e_bdb4_b1c4); // 2.08757232129817482790e-9
+const C6: f64 = f64::from_bits(0xbda8_fae9_be88_38d4); // -1.13596475577881948265e-11
+/// `libm::sincos` returns (x, 1) below this |x| (high word 0x3e46a09e: 2⁻²⁷·√2).
+const TINY: f64 = f64::from_bits(0x3e46_a09e_0000_0000);
+
+/// (sin 2πu, cos 2πu) of every u in [0, 1), as `geometry::sin_cos_turns` computes them: k =
+/// round(4u), r = u − k/4, x = 2πr ∈ [−π/4, π/4], musl's kernels at (x, 0), quadrant k.
+/// Elements with u outside [0, 1) give unspecified values (the callers recompute them).
+#[inline(always)]
+fn sin_cos_turns_block(u: &[f64], s: &mut [f64], c: &mut [f64]) {
+    for ((&u, s), c) in u.iter().zip(s.iter_mut()).zip(c.iter_mut()) {
+        // 4u + 0.5 ∈ [0.5, 4.5): truncation through i32 is the scalar path's through i64.
+        let k = ((4.0 * u + 0.5) as i32) as f64;
+        let r = u - 0.25 * k;
+        let x = std::f64::consts::TAU * r;
+        // k_sin(x, 0, 0)
+        let z = x * x;
+        let w = z * z;
+        let rs = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6);
+        let v = z * x;
+        let sin = x + v * (S1 + z * rs);
+        // k_cos(x, 0)
+        let rc = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
+        let hz = 0.5 * z;
+        let w1 = 1.0 - hz;
+        let cos = w1 + (((1.0 - w1) - hz) + (z * rc - x * 0.0));
+        let tiny = x.abs() < TINY;
+        let (sin, cos) = if tiny { (x, 1.0) } else { (sin, cos) };
+        // Quadrant k mod 4 (k ∈ {0, …, 4}): 0 (s, c), 1 (c, −s), 2 (−s, −c), 3 (−c, s).
+        let odd = k == 1.0 || k == 3.0;
+        let high = k == 2.0 || k == 3.0;
+        let (a, b) = if odd { (cos, sin) } else { (sin, cos) };
+        *s = if high { -a } else { a };
+        *c = if odd != high { -b } else { b };
+    }
+}
+
+/// `out[i]` = the normal of slope radius(u[i][1]) · (sx cos 2πu[i][0], sy sin 2πu[i][0]), as the
+/// scalar `sample_wm` of an elliptic model computes it: `radius2_block` fills the squared slope
+/// radius of each u₁ (written as a loop the compiler may vectorize, or calling a scalar
+/// function per element), and `scalar` is the model's `sample_wm` for the elements outside the
+/// fast path.
+///
+/// # Panics
+/// If `u` and `out` differ in length.
+pub(crate) fn sample_elliptic_batch(
+    sx: f64,
+    sy: f64,
+    u: &[[f64; 2]],
+    out: &mut [Vec3],
+    radius2_block: impl Fn(&[f64], &mut [f64]),
+    scalar: impl Fn([f64; 2]) -> Vec3,
+) {
+    assert_eq!(
+        u.len(),
+        out.len(),
+        "sample_wm_batch: u and out differ in length"
+    );
+    let mut u0 = [0.0; BLOCK];
+    let mut u1 = [0.0; BLOCK];
+    let mut r = [0.0; BLOCK];
+    let mut s = [0.0; BLOCK];
+    let mut c = [0.0; BLOCK];
+    for (u, out) in u.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+        let n = u.len();
+        for ((a, b), u) in u0.iter_mut().zip(u1.iter_mut()).zip(u) {
+            (*a, *b) = (u[0], u[1]);
+        }
+        radius2_block(&u1[..n], &mut r[..n]);
+        sin_cos_turns_block(&u0[..n], &mut s[..n], &mut c[..n]);
+        for (i, m) in out.iter_mut().enumerate() {
+            let radius = r[i].sqrt();
+            // elliptic_direction, then normal_from_slopes' finite branch.
+            let (p, q) = (radius * (sx * c[i]), radius * (sy * s[i]));
+            let inv = 1.0 / (1.0 + p * p + q * q).sqrt();
+            *m = [p * inv, q * inv, inv];
+        }
+        // The scalar path's other branches: u₀ outside [0, 1) (a general argument reduction),
+        // an infinite or NaN slope (the horizon branch); either leaves m_x or m_y non-finite
+        // here or is flagged by u₀.
+        for (i, m) in out.iter_mut().enumerate() {
+            if !(u0[i] >= 0.0 && u0[i] < 1.0 && m[0].is_finite() && m[1].is_finite()) {
+                *m = scalar(u[i]);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::geometry::sin_cos_turns;
+    use crate::model::NormalSampler;
+    use crate::ndf::student::Member;
+    use crate::ndf::{Beckmann, Ggx, Student};
+
+    /// u on [0, 1): a stride through it, the quadrant points and the doubles next to them,
+    /// the tiny-angle branch, and arguments outside the fast path.
+    fn arguments() -> Vec<[f64; 2]> {
+        let mut u: Vec<f64> = (0..20_011).map(|i| i as f64 / 20_011.0).collect();
+        for k in 0..=4 {
+            let q = k as f64 / 8.0;
+            for v in [q, q.next_up(), q.next_down(), k as f64 / 4.0] {
+                u.extend([v, v.next_up(), v.next_down(), v + 1e-9, v - 1e-9]);
+            }
+        }
+        u.extend([
+            0.0,
+            1e-300,
+            5e-324,
+            1e-10,
+            2e-9,
+            1.0f64.next_down(),
+            0.25 + 1e-12,
+        ]);
+        let mut pairs: Vec<[f64; 2]> = Vec::new();
+        for (i, &a) in u.iter().enumerate() {
+            let b = u[(i * 7919) % u.len()];
+            pairs.push([a, b]);
+        }
+        // Outside the fast path: u₀ ∉ [0, 1), u₁ = 1 (an infinite slope radius), NaN.
+        for w in [
+            [1.0, 0.3],
+            [1.5, 0.3],
+            [-0.25, 0.3],
+            [0.3, 1.0],
+            [f64::NAN, 0.5],
+            [0.5, f64::NAN],
+        ] {
+            pairs.push(w);
+        }
+        pairs.retain(|p| p[1] <= 1.0 && !(p[1] < 0.0));
+        pairs
+    }
+
+    fn same(a: [f64; 3], b: [f64; 3]) -> bool {
+        a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits())
+    }
+
+    #[test]
+    fn sin_cos_block_is_the_scalar_sin_cos_turns() {
+        let u: Vec<f64> = arguments()
+            .iter()
+            .map(|p| p[0])
+            .filter(|u| (0.0..1.0).contains(u))
+            .collect();
+        let (mut s, mut c) = (vec![0.0; u.len()], vec![0.0; u.len()]);
+        super::sin_cos_turns_block(&u, &mut s, &mut c);
+        for i in 0..u.len() {
+            let (ws, wc) = sin_cos_turns(u[i]);
+            assert_eq!(
+                (s[i].to_bits(), c[i].to_bits()),
+                (ws.to_bits(), wc.to_bits()),
+                "u = {:e}",
+                u[i]
+            );
+        }
+    }
+
+    #[test]
+    fn batch_samplers_agree_with_scalar_bit_for_bit() {
+        let u = arguments();
+        let samplers: Vec<(&str, Box<dyn NormalSampler>)> = vec![
+            ("ggx 0.3", Box::new(Ggx::new(0.3, 0.3).unwrap())),
+            ("ggx 0.02 0.8", Box::new(Ggx::new(0.02, 0.8).unwrap())),
+            ("beckmann 0.3", Box::new(Beckmann::new(0.3, 0.3).unwrap())),
+            (
+                "beckmann 0.1 0.5",
+                Box::new(Beckmann::new(0.1, 0.5).unwrap()),
+            ),
+            (
+                "std 2.5",
+                Box::new(Student::new(Member::Std, 2.5, 0.1, 0.4).unwrap()),
+            ),
+            (
+                "std 40",
+                Box::new(Student::new(Member::Std, 40.0, 0.3, 0.3).unwrap()),
+            ),
+        ];
+        for (name, sampler) in &samplers {
+            let mut out = vec![[0.0; 3]; u.len()];
+            sampler.sample_wm_batch(&u, &mut out);
+            // Also through an odd-sized slice (a partial block).
+            let mut tail = vec![[0.0; 3]; 37];
+            sampler.sample_wm_batch(&u[1000..1037], &mut tail);
+            for (i, (&u, &m)) in u.iter().zip(&out).enumerate() {
+                let want = sampler.sample_wm(u);
+                assert!(same(m, want), "{name}, u = {u:?}: {m:?} vs {want:?}");
+                if (1000..1037).contains(&i) {
+                    assert!(same(tail[i - 1000], want), "{name}, u = {u:?}");
+                }
+            }
+        }
+    }
+}
