@@ -358,7 +358,14 @@ fn family_of(r: &CheckRecord) -> String {
 /// Summarizes records.
 pub fn summarize(records: &[CheckRecord], statistical: (usize, f64), wall_seconds: f64) -> Summary {
     let mut counts = BTreeMap::new();
-    for name in ["pass", "fail", "expected_failure", "skipped", "error"] {
+    for name in [
+        "pass",
+        "fail",
+        "expected_failure",
+        "unexpected_pass",
+        "skipped",
+        "error",
+    ] {
         counts.insert(name.to_string(), 0);
     }
     let mut worst_error: BTreeMap<String, (f64, String)> = BTreeMap::new();

@@ -22,6 +22,13 @@ pub enum Verdict {
         /// Why the failure is expected (an erratum id and what it is).
         reason: String,
     },
+    /// An expected failure that did not fail: the record met its tolerance although the table
+    /// of expected failures lists it (as libm-test's xfail table), so the table is no longer
+    /// true. Counts as a failure, so that the entry is removed or narrowed.
+    UnexpectedPass {
+        /// The entry that expected the failure (its erratum id and reason).
+        reason: String,
+    },
     /// The check did not run.
     Skipped {
         /// Why.
@@ -35,20 +42,25 @@ pub enum Verdict {
 }
 
 impl Verdict {
-    /// The short name used in summaries: pass, fail, expected_failure, skipped, error.
+    /// The short name used in summaries: pass, fail, expected_failure, unexpected_pass,
+    /// skipped, error.
     pub fn name(&self) -> &'static str {
         match self {
             Verdict::Pass => "pass",
             Verdict::Fail => "fail",
             Verdict::ExpectedFailure { .. } => "expected_failure",
+            Verdict::UnexpectedPass { .. } => "unexpected_pass",
             Verdict::Skipped { .. } => "skipped",
             Verdict::Error { .. } => "error",
         }
     }
 
-    /// Whether this verdict makes an audit fail (fail or error).
+    /// Whether this verdict makes an audit fail (fail, unexpected_pass or error).
     pub fn is_failure(&self) -> bool {
-        matches!(self, Verdict::Fail | Verdict::Error { .. })
+        matches!(
+            self,
+            Verdict::Fail | Verdict::UnexpectedPass { .. } | Verdict::Error { .. }
+        )
     }
 }
 

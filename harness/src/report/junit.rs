@@ -33,7 +33,7 @@ pub fn render(report: &AuditReport) -> String {
     let failures = report
         .records
         .iter()
-        .filter(|r| r.verdict == Verdict::Fail)
+        .filter(|r| matches!(r.verdict, Verdict::Fail | Verdict::UnexpectedPass { .. }))
         .count();
     let errors = report
         .records
@@ -49,7 +49,7 @@ pub fn render(report: &AuditReport) -> String {
     for (check, records) in suites {
         let f = records
             .iter()
-            .filter(|r| r.verdict == Verdict::Fail)
+            .filter(|r| matches!(r.verdict, Verdict::Fail | Verdict::UnexpectedPass { .. }))
             .count();
         let e = records
             .iter()
@@ -87,6 +87,11 @@ pub fn render(report: &AuditReport) -> String {
                 Verdict::Error { message } => out.push_str(&format!(
                     ">\n      <error message=\"{}\"/>\n    </testcase>\n",
                     escape(message)
+                )),
+                Verdict::UnexpectedPass { reason } => out.push_str(&format!(
+                    ">\n      <failure message=\"unexpected pass: {}\">{}</failure>\n    </testcase>\n",
+                    escape(reason),
+                    escape(&detail(r))
                 )),
                 Verdict::ExpectedFailure { reason } => out.push_str(&format!(
                     ">\n      <skipped message=\"expected failure: {}\"/>\n    </testcase>\n",

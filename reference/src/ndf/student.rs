@@ -279,6 +279,7 @@ impl Smith for Student {
     fn lambda_route(&self, w: Vec3, route: &str) -> Result<f64, QueryError> {
         let x = self.standardized_cotangent(w);
         let f = routes::route(route, self.c)?;
+        routes::route_domain(route, self.c, x)?;
         let sigma = scale_along(self.sx, self.sy, w[1].atan2(w[0])) / (self.c - 1.0).sqrt();
         Ok(lambda_both_hemispheres(x, |x| f(self.c, x, sigma)))
     }

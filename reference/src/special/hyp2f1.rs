@@ -339,33 +339,157 @@ pub fn hyp2f1_lambda_algorithm2(c: f64, z: f64) -> f64 {
     }
 }
 
+/// The most terms the positive series of the corrected Algorithm 2 may take (about 0.3 s):
+/// beyond, `lambda_algorithm2_corrected` returns NaN and the route answers a typed error
+/// (`algorithm2_terms_needed`).
+pub const ALGORITHM2_MAX_TERMS: f64 = 1e8;
+
+/// Σₘ (a)ₘ/(c)ₘ zᵐ (b = 1) for 0 ≤ z < 1 and a, c > 0: ₂F₁(a, 1; c; z), every term
+/// positive, summed until the tail cannot change the sum: the ratios of successive terms
+/// (a+n)z/(c+n) move monotonically towards z, so past the n-th term they stay below
+/// r = max(z, (a+n)z/(c+n)) and the tail is below term·r/(1 − r).
+fn series_b1(a: f64, c: f64, z: f64) -> f64 {
+    let mut term = 1.0;
+    let mut sum = 1.0;
+    let mut n = 0.0;
+    while n < ALGORITHM2_MAX_TERMS {
+        term *= (a + n) / (c + n) * z;
+        sum += term;
+        n += 1.0;
+        let r = z.max((a + n) / (c + n) * z);
+        if r < 1.0 && term * r <= sum * 1e-17 * (1.0 - r) {
+            return sum;
+        }
+    }
+    f64::NAN
+}
+
+/// The terms `series_b1` needs at ratio ≤ w = 1/(1 + x²) (the 15.3.7 form of
+/// `lambda_algorithm2_corrected`): ln(1e-17 (1 − w))/ln w + 1.
+pub fn algorithm2_terms_needed(x: f64) -> f64 {
+    let w = 1.0 / (1.0 + x * x);
+    let one_minus_w = x * x / (1.0 + x * x);
+    (1e-17 * one_minus_w).ln() / w.ln() + 1.0
+}
+
 /// Seed 001 §8 Algorithm 2 with its printed errors corrected (line 1 returns 1; line 6 is
-/// Γ(3/2)Γ(γ−1)/Γ(γ−½) (−z)^{−½}; line 7 uses Γ(1−γ)/Γ(2−γ) = 1/(1−γ); line 12 is
-/// (1−z)^{−½} ₂F₁(½, 2−γ; 3/2; normalZ)). Still a poor algorithm — the 15.3.7 branch sums an
-/// alternating series that cancels for large γ near z = −1, and returns ∞ − ∞ at γ = 1 + …
-/// integers where b − a is an integer (A&S 15.3.7 needs 15.3.14 there) — which the harness
-/// measures; `hyp2f1_lambda` is the evaluator to use.
+/// Γ(3/2)Γ(γ−1)/Γ(γ−½) (−z)^{−½}, the series ₂F₁(½, 0; 2−γ; 1/z) = 1; line 7 uses
+/// Γ(1−γ)/Γ(2−γ) = 1/(1−γ)), and with every series put in a form whose terms are all positive
+/// (the issue-12 defect: the Gauss series of line 15 and of line 7 alternate, and for γ = 50
+/// cancel to Λ = −1.5e11 where Λ = 1.3e-15):
+///
+/// ```text
+/// z ≤ −1 (lines 4–9, A&S 15.3.7, then 15.3.4 on the second series, w = 1/(1 − z)):
+///   ₂F₁ = 1/(2 N x) − (1 − z)^{½−γ} ₂F₁(γ−½, 1; γ; w) / (2(γ − 1))
+/// −1 < z ≤ 0 (line 10, A&S 15.3.5, for every γ, not only γ = 2; s = z/(z − 1)):
+///   ₂F₁ = (1 − z)^{½−γ} ₂F₁(γ−½, 1; 3/2; s)
+/// ```
+///
+/// with x = √(−z), N = Γ(γ−½)/(√π Γ(γ−1)). NaN for γ ≤ 1 or z > 0.
 pub fn hyp2f1_lambda_algorithm2_corrected(c: f64, z: f64) -> f64 {
+    if !(c > 1.0) || !(z <= 0.0) {
+        return f64::NAN;
+    }
     if z == 0.0 {
         return 1.0;
     }
+    let x2 = -z;
+    let power = ((0.5 - c) * x2.ln_1p()).exp();
     if z <= -1.0 {
-        let normal_z = z / (z - 1.0);
-        if c >= 12.0 || normal_z >= 0.99 {
-            let x = gamma(1.5) / gamma_half_ratio(c - 1.0) * (-z).powf(-0.5);
-            let y = gamma(1.5) / (gamma(0.5) * (1.0 - c))
-                * (-z).powf(0.5 - c)
-                * gauss_series(c - 0.5, c - 1.0, c, 1.0 / z);
-            x + y
-        } else if c == 2.0 {
-            (1.0 - z).powf(0.5 - c) * gauss_series(c - 0.5, 1.0, 1.5, normal_z)
-        } else {
-            (1.0 - z).powf(-0.5) * gauss_series(0.5, 2.0 - c, 1.5, normal_z)
-        }
+        let w = 1.0 / (1.0 + x2);
+        0.5 / (student_norm(c) * x2.sqrt()) - power * series_b1(c - 0.5, c, w) / (2.0 * (c - 1.0))
     } else {
-        gauss_series(0.5, c - 0.5, 1.5, z)
+        power * series_b1(c - 0.5, 1.5, x2 / (1.0 + x2))
     }
 }
+
+/// Λ_C(x) by seed 001 eq 21 with ₂F₁ from the corrected Algorithm 2
+/// (`hyp2f1_lambda_algorithm2_corrected`), the difference of eq 21 taken where it cancels:
+///
+/// In the 15.3.7 form, N x · Γ(3/2)Γ(γ−1)/Γ(γ−½) (−z)^{−½} = ½ exactly, so eq 21's − ½ cancels
+/// algebraically, and with ₂F₁(γ−½, 1; γ; w)(1 − w) = 1 − Σ_{n≥1} (γ−½)_{n−1}/(γ)_{n−1}
+/// wⁿ/(2(γ+n−1)) (the 15.3.4 series times 1 − w, term by term) the remaining difference
+/// 1/(2γ−3) − 1/(2γ−2) is exact too:
+///
+/// ```text
+/// Λ = N (1 + x²)^{3/2−γ} / x · [ 1/((2γ−3)(2γ−2)) + w ₂F₁(γ−½, 1; γ+1; w) / (4γ(γ−1)) ]
+/// ```
+///
+/// every term positive (w = 1/(1 + x²)). It serves wherever the line-10 form would cancel
+/// (Λ < 0.02, or γ s > 2 where its series grows before it converges); elsewhere eq 21 is
+/// summed as printed with the line-10 ₂F₁ (relative error ≤ 32ε/Λ ≤ 2e-13 there). Measured
+/// against the stable route: see `tests::algorithm2_corrected_at_the_stress_gammas`. NaN where
+/// the series would need more than `ALGORITHM2_MAX_TERMS` terms.
+pub fn lambda_algorithm2_corrected(c: f64, x: f64) -> f64 {
+    if !(c > 1.5) || x.is_nan() || x < 0.0 {
+        return f64::NAN;
+    }
+    if x == 0.0 {
+        return f64::INFINITY;
+    }
+    if x == f64::INFINITY {
+        return 0.0;
+    }
+    let x2 = x * x;
+    let n = student_norm(c);
+    let s = x2 / (1.0 + x2);
+    let w = 1.0 / (1.0 + x2);
+    // (1 + x²)^{3/2−C}
+    let power = ((1.5 - c) * x2.ln_1p()).exp();
+    if x2 < 1.0 && c * s <= 2.0 {
+        let f = ((0.5 - c) * x2.ln_1p()).exp() * series_b1(c - 0.5, 1.5, s);
+        let eq21 = n * power / ((2.0 * c - 3.0) * x) + n * x * f - 0.5;
+        if eq21 >= EQ21_MIN {
+            return eq21;
+        }
+    }
+    if algorithm2_terms_needed(x) > ALGORITHM2_MAX_TERMS {
+        return f64::NAN;
+    }
+    let bracket =
+        1.0 / ((2.0 * c - 3.0) * (2.0 * c - 2.0)) + w * tail_series(c, x2) / (4.0 * c * (c - 1.0));
+    n * power / x * bracket
+}
+
+/// ₂F₁(C−½, 1; C+1; w), w = 1/(1 + x²), the positive series of the 15.3.7 form. Near w = 1
+/// (large C, a = x√(C−1) ≈ 1–6) it takes 10⁴–10⁷ terms, and a running product of the term
+/// ratios would carry n roundings and the rounding of w to the n-th power (1.1e-13 measured at
+/// C = 1000, a = 1.08). So every `ANCHOR` terms the term is recomputed from
+///
+/// ```text
+/// (C−½)ₙ/(C+1)ₙ = C g(C−½) / ((C+n) g(C+n−½)),   g(y) = Γ(y+½)/Γ(y),   wⁿ = e^{−n ln(1+x²)}
+/// ```
+///
+/// (`gamma_half_ratio`, a few ulps), and the running product only bridges the gaps.
+fn tail_series(c: f64, x2: f64) -> f64 {
+    const ANCHOR: f64 = 64.0;
+    let l = x2.ln_1p();
+    let w = 1.0 / (1.0 + x2);
+    let one_minus_w = x2 / (1.0 + x2);
+    let base = c * gamma_half_ratio(c - 0.5);
+    let (mut sum, mut comp) = (1.0f64, 0.0f64);
+    let mut term = 1.0;
+    let mut n = 0.0;
+    while n < ALGORITHM2_MAX_TERMS {
+        term *= (c - 0.5 + n) / (c + 1.0 + n) * w;
+        n += 1.0;
+        if n % ANCHOR == 0.0 {
+            term = base / ((c + n) * gamma_half_ratio(c + n - 0.5)) * (-n * l).exp();
+        }
+        // Neumaier's compensated sum.
+        let t = sum + term;
+        comp += (sum - t) + term;
+        sum = t;
+        if term * w <= (sum + comp) * 1e-17 * one_minus_w {
+            return sum + comp;
+        }
+    }
+    f64::NAN
+}
+
+/// Below this Λ, `lambda_algorithm2_corrected` leaves eq 21's difference for the
+/// cancellation-free 15.3.7 form (eq 21's absolute error ≈ 4ε).
+const EQ21_MIN: f64 = 0.02;
 
 #[cfg(test)]
 mod tests {
@@ -460,6 +584,51 @@ mod tests {
                 hyp2f1_lambda(2.0, -5.0)
             ) < 1e-13
         );
+    }
+
+    /// The corrected Algorithm 2 against the stable route (itself ≤ 2e-14 against mpmath) at
+    /// the stress shapes of issue 12, over θ from 1e-6 to π/2 − 1e-6 and three roughnesses.
+    #[test]
+    fn algorithm2_corrected_at_the_stress_gammas() {
+        use crate::special::student_tail::student_lambda;
+        let mut overall: f64 = 0.0;
+        for &c in &[1.6, 2.0, 2.5, 3.0, 7.5, 20.0, 50.0, 90.0, 171.8, 1e3, 1e6] {
+            let mut worst: (f64, f64) = (0.0, 0.0);
+            for &alpha in &[0.05, 0.3, 1.0] {
+                let scale = alpha * (c - 1.0f64).sqrt();
+                let thetas = (0..=24)
+                    .map(|i| 1e-6 + (std::f64::consts::FRAC_PI_2 - 2e-6) * i as f64 / 24.0)
+                    .chain([1e-3, 0.5, 1.2, 1.5, std::f64::consts::FRAC_PI_2 - 1e-6]);
+                for theta in thetas {
+                    let x = 1.0 / (theta.tan() * scale);
+                    let want = student_lambda(c, x);
+                    if !(want >= 1e-300) {
+                        continue;
+                    }
+                    let got = lambda_algorithm2_corrected(c, x);
+                    let e = rel_err(got, want);
+                    assert!(
+                        e <= 1e-13,
+                        "γ = {c}, α = {alpha}, θ = {theta}, x = {x}: {got:e} vs {want:e} ({e:.1e})"
+                    );
+                    if e > worst.0 {
+                        worst = (e, x);
+                    }
+                }
+            }
+            eprintln!(
+                "algorithm2_corrected γ = {c}: max rel err {:.2e} (at x = {:.3e})",
+                worst.0, worst.1
+            );
+            overall = overall.max(worst.0);
+        }
+        // The two defects of issue 12: γ = 50, θ = 0.5 and γ = 90 (STD, α = 0.3).
+        for &(c, theta) in &[(50.0, 0.5), (90.0, 0.5), (90.0, 1.2)] {
+            let x = 1.0 / (f64::tan(theta) * 0.3 * (c - 1.0f64).sqrt());
+            let (got, want) = (lambda_algorithm2_corrected(c, x), student_lambda(c, x));
+            assert!(rel_err(got, want) < 1e-13, "γ = {c}: {got:e} vs {want:e}");
+        }
+        assert!(overall > 0.0);
     }
 
     #[test]
