@@ -424,4 +424,64 @@ mod tests {
             }
         }
     }
+
+    /// Chi-square detection of Algorithm 2's printed tolerance: u = F(θ(ξ)) for ξ on a
+    /// midpoint grid of n values (2²⁰ for the numbers in ERRATA.md 000-E13, 2¹⁸ here) is histogrammed into K bins equiprobable under the true
+    /// conditional cdf F (the reference's `cdf_theta`); p′ᵢ is the fraction in bin i. The
+    /// chi-square statistic of N samples is noncentral with λ = N·K Σ (p′ᵢ − 1/K)², so the test
+    /// at level α catches the bias (with probability ½) at N* = λ*/(K Σ (p′ᵢ − 1/K)²), λ* the
+    /// noncentrality whose median reaches the critical value.
+    fn detection_count(
+        m: &PiecewiseLinear,
+        phi: f64,
+        tolerance: f64,
+        k: usize,
+        n: usize,
+    ) -> (f64, f64, f64) {
+        use statrs::distribution::{ChiSquared, ContinuousCDF};
+        let mut counts = vec![0usize; k];
+        let mut worst = 0.0f64;
+        for j in 0..n {
+            let xi = (j as f64 + 0.5) / n as f64;
+            let r = algorithm2_printed(m, xi, phi, tolerance, 200);
+            let u = m.cdf_theta(r.value, phi);
+            worst = worst.max((u - xi).abs());
+            counts[((u * k as f64) as usize).min(k - 1)] += 1;
+        }
+        let lambda1: f64 = counts
+            .iter()
+            .map(|&c| (c as f64 / n as f64 - 1.0 / k as f64).powi(2))
+            .sum::<f64>()
+            * k as f64;
+        // The grid's own discretization: each bin's count is off by < 1 (|p′ − 1/K| < 1/n).
+        let floor = k as f64 * k as f64 / (n as f64 * n as f64);
+        let dof = (k - 1) as f64;
+        let crit = ChiSquared::new(dof).unwrap().inverse_cdf(1.0 - 1e-3);
+        // Median of the noncentral chi-square ≈ dof + λ − 2/3 (+ O(1/(dof + λ))).
+        let lambda_star = crit - dof + 2.0 / 3.0;
+        (lambda_star / lambda1, worst, lambda1 / floor)
+    }
+
+    #[test]
+    fn algorithm2_printed_tolerance_bias_and_its_chi_square_detection() {
+        let m = model();
+        let phi = 0.4;
+        for &k in &[16usize, 256] {
+            let (n_printed, worst, above_floor) =
+                detection_count(&m, phi, PRINTED_TOLERANCE, k, 1 << 18);
+            println!(
+                "φ = {phi}, K = {k}: printed 1e-5: max |F(θ) − ξ| = {worst:.2e}, caught at N ≈ \
+                 {n_printed:.2e} (λ₁ = {above_floor:.1e} × grid floor)"
+            );
+            // |value| < 1e-5 in unnormalized units is up to 1e-5 · 2π/(D_y(0) cos²φ + D_x(0)
+            // sin²φ) in probability (2.2e-4 at φ = 0.4 for this model).
+            assert!(
+                worst > 1e-6 && worst < 1e-5 * TAU / m.d_y(0.0).min(m.d_x(0.0)),
+                "{worst}"
+            );
+            // Measured at 2²⁰: 8.1e7 (K = 16) and 2.1e6 (K = 256).
+            assert!(above_floor > 10.0, "{above_floor}");
+            assert!(n_printed > 5e5 && n_printed < 1e9, "{n_printed}");
+        }
+    }
 }
