@@ -395,8 +395,8 @@ fn e000_16() -> Result<Shown, String> {
 }
 
 /// 000-E17: seed 000 eq 25, last line: −(cos θ_o/4)(∫_{θ_{k+1}}^{π/2} 2π D_x(θ) D_x(0) cos sin/c
-/// + twice ∫_E^{θ_{k+1}} 2π D_y D_x(0) cos sin/c) as printed, against −(cos θ_o/4) ∫_E^{π/2} 2π
-/// D_y D_x(0) cos θ sin θ/c dθ by harness quadrature (θ_o = 0.9).
+/// plus twice ∫_E^{θ_{k+1}} 2π D_y D_x(0) cos sin/c) as printed, against −(cos θ_o/4) ∫_E^{π/2}
+/// 2π D_y D_x(0) cos θ sin θ/c dθ by harness quadrature (θ_o = 0.9).
 fn e000_17() -> Result<Shown, String> {
     let m = pl()?;
     let theta_o = 0.9f64;
