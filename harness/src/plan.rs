@@ -137,8 +137,9 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
     }
     let documents: Vec<&str> = documents.into_iter().collect();
     let used = format!("the scene uses seed(s) {}", documents.join(", "));
-    out.extend(errata::plan(&documents, &used));
-    out.extend(claims::plan(&documents, &used));
+    let scope = errata::Scope::of_scene(scene);
+    out.extend(errata::plan(&scope, &used));
+    out.extend(claims::plan(&scope, &used));
     out
 }
 

@@ -5,6 +5,7 @@
 //! `../shared/seeds/`). This crate holds closed forms only: no oracles, no I/O, no randomness.
 //! Every closed form is checked by the harness (`mfh-harness`) against independent oracles.
 
+pub mod errata;
 pub mod error;
 pub mod geometry;
 pub mod model;

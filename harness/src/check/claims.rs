@@ -2,21 +2,53 @@
 //! formulations, convergence) as a check with a verdict: value = the measured error, tolerance =
 //! the claimed bound (with the document's words as its reason, `crate::tolerance`), oracle =
 //! harness quadrature. A claim reference/ERRATA.md shows false is an expected failure tagged
-//! with its erratum id.
+//! with its erratum id. Forms a document presents as approximations without a bound (seed 003
+//! §3.2.1, §4.3) are measured against a bound on their measured error, so a changed form fails.
+//! Each claim declares what it concerns ([`Concern`]); a scene plans only those it uses.
 
-use super::errata::{g1_gamma0, gtr_g1_oracle};
+use super::errata::{Concern, Effect, Scope, STUDENT};
 use super::smith::lambda_oracle;
 use super::{applied, covers, timed, Planned};
-use crate::oracle::quadrature::{integrate_line, Accuracy};
+use crate::oracle::gtr::g1_gamma0;
+use crate::oracle::quadrature::{
+    integrate, integrate_hemisphere, integrate_line, integrate_pieces, integrate_upper, Accuracy,
+};
+use crate::oracle::Estimate;
 use crate::record::{CheckRecord, Measured, Verdict};
 use crate::tolerance::{
-    Tolerance, GTR_CLAMP, GTR_LIMIT, GTR_SPLINE, IDENTITY, PIECEWISE_TRAPEZOID, SLOPE_MOMENT_CLAIM,
+    Tolerance, CLOSED_FORM, GTR_CLAMP, GTR_LIMIT, GTR_SPLINE, IDENTITY, PIECEWISE_TRAPEZOID,
+    SLOPE_MOMENT_CLAIM,
 };
+use mfh_reference::errata::seed001;
 use mfh_reference::geometry::from_spherical;
 use mfh_reference::ndf::gtr::Gtr;
+use mfh_reference::sg::asg::Asg;
+use mfh_reference::sg::circular::CircularGaussian;
 use mfh_reference::{Model, ModelSpec};
 use serde_json::{json, Value};
 use std::f64::consts::FRAC_PI_2;
+
+/// Seed 003 §3.2.1's ASG integral with F, an approximation the document states no error for
+/// (not an erratum: "can be approximated as follows").
+// To move to crate::tolerance (owned by another change): kept here with its reason.
+pub const ASG_INTEGRAL_APPROXIMATION: Tolerance = Tolerance {
+    name: "asg_integral_approximation",
+    value: 0.045,
+    reason: "the document states no error; the reference measured max 4.24 % relative for \
+             bandwidths μ ≥ 1, λ ≥ μ (at λ = 2, μ = 1; exact for λ = μ; unbounded as μ → 0): \
+             4.5 % bounds the measured error over the planned grid, so a changed form fails",
+};
+
+/// Seed 003 §4.3's ∫g^c ≈ ∫g (erf form), as a multiple of its leading-order relative error
+/// σ²/16.
+// To move to crate::tolerance (owned by another change): kept here with its reason.
+pub const CIRCULAR_ERF_LEADING_ORDER: Tolerance = Tolerance {
+    name: "circular_erf_leading_order",
+    value: 1.2,
+    reason: "the document says \"approximated\" and states no error; g^c = g·e^{x⁴/(12σ²) + …} \
+             gives a relative error σ²/16 to leading order; measured ≤ 1.15 σ²/16 for σ ≤ 1 and \
+             means in [−1.4, 1.4]: the check allows 1.2 σ²/16",
+};
 
 /// What a claim check measured.
 struct Measurement {
@@ -24,12 +56,24 @@ struct Measurement {
     error: f64,
     /// Whether `error` is relative (else absolute).
     relative: bool,
+    /// Other measured quantities, added to the record's case.
+    detail: Value,
+}
+
+impl Measurement {
+    fn new(error: f64, relative: bool) -> Self {
+        Self {
+            error,
+            relative,
+            detail: Value::Null,
+        }
+    }
 }
 
 /// One claim.
 struct Claim {
     check: &'static str,
-    document: &'static str,
+    concern: Concern,
     source: &'static str,
     covers: Vec<String>,
     model: Value,
@@ -45,13 +89,14 @@ fn build(spec: Value) -> Result<Box<dyn Model>, String> {
     s.build().map_err(|e| e.to_string())
 }
 
-/// Plans one check per claim of the given documents (seed ids "000" … "004").
-pub fn plan(documents: &[&str], why: &str) -> Vec<Planned> {
+/// Plans one check per claim that concerns what the scene uses (`scope`); the reason names
+/// the families and effects that call for it.
+pub fn plan(scope: &Scope, why: &str) -> Vec<Planned> {
     let mut out = Vec::new();
     for claim in claims() {
-        if !documents.contains(&claim.document) {
+        let Some(used) = scope.uses(&claim.concern) else {
             continue;
-        }
+        };
         let Claim {
             check,
             source,
@@ -68,7 +113,7 @@ pub fn plan(documents: &[&str], why: &str) -> Vec<Planned> {
             check: check.into(),
             model,
             case,
-            why: format!("{why}: claim of {source}"),
+            why: format!("{why}: claim of {source}; {used}"),
             covers,
             statistical: false,
             run: Box::new(move |_| {
@@ -79,6 +124,11 @@ pub fn plan(documents: &[&str], why: &str) -> Vec<Planned> {
                     match run() {
                         Ok(m) => {
                             r.value = Some(m.error);
+                            if let (Value::Object(case), Value::Object(detail)) =
+                                (&mut r.case, m.detail)
+                            {
+                                case.extend(detail);
+                            }
                             r.measured = Some(if m.relative {
                                 Measured::Relative { error: m.error }
                             } else {
@@ -106,6 +156,25 @@ pub fn plan(documents: &[&str], why: &str) -> Vec<Planned> {
         });
     }
     out
+}
+
+/// G1 of GTR by the harness oracle of Λ (`check::smith::lambda_oracle`: one quadrature of the
+/// model's P2; the nested quadrature of `oracle::gtr`, which owes nothing to the model, costs
+/// ~10⁵ evaluations per Λ, too many for the 600 points of the spline grid).
+fn gtr_g1(gamma: f64, alpha: f64, theta: f64) -> Estimate {
+    let spec = json!({"family": "gtr", "gamma": gamma, "alpha": alpha});
+    let Ok(m) = build(spec.clone()) else {
+        return Estimate {
+            value: f64::NAN,
+            ..Estimate::default()
+        };
+    };
+    let lam = lambda_oracle(m.as_ref(), &spec, from_spherical(theta, 0.0));
+    Estimate {
+        value: 1.0 / (1.0 + lam.value),
+        error_bound: lam.error_bound / (1.0 + lam.value).powi(2),
+        evaluations: lam.evaluations,
+    }
 }
 
 /// The plot domain of seed 004 §5 with γ between the knots.
@@ -137,7 +206,7 @@ fn spline_errors_uncached() -> Result<(f64, f64), String> {
         let s = m
             .g1_route(from_spherical(theta, 0.0), "spline")
             .map_err(|e| e.to_string())?;
-        let e = (s - gtr_g1_oracle(g, a, theta)?.value).abs();
+        let e = (s - gtr_g1(g, a, theta).value).abs();
         max = max.max(e);
         sum += e;
         n += 1.0;
@@ -151,28 +220,21 @@ fn clamp_difference() -> Result<Measurement, String> {
     for a in [0.05, 0.2, 0.4, 0.57, 0.8, 0.95] {
         for mu in [0.05f64, 0.1, 0.2, 0.5, 1.0, 1.5, 2.0] {
             let theta = (1.0 / mu).atan();
-            let d =
-                (gtr_g1_oracle(4.0, a, theta)?.value - gtr_g1_oracle(10.0, a, theta)?.value).abs();
+            let d = (gtr_g1(4.0, a, theta).value - gtr_g1(10.0, a, theta).value).abs();
             max = max.max(d);
         }
     }
-    Ok(Measurement {
-        error: max,
-        relative: false,
-    })
+    Ok(Measurement::new(max, false))
 }
 
 /// max over γ ∈ {1, 2, 3, 4} of |G1^γ − G1⁰| at μ = 1, α = 1e-4.
 fn convergence_to_g1_0() -> Result<Measurement, String> {
     let mut max = 0.0f64;
     for g in [1.0, 2.0, 3.0, 4.0] {
-        let d = (gtr_g1_oracle(g, 1e-4, FRAC_PI_2 / 2.0)?.value - g1_gamma0(1.0)).abs();
+        let d = (gtr_g1(g, 1e-4, FRAC_PI_2 / 2.0).value - g1_gamma0(1.0)).abs();
         max = max.max(d);
     }
-    Ok(Measurement {
-        error: max,
-        relative: false,
-    })
+    Ok(Measurement::new(max, false))
 }
 
 /// The piecewise-linear model of the trapezoid claim (7 irregular breakpoints).
@@ -200,10 +262,7 @@ fn trapezoid_error() -> Result<Measurement, String> {
         let e = ((1.0 + o) / (1.0 + lam) - 1.0).abs();
         max = max.max(e);
     }
-    Ok(Measurement {
-        error: max,
-        relative: true,
-    })
+    Ok(Measurement::new(max, true))
 }
 
 /// ∫ q^{2k} P2(q) dq by harness quadrature of the model's P2.
@@ -227,10 +286,7 @@ fn fixed_variance() -> Result<Measurement, String> {
         let v = moment(m.as_ref(), 1, 0.4)?;
         max = max.max((v / (0.4 * 0.4 / 2.0) - 1.0).abs());
     }
-    Ok(Measurement {
-        error: max,
-        relative: true,
-    })
+    Ok(Measurement::new(max, true))
 }
 
 /// Seed 001 eq 7: excess kurtosis 3/(C − 3) of D^G (STD γ = 8, α = 0.3), by quadrature.
@@ -240,10 +296,10 @@ fn excess_kurtosis() -> Result<Measurement, String> {
     let v = moment(m.as_ref(), 1, 0.3)?;
     let k4 = moment(m.as_ref(), 2, 0.3)?;
     let kurt = k4 / (v * v) - 3.0;
-    Ok(Measurement {
-        error: (kurt / (3.0 / (g - 3.0)) - 1.0).abs(),
-        relative: true,
-    })
+    Ok(Measurement::new(
+        (kurt / (3.0 / (g - 3.0)) - 1.0).abs(),
+        true,
+    ))
 }
 
 /// Seed 001 §1.1 / Table 1: "STD … includes GGX" (γ = 2) and Hyper-Cauchy includes GGX (γ = 2):
@@ -256,9 +312,99 @@ fn includes_ggx(family: &'static str) -> Result<Measurement, String> {
         let w = from_spherical(t, 0.3);
         max = max.max((m.d(w) / ggx.d(w) - 1.0).abs());
     }
+    Ok(Measurement::new(max, true))
+}
+
+/// Seed 001 eq 41–42 as a pair: θ_m from eq 42 as printed, at φ ∈ {0, 0.7, 2} and ξ₂ on a
+/// grid, must satisfy F(θ_m | φ) = ξ₂, F the conditional cdf of θ by harness quadrature of
+/// D cos θ sin θ (in u = tan θ: (1 + A u²)^{−γ} u). Eq 41 alone tends to 1/(σxσy A′) ≠ 1 (it
+/// keeps 2π p(φ)), but eq 42 divides ξ₂ by the same factor (formerly erratum 001-11,
+/// withdrawn): the measured max |F − ξ₂| and the limit of eq 41 are recorded.
+fn eq41_42_sampler() -> Result<Measurement, String> {
+    let (g, sx, sy) = (3.0f64, 0.2f64, 0.5f64);
+    let (mut max, mut limits) = (0.0f64, Vec::new());
+    for phi in [0.0f64, 0.7, 2.0] {
+        let a_phi = (phi.cos() / sx).powi(2) + (phi.sin() / sy).powi(2);
+        let a = a_phi / (g - 1.0);
+        let f = |u: f64| (1.0 + a * u * u).powf(-g) * u;
+        let whole = integrate_upper(&f, 0.0, 1.0 / a.sqrt(), Accuracy::relative(1e-13)).value;
+        for xi in [0.02, 0.1, 0.3, 0.5, 0.7, 0.9, 0.98] {
+            let theta = seed001::eq42_theta_printed(g, sx, sy, phi, xi);
+            let part = integrate(&f, 0.0, theta.tan(), Accuracy::relative(1e-13)).value;
+            max = max.max((part / whole - xi).abs());
+        }
+        limits.push(seed001::eq41_theta_cdf_printed(
+            g,
+            sx,
+            sy,
+            phi,
+            FRAC_PI_2 - 1e-9,
+        ));
+    }
     Ok(Measurement {
         error: max,
+        relative: false,
+        detail: json!({"eq41_at_horizon": limits}),
+    })
+}
+
+/// Seed 003 §3.2.1: max relative error of the ASG integral with F against harness quadrature
+/// of the ASG over the hemisphere, bandwidths λ ≥ μ ≥ 1.
+fn asg_integral_error() -> Result<Measurement, String> {
+    let mut worst = (0.0f64, [0.0f64; 2]);
+    for (l, m) in [
+        (1.0, 1.0),
+        (2.0, 1.0),
+        (5.0, 1.0),
+        (20.0, 1.0),
+        (5.0, 2.0),
+        (10.0, 5.0),
+    ] {
+        let a = Asg::new(
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [l, m],
+            1.0,
+        )
+        .map_err(|e| e.to_string())?;
+        let width = 1.0 / f64::sqrt(l);
+        let o = integrate_hemisphere(&|v| a.eval(v), width, None, Accuracy::relative(1e-10));
+        let e = (a.integral().map_err(|e| e.to_string())? / o.value - 1.0).abs();
+        if e > worst.0 {
+            worst = (e, [l, m]);
+        }
+    }
+    Ok(Measurement {
+        error: worst.0,
         relative: true,
+        detail: json!({"worst_bandwidths": worst.1}),
+    })
+}
+
+/// Seed 003 §4.3: max over σ ≤ 1 and means in [−1.4, 1.4] of the relative error of ∫g (the erf
+/// form) for ∫g^c over [−π/2, π/2], in units of σ²/16; ∫g^c by harness quadrature.
+fn circular_erf_error() -> Result<Measurement, String> {
+    let mut worst = (0.0f64, [0.0f64; 2]);
+    for sigma in [0.1, 0.3, 0.5, 1.0] {
+        for mean in [-1.4, 0.0, 0.3, 1.4] {
+            let g = CircularGaussian::new(mean, sigma).map_err(|e| e.to_string())?;
+            let o = integrate_pieces(
+                &|x| g.eval(x),
+                &[-FRAC_PI_2, mean, FRAC_PI_2],
+                Accuracy::relative(1e-13),
+            );
+            let e = (g.integral_interval(-FRAC_PI_2, FRAC_PI_2) / o.value - 1.0).abs()
+                / (sigma * sigma / 16.0);
+            if e > worst.0 {
+                worst = (e, [sigma, mean]);
+            }
+        }
+    }
+    Ok(Measurement {
+        error: worst.0,
+        relative: true,
+        detail: json!({"worst_sigma_mean": worst.1, "unit": "σ²/16"}),
     })
 }
 
@@ -266,25 +412,8 @@ fn claims() -> Vec<Claim> {
     let gtr = |g: f64, a: f64| json!({"family": "gtr", "gamma": g, "alpha": a});
     vec![
         Claim {
-            check: "claims.gtr_spline_max",
-            document: "004",
-            source: "seed 004 §2 (\"less than 0.1 % error\") and §5",
-            covers: vec![covers("gtr", "g1", "spline")],
-            model: gtr(0.5, 0.1),
-            case: json!({"quantity": "max |G1_spline − G1|", "gamma": "0.1, 0.3, …, 3.9",
-                         "alpha": [0.1, 0.2, 0.3, 0.4, 0.5], "mu": [0.1, 1.1, 2.1, 3.1, 4.1, 5.0]}),
-            tolerance: &GTR_SPLINE,
-            erratum: Some("004-E3"),
-            run: || {
-                spline_errors().map(|(max, _)| Measurement {
-                    error: max,
-                    relative: false,
-                })
-            },
-        },
-        Claim {
             check: "claims.gtr_spline_mean",
-            document: "004",
+            concern: Concern::new(&["gtr"], &[Effect::Masking]),
             source: "seed 004 §5 (\"the mean difference was 0.001\")",
             covers: vec![covers("gtr", "g1", "spline")],
             model: gtr(0.5, 0.1),
@@ -293,15 +422,18 @@ fn claims() -> Vec<Claim> {
             tolerance: &GTR_SPLINE,
             erratum: None,
             run: || {
-                spline_errors().map(|(_, mean)| Measurement {
+                spline_errors().map(|(max, mean)| Measurement {
                     error: mean,
                     relative: false,
+                    // The document bounds the mean only ("the mean difference was 0.001"); the
+                    // max is reported, not judged (formerly erratum 004-E3, withdrawn).
+                    detail: json!({"max_abs_error": max}),
                 })
             },
         },
         Claim {
             check: "claims.gtr_clamp",
-            document: "004",
+            concern: Concern::new(&["gtr"], &[Effect::Masking]),
             source: "seed 004 §6 (|G1⁴ − G1¹⁰| \"up to 0.3\")",
             covers: vec![covers("gtr", "g1", "exact")],
             model: gtr(4.0, 0.5),
@@ -313,7 +445,7 @@ fn claims() -> Vec<Claim> {
         },
         Claim {
             check: "claims.gtr_convergence",
-            document: "004",
+            concern: Concern::new(&["gtr"], &[Effect::Masking]),
             source: "seed 004 §4 (\"All height fields converge to G1⁰ when μ → 1 and α → 0\")",
             covers: vec![covers("gtr", "g1", "exact")],
             model: gtr(2.0, 1e-4),
@@ -324,7 +456,7 @@ fn claims() -> Vec<Claim> {
         },
         Claim {
             check: "claims.piecewise_trapezoid",
-            document: "000",
+            concern: Concern::new(&["piecewise_linear"], &[Effect::Masking]),
             source: "seed 000 eq 28 (trapezoid rule for the remaining Λ integral; no bound stated)",
             covers: vec![covers("piecewise_linear", "lambda", "domain_split")],
             model: trapezoid_spec(),
@@ -335,7 +467,7 @@ fn claims() -> Vec<Claim> {
         },
         Claim {
             check: "claims.student_fixed_variance",
-            document: "001",
+            concern: Concern::new(&["student_fixed_variance"], &[]),
             source: "seed 001 eq 9 (\"The variance of this distribution is σ²/2 for γ > 2\")",
             covers: vec![covers("student_fixed_variance", "p2", "default")],
             model: json!({"family": "student_fixed_variance", "gamma": [3.5, 6.0, 20.0], "alpha": 0.4}),
@@ -346,7 +478,7 @@ fn claims() -> Vec<Claim> {
         },
         Claim {
             check: "claims.student_excess_kurtosis",
-            document: "001",
+            concern: Concern::new(&["std", "student_general"], &[]),
             source: "seed 001 eq 7 (excess kurtosis 3/(C − 3))",
             covers: vec![covers("std", "p2", "default")],
             model: json!({"family": "std", "gamma": 8.0, "alpha": 0.3}),
@@ -357,7 +489,7 @@ fn claims() -> Vec<Claim> {
         },
         Claim {
             check: "claims.std_includes_ggx",
-            document: "001",
+            concern: Concern::new(&["std"], &[]),
             source: "seed 001 §1.1 (\"It includes GGX\", γ = 2)",
             covers: vec![covers("std", "d", "default"), covers("ggx", "d", "default")],
             model: json!({"family": "std", "gamma": 2.0, "alpha": 0.3}),
@@ -368,7 +500,7 @@ fn claims() -> Vec<Claim> {
         },
         Claim {
             check: "claims.hyper_cauchy_includes_ggx",
-            document: "001",
+            concern: Concern::new(&["hyper_cauchy"], &[]),
             source:
                 "seed 001 eq 8 (\"The GGX distribution is included by Hyper-Cauchy (when γ = 2)\")",
             covers: vec![covers("hyper_cauchy", "d", "default")],
@@ -377,6 +509,42 @@ fn claims() -> Vec<Claim> {
             tolerance: &IDENTITY,
             erratum: None,
             run: || includes_ggx("hyper_cauchy"),
+        },
+        Claim {
+            check: "claims.std_eq41_42_sampler",
+            concern: Concern::new(STUDENT, &[Effect::SampleNormals, Effect::PseudoVnis]),
+            source: "seed 001 eq 41–42 (θ_m given φ_m: the cdf and its inversion)",
+            covers: vec![covers("std", "sample_wm", "default")],
+            model: json!({"family": "std", "gamma": 3.0, "alpha_x": 0.2, "alpha_y": 0.5}),
+            case: json!({"quantity": "max |F(θ(ξ₂) | φ) − ξ₂|", "phi": [0.0, 0.7, 2.0],
+                         "xi2": [0.02, 0.1, 0.3, 0.5, 0.7, 0.9, 0.98]}),
+            tolerance: &CLOSED_FORM,
+            erratum: None,
+            run: eq41_42_sampler,
+        },
+        Claim {
+            check: "claims.asg_integral",
+            concern: Concern::new(&[], &[Effect::AnisotropicSphericalGaussians]),
+            source: "seed 003 §3.2.1 (ASG integral \"can be approximated as follows\")",
+            covers: vec![covers("asg", "asg_integral", "default")],
+            model: Value::Null,
+            case: json!({"quantity": "max relative error of the F form",
+                         "bandwidths": [[1, 1], [2, 1], [5, 1], [20, 1], [5, 2], [10, 5]]}),
+            tolerance: &ASG_INTEGRAL_APPROXIMATION,
+            erratum: None,
+            run: asg_integral_error,
+        },
+        Claim {
+            check: "claims.circular_interval_erf",
+            concern: Concern::new(&[], &[Effect::SphericalGaussians]),
+            source: "seed 003 §4.3 (∫g^c over [−π/2, π/2] \"approximated\" by the erf form)",
+            covers: vec![covers("circular", "integral_interval", "default")],
+            model: Value::Null,
+            case: json!({"quantity": "max relative error / (σ²/16)", "sigma": [0.1, 0.3, 0.5, 1.0],
+                         "mean": [-1.4, 0.0, 0.3, 1.4]}),
+            tolerance: &CIRCULAR_ERF_LEADING_ORDER,
+            erratum: None,
+            run: circular_erf_error,
         },
     ]
 }
@@ -387,7 +555,7 @@ mod tests {
 
     #[test]
     fn claims_reach_the_verdicts_errata_md_records() {
-        let plan = plan(&["000", "001", "002", "003", "004"], "test");
+        let plan = plan(&Scope::everything(), "test");
         let ctx = super::super::RunContext { seed: 1, out: None };
         for p in &plan {
             let r = (p.run)(&ctx);

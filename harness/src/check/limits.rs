@@ -1,5 +1,6 @@
 //! Limits: the Student-t family tends to Beckmann as γ → ∞ (seed 001 §4), at the measured rate
-//! O(1/γ), for D and Λ.
+//! O(1/γ), for D and Λ. Each record carries the fitted exponent (the verdict) and the constant
+//! of the rate: max over γ of γ × (relative D error) or γ × (absolute Λ error).
 
 use super::{applied, covers, timed, Planned};
 use crate::record::{relative_error, CheckRecord, Measured, Verdict};
@@ -83,10 +84,26 @@ pub fn plan(alpha: f64, why: &str) -> Vec<Planned> {
                             };
                             return r;
                         };
-                        let errors: Vec<f64> = GAMMAS
+                        let values: Vec<f64> = GAMMAS
                             .iter()
-                            .map(|&g| eval(std(g)).map_or(f64::NAN, |v| relative_error(v, limit)))
+                            .map(|&g| eval(std(g)).unwrap_or(f64::NAN))
                             .collect();
+                        let errors: Vec<f64> =
+                            values.iter().map(|&v| relative_error(v, limit)).collect();
+                        // The constant of the O(1/γ) rate: relative for D, absolute for Λ (Λ → 0
+                        // at grazing-free incidences is not the concern; its size is O(1)).
+                        let scaled: Vec<f64> = GAMMAS
+                            .iter()
+                            .zip(&values)
+                            .map(|(&g, &v)| {
+                                g * if quantity == "d" {
+                                    relative_error(v, limit)
+                                } else {
+                                    (v - limit).abs()
+                                }
+                            })
+                            .collect();
+                        let constant = scaled.iter().copied().fold(f64::NAN, f64::max);
                         let exponent = fitted_exponent(&GAMMAS, &errors);
                         r.value = Some(exponent);
                         r.measured = Some(Measured::Rate {
@@ -96,6 +113,13 @@ pub fn plan(alpha: f64, why: &str) -> Vec<Planned> {
                         r.tolerance = Some(applied(&LIMIT_RATE));
                         r.case = json!({"quantity": quantity, "alpha": alpha, "theta": theta,
                                         "gammas": GAMMAS, "relative_errors": errors,
+                                        "rate_constant": constant,
+                                        "rate_constant_kind": if quantity == "d" {
+                                            "max γ·|D_γ/D_∞ − 1|"
+                                        } else {
+                                            "max γ·|Λ_γ − Λ_∞|"
+                                        },
+                                        "gamma_times_error": scaled,
                                         "gamma_inf_equals_beckmann": at_inf == limit});
                         r.verdict = if (exponent + 1.0).abs() <= LIMIT_RATE.value && at_inf == limit
                         {
@@ -109,4 +133,27 @@ pub fn plan(alpha: f64, why: &str) -> Vec<Planned> {
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_rate_and_its_constants_are_recorded() {
+        let ctx = super::super::RunContext { seed: 1, out: None };
+        for alpha in [0.2, 0.4] {
+            for p in plan(alpha, "test") {
+                let r = (p.run)(&ctx);
+                let c = r.case["rate_constant"].as_f64().unwrap_or(f64::NAN);
+                println!(
+                    "α = {alpha} {}: exponent {:?}, constant {c:.4}, γ·error {}",
+                    r.case["quantity"], r.value, r.case["gamma_times_error"]
+                );
+                assert!(matches!(r.verdict, Verdict::Pass), "{:?}", r.verdict);
+                // O(1/γ): the constant is finite and of order one.
+                assert!(c.is_finite() && c > 1e-3 && c < 1e2, "{c}");
+            }
+        }
+    }
 }

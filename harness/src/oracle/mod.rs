@@ -4,12 +4,14 @@
 pub mod chi2;
 pub mod cubature;
 pub mod domain;
+pub mod gtr;
 pub mod ks;
 pub mod lobe;
 pub mod monte_carlo;
 pub mod precise;
 pub mod quadrature;
 pub mod student_t;
+pub mod visible_moments;
 
 /// An integral (or other numerical) estimate with a bound on its error.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]

@@ -3,9 +3,10 @@
 //! independent integral, and asserts that the printed one fails and the corrected one holds.
 //! The errata of evaluated routes are demonstrated beside them (ERRATA.md names every test).
 
-use crate::ndf::student_lambda::{alternating_tail_sum, eq33_prefactor};
+use crate::errata::seed001;
+use crate::ndf::student_lambda::eq33_prefactor;
 use crate::special::gamma_ratio::gamma_half_ratio;
-use crate::special::hyp2f1::{hyp2f1_lambda, student_norm};
+use crate::special::hyp2f1::student_norm;
 use crate::test_support::{integrate, integrate_tail, rel_err};
 use std::f64::consts::PI;
 
@@ -29,12 +30,9 @@ fn eq20_has_a_spurious_half_on_the_2f1_term() {
     // I2 = μ/((γ−1)σ²)^{γ−1} ∫_{t0}^∞ (1+t²)^{½−γ} dt, t0 = μ/√((γ−1)σ²). Eq 20 writes the
     // integral as √π Γ(γ−1)/(2Γ(γ−½)) − (μ/2) ₂F₁(…)/√((γ−1)σ²); it is … − t0 ₂F₁(…).
     for &(g, sigma, mu) in &[(2.5f64, 0.3f64, 0.4f64), (4.0, 0.5, 0.2), (7.5, 0.2, 0.3)] {
-        let k = (g - 1.0) * sigma * sigma;
-        let t0 = mu / k.sqrt();
-        let whole = PI.sqrt() / (2.0 * gamma_half_ratio(g - 1.0)); // √πΓ(γ−1)/(2Γ(γ−½))
-        let f = hyp2f1_lambda(g, -t0 * t0);
-        let printed = whole - mu / 2.0 * f / k.sqrt();
-        let corrected = whole - t0 * f;
+        let t0 = mu / ((g - 1.0) * sigma * sigma).sqrt();
+        let printed = seed001::eq20_tail_printed(g, sigma, mu);
+        let corrected = seed001::eq20_tail_corrected(g, sigma, mu);
         let truth = tail_integral(g, t0);
         assert!(
             rel_err(corrected, truth) < 1e-11,
@@ -54,9 +52,8 @@ fn eq28_last_line_misplaces_the_square_root() {
     for &(g, sigma, mu) in &[(3.0f64, 0.3f64, 0.4f64), (5.0, 0.6, 0.5)] {
         let t0 = mu / ((g - 1.0).sqrt() * sigma);
         let truth = tail_integral(g, t0);
-        let sum = |s: f64| alternating_tail_sum(g as u64 - 2, s);
-        let printed = sum(mu / (sigma * (g - 1.0).sqrt() + mu * mu / (sigma * sigma)));
-        let corrected = sum(mu / (sigma * ((g - 1.0) + mu * mu / (sigma * sigma)).sqrt()));
+        let printed = seed001::eq28_tail_printed(g as u64, sigma, mu);
+        let corrected = seed001::eq28_tail_corrected(g as u64, sigma, mu);
         assert!(
             rel_err(corrected, truth) < 1e-11,
             "γ={g}: {corrected} vs {truth}"
@@ -124,15 +121,14 @@ fn table1_anisotropic_beckmann_d_lacks_tan2_theta() {
     let norm = |printed: bool| -> f64 {
         let theta_max = if printed { 1.3 } else { PI / 2.0 - 1e-9 };
         let inner = |phi: f64| -> f64 {
-            let a = (phi.cos() / sx).powi(2) + (phi.sin() / sy).powi(2);
             let f = |theta: f64| -> f64 {
                 let (s, c) = theta.sin_cos();
-                let e = if printed {
-                    a.tan().powi(2)
+                let d = if printed {
+                    seed001::table1_aniso_beckmann_printed(sx, sy, theta, phi)
                 } else {
-                    theta.tan().powi(2) * a
+                    seed001::table1_aniso_beckmann_corrected(sx, sy, theta, phi)
                 };
-                (-e).exp() / (PI * sx * sy * c.powi(4)) * c * s
+                d * c * s
             };
             integrate(&f, 0.0, theta_max, 1e-12, 0.0).0
         };
@@ -146,15 +142,8 @@ fn table1_anisotropic_beckmann_d_lacks_tan2_theta() {
     assert!(norm(true) > 1.1, "printed: {}", norm(true));
 }
 
-#[test]
-fn eq41_theta_cdf_is_not_normalized_for_anisotropic_roughness() {
-    // Eq 41's last line, 1/(σx σy (cos²φ/σx² + sin²φ/σy²)) (1 − (1 + A tan²θ)^{1−γ}), tends to
-    // 1/(σx σy (…)) ≠ 1 at θ → π/2: the conditional cdf of θ given φ is 1 − (1+A tan²θ)^{1−γ}
-    // (eq 42, which the sampler uses); eq 41 still carries the φ density.
-    let (sx, sy, phi) = (0.2f64, 0.5f64, 0.7f64);
-    let printed_limit = 1.0 / (sx * sy * ((phi.cos() / sx).powi(2) + (phi.sin() / sy).powi(2)));
-    assert!((printed_limit - 1.0).abs() > 0.1, "{printed_limit}");
-}
+// Eq 41–42 (formerly ERRATA 001-11) are right as a pair: `errata::seed001::tests::
+// eq41_and_eq42_as_printed_sample_the_conditional_cdf`.
 
 /// P2 of §7.1 (σ = 1): (γ−1)^γ Γ(γ−½) / (√π Γ(γ) (γ − 1 + p²)^{γ−½}).
 fn p2_sec71(g: f64, p: f64) -> f64 {
@@ -177,12 +166,8 @@ fn sec71_visible_slope_cdf_has_the_wrong_sign_of_exponent() {
     };
     let g1 = 1.0 / (1.0 + lam);
     let truth = g1 * integrate_tail(&|u: f64| density(p - u), 0.0, 1.0, 1e-13);
-    let c = g1 * (g - 1.0).powf(g) / (PI.sqrt() * (g - 1.0)) * gamma_half_ratio(g - 1.0);
-    let f = hyp2f1_lambda(g, -p * p / (g - 1.0));
-    let rest = PI.sqrt() / (2.0 * (g - 1.0).powf(g) / (g - 1.0) * gamma_half_ratio(g - 1.0))
-        + t / ((2.0 * g - 3.0) * (p * p + g - 1.0).powf(g - 1.5));
-    let printed = c * ((g - 1.0).powf(g - 0.5) * p * f + rest);
-    let corrected = c * ((g - 1.0).powf(0.5 - g) * p * f + rest);
+    let printed = seed001::sec71_cdf_printed(g, theta, p);
+    let corrected = seed001::sec71_cdf_corrected(g, theta, p);
     assert!(rel_err(corrected, truth) < 1e-10, "{corrected} vs {truth}");
     assert!(rel_err(printed, truth) > 1e-2, "printed agreed");
 }
@@ -197,8 +182,8 @@ fn sec71_conditional_cdf_substitution_is_wrong() {
         below / all
     };
     let truth = cdf(&|s: f64| (1.0 + p * p / (g - 1.0) + s * s / (g - 1.0)).powf(-g));
-    let printed = cdf(&|s: f64| (1.0 / (g - 1.0) + p * p + s * s).powf(-g));
-    let corrected = cdf(&|s: f64| (g - 1.0 + p * p + s * s).powf(-g));
+    let printed = cdf(&|s: f64| seed001::sec71_kernel_printed(g, p, s));
+    let corrected = cdf(&|s: f64| seed001::sec71_kernel_corrected(g, p, s));
     assert!(rel_err(corrected, truth) < 1e-10);
     assert!(rel_err(printed, truth) > 1e-3, "{printed} vs {truth}");
 }

@@ -1,0 +1,63 @@
+//! Errata demonstrations of Seed 004 (GTR, Dimov): each printed form and its correction against a
+//! harness oracle (reference/ERRATA.md, section "Seed 004").
+
+use super::*;
+use crate::oracle::gtr::{self, g1_gamma0};
+
+/// 004-E1: seed 004 §3.5, P2⁴ with "4α²q2" read literally (8α²q) and as 4α²q², against
+/// ∫ P22⁴(p, q) dp by harness quadrature (α = 0.3, q = 0.5).
+fn e004_1() -> Result<Shown, String> {
+    let (alpha, q) = (0.3f64, 0.5f64);
+    let m = Gtr::new(4.0, alpha).map_err(|e| e.to_string())?;
+    let slopes = m.as_slopes().ok_or("no slopes")?;
+    let o = integrate_line(&|p| slopes.p22(p, q), 0.0, alpha, acc());
+    let a2 = alpha * alpha;
+    let p2 = |middle: f64| {
+        3.0 * a2.powi(3) * (8.0 * q.powi(4) + middle + 12.0 * q * q + a2 * a2 + 2.0 * a2 + 5.0)
+            / (16.0 * (a2 * a2 + a2 + 1.0) * (q * q + a2).powf(3.5))
+    };
+    Ok(Shown::new(
+        p2(4.0 * a2 * q * 2.0),
+        p2(4.0 * a2 * q * q),
+        o,
+        &ERRATUM,
+    ))
+}
+
+/// 004-E2: seed 004 §4 "all height fields converge to G1⁰ when μ → 1 and α → 0": at μ = 1,
+/// α = 1e-4, γ = 2 the printed limit is G1⁰(1) = 0.83; the true limit is 1.
+fn e004_2() -> Result<Shown, String> {
+    let o = gtr::g1(2.0, 1e-4, FRAC_PI_2 / 2.0);
+    Ok(Shown::new(
+        g1_gamma0(1.0),
+        1.0,
+        o,
+        &crate::tolerance::GTR_LIMIT,
+    ))
+}
+
+/// The demonstrations of this document's errata.
+pub(super) fn demos() -> Vec<Demo> {
+    let gtr = |g: f64, a: f64| json!({"family": "gtr", "gamma": g, "alpha": a});
+    let d = demo;
+    vec![
+        d(
+            "004-E1",
+            Concern::new(&["gtr"], &[Effect::Masking]),
+            "seed 004 §3.5, P2⁴",
+            vec![covers("gtr", "p22", "default")],
+            gtr(4.0, 0.3),
+            json!({"q": 0.5}),
+            e004_1,
+        ),
+        d(
+            "004-E2",
+            Concern::new(&["gtr"], &[Effect::Masking]),
+            "seed 004 §4",
+            vec![],
+            gtr(2.0, 1e-4),
+            json!({"mu": 1.0}),
+            e004_2,
+        ),
+    ]
+}
