@@ -57,6 +57,7 @@ impl<'a> Audit<'a> {
                 profile: Profile::Quick,
                 seed,
                 out: None,
+                ..Default::default()
             },
             masking: None,
             sampling: None,

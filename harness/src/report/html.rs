@@ -92,6 +92,7 @@ fn verdict_text(v: &Verdict) -> String {
         Verdict::ExpectedFailure { reason } => format!("expected failure: {reason}"),
         Verdict::Skipped { reason } => format!("skipped: {reason}"),
         Verdict::Error { message } => format!("ERROR: {message}"),
+        Verdict::UnexpectedPass { reason } => format!("UNEXPECTED PASS: {reason}"),
     }
 }
 
