@@ -52,15 +52,44 @@ pub enum Command {
         /// Print report.json to standard output instead of the summary.
         #[arg(long)]
         json: bool,
+        /// Run only shard i of n (1 ≤ i ≤ n) of the plan, balanced by estimated cost; writes
+        /// shard.json beside report.json for `mfh merge`.
+        #[arg(long)]
+        shard: Option<crate::shard::ShardSpec>,
+        /// Comparison with a saved run.
+        #[command(flatten)]
+        baseline: BaselineArgs,
+    },
+    /// Merge the output folders of `mfh audit --shard i/n` (every i of one n) into the
+    /// unsharded report: report.json and junit.xml in --out.
+    ///
+    /// Exit status 0 if every check passes, 1 if one fails, 2 on bad input.
+    Merge {
+        /// The shard output folders.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Output folder.
+        #[arg(long, default_value = "reports/merged")]
+        out: PathBuf,
+        /// Print report.json to standard output instead of the summary.
+        #[arg(long)]
+        json: bool,
+        /// Comparison with a saved run.
+        #[command(flatten)]
+        baseline: BaselineArgs,
     },
     /// Print the plan of a scene: one JSON line per check, with the reason it is planned.
     Plan {
-        /// The scene file; default: the embedded default scene.
+        /// The scene file (JSON, or Mitsuba 3 XML for `.xml`); default: the embedded default
+        /// scene.
         #[arg(long)]
         scene: Option<PathBuf>,
         /// The profile.
         #[arg(long, value_enum, default_value = "quick")]
         profile: crate::check::Profile,
+        /// JSON lines (for machines) or a table (for people).
+        #[arg(long, value_enum, default_value = "jsonl")]
+        format: PlanFormat,
     },
     /// Chi-square test of a model's normal sampler (sample_wm) against its pdf (pdf_wm) over
     /// a grid of R cos θ-rows × 2R φ-columns of the upper hemisphere.
@@ -102,6 +131,27 @@ pub enum Command {
     },
 }
 
+/// The output format of `mfh plan`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PlanFormat {
+    /// One JSON object per line.
+    Jsonl,
+    /// A text table.
+    Table,
+}
+
+/// Comparison with a saved run (`mfh audit` and `mfh merge`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct BaselineArgs {
+    /// A saved report.json: report checks whose error grew or whose cost rose by more than the
+    /// factors of `baseline.rs` (error ×2, cost ×3).
+    #[arg(long)]
+    pub baseline: Option<PathBuf>,
+    /// Exit 1 when the baseline comparison finds a regression.
+    #[arg(long, requires = "baseline")]
+    pub fail_on_regression: bool,
+}
+
 /// Runs the command line `args` (including the program name) with the given streams and
 /// returns the exit status.
 pub fn run<I, T>(
@@ -134,8 +184,28 @@ where
             seed,
             out,
             json,
-        } => run_audit(scene, profile, seed, out, json, stdout, stderr),
-        Command::Plan { scene, profile } => {
+            shard,
+            baseline,
+        } => run_audit(
+            scene, profile, seed, out, json, shard, &baseline, stdout, stderr,
+        ),
+        Command::Merge {
+            dirs,
+            out,
+            json,
+            baseline,
+        } => match crate::merge::merge_dirs(&dirs) {
+            Ok(report) => finish_report(&report, &out, json, &baseline, "merge", stdout, stderr),
+            Err(e) => {
+                let _ = writeln!(stderr, "mfh merge: {e}");
+                EXIT_BAD_INPUT
+            }
+        },
+        Command::Plan {
+            scene,
+            profile,
+            format,
+        } => {
             let scene = match load_scene(scene.as_deref()) {
                 Ok(s) => s,
                 Err(e) => {
@@ -144,8 +214,20 @@ where
                 }
             };
             let plan = crate::plan::plan(&scene, profile);
-            for line in crate::plan::describe(&plan) {
-                let _ = writeln!(stdout, "{line}");
+            match format {
+                PlanFormat::Table => {
+                    let table = crate::plan_table::plan_table(&plan, &scene.not_audited);
+                    let _ = write!(stdout, "{table}");
+                }
+                PlanFormat::Jsonl => {
+                    for line in crate::plan::describe(&plan) {
+                        let _ = writeln!(stdout, "{line}");
+                    }
+                    for n in &scene.not_audited {
+                        let line = serde_json::json!({"not_audited": n, "why": n.to_string()});
+                        let _ = writeln!(stdout, "{line}");
+                    }
+                }
             }
             let _ = writeln!(
                 stderr,
@@ -237,12 +319,15 @@ pub fn resolve_seed(seed: Option<u64>) -> Result<u64, String> {
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run_audit(
     scene_path: Option<PathBuf>,
     profile: crate::check::Profile,
     seed: Option<u64>,
     out: PathBuf,
     json: bool,
+    shard: Option<crate::shard::ShardSpec>,
+    baseline: &BaselineArgs,
     stdout: &mut dyn Write,
     stderr: &mut dyn Write,
 ) -> i32 {
@@ -270,30 +355,81 @@ fn run_audit(
         out: Some(out.clone()),
     };
     let scene_name = scene_path.as_ref().map(|p| p.display().to_string());
-    let report = crate::audit::audit_scene(&scene, scene_name.as_deref(), &options);
-    let written = match crate::report::write_all(&report, &out) {
+    let report = match shard {
+        None => crate::audit::audit_scene(&scene, scene_name.as_deref(), &options),
+        Some(spec) => {
+            let (report, info) =
+                crate::shard::audit_shard(&scene, scene_name.as_deref(), &options, spec);
+            let path = out.join(crate::shard::SHARD_FILE);
+            let text = serde_json::to_string_pretty(&info).unwrap_or_default();
+            if let Err(e) = std::fs::write(&path, text + "\n") {
+                let _ = writeln!(stderr, "mfh audit: cannot write {}: {e}", path.display());
+                return EXIT_BAD_INPUT;
+            }
+            report
+        }
+    };
+    finish_report(&report, &out, json, baseline, "audit", stdout, stderr)
+}
+
+/// Writes the report's sinks into `out`, prints the summary (or the JSON), the not-audited
+/// list and the baseline comparison; the exit status.
+fn finish_report(
+    report: &crate::audit::AuditReport,
+    out: &std::path::Path,
+    json: bool,
+    baseline: &BaselineArgs,
+    command: &str,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> i32 {
+    let old = match &baseline.baseline {
+        Some(path) => match crate::readback::read_report(path) {
+            Ok(r) => Some((path.display().to_string(), r)),
+            Err(e) => {
+                let _ = writeln!(stderr, "mfh {command}: --baseline: {e}");
+                return EXIT_BAD_INPUT;
+            }
+        },
+        None => None,
+    };
+    let written = match crate::report::write_all(report, out) {
         Ok(w) => w,
         Err(e) => {
             let _ = writeln!(
                 stderr,
-                "mfh audit: cannot write the report into {}: {e}",
+                "mfh {command}: cannot write the report into {}: {e}",
                 out.display()
             );
             return EXIT_BAD_INPUT;
         }
     };
     if json {
-        let _ = writeln!(stdout, "{}", crate::report::json::to_string(&report));
+        let _ = writeln!(stdout, "{}", crate::report::json::to_string(report));
     } else {
-        let _ = write!(stdout, "{}", crate::report::terminal::render(&report, 20));
+        let _ = write!(stdout, "{}", crate::report::terminal::render(report, 20));
+        for n in &report.not_audited {
+            let _ = writeln!(stdout, "{n}");
+        }
         for p in written {
             let _ = writeln!(stdout, "wrote {}", p.display());
         }
     }
-    if report.passed() {
-        0
-    } else {
+    let mut regressed = false;
+    if let Some((name, old)) = old {
+        let c = crate::baseline::compare(&old, report);
+        regressed = !c.regressions.is_empty();
+        let text = crate::baseline::render(&c, &name, 20);
+        let _ = if json {
+            write!(stderr, "{text}")
+        } else {
+            write!(stdout, "{text}")
+        };
+    }
+    if !report.passed() || (regressed && baseline.fail_on_regression) {
         1
+    } else {
+        0
     }
 }
 
