@@ -116,6 +116,11 @@ pub fn merge(shards: Vec<ShardReport>) -> Result<AuditReport, MergeError> {
                 a.report.mfh_version.to_string(),
                 b.report.mfh_version.to_string(),
             ),
+            (
+                "not-audited list",
+                format!("{:?}", a.report.not_audited),
+                format!("{:?}", b.report.not_audited),
+            ),
         ]
         .into_iter()
         .find(|(_, x, y)| x != y);
