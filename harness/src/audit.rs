@@ -10,7 +10,7 @@ use crate::record::{CheckRecord, Measured, Verdict, SCHEMA_VERSION};
 use crate::scene::Scene;
 use crate::tolerance::STATISTICAL_ALPHA;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
@@ -63,7 +63,7 @@ impl std::fmt::Debug for ProgressFn {
 }
 
 /// Counts and extremes of an audit.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Summary {
     /// Records by verdict name.
     pub counts: BTreeMap<String, usize>,
@@ -78,7 +78,7 @@ pub struct Summary {
 }
 
 /// Per-check-id totals.
-#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct CheckSummary {
     /// Records.
     pub records: usize,
@@ -93,15 +93,17 @@ pub struct CheckSummary {
 }
 
 /// The result of an audit, as written to `report.json`.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct AuditReport {
     /// The record schema version.
     pub schema_version: u32,
     /// mfh's version.
-    pub mfh_version: &'static str,
+    #[serde(deserialize_with = "crate::readback::interned")]
+    pub mfh_version: crate::readback::StaticStr,
     /// The scene's name.
     pub scene: String,
     /// The profile.
+    #[serde(deserialize_with = "crate::readback::profile")]
     pub profile: Profile,
     /// The audit seed.
     pub seed: u64,
@@ -111,6 +113,9 @@ pub struct AuditReport {
     pub summary: Summary,
     /// Every record, in plan order.
     pub records: Vec<CheckRecord>,
+    /// What the scene file holds that was not audited, and why (Mitsuba scenes).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub not_audited: Vec<crate::scene::NotAudited>,
 }
 
 impl AuditReport {
@@ -241,12 +246,13 @@ impl AuditReport {
             command,
             summary,
             records,
+            not_audited: Vec::new(),
         }
     }
 }
 
 /// FNV-1a of a string: a stable key for seeding (std's hasher may change between releases).
-fn fnv1a(text: &str) -> u64 {
+pub fn fnv1a(text: &str) -> u64 {
     text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
         (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
     })
@@ -321,8 +327,22 @@ pub fn run_plan(
             r
         })
         .collect();
+    let (k, alpha) = judge_statistical(&mut records);
+    (records, k, alpha)
+}
+
+/// Judges the statistical records (those with a p-value) at the Šidák level of their number
+/// k, in place: each gets that α, and a pass/fail verdict from p ≥ α (errors stay errors).
+/// Returns (k, α). Idempotent, so a merge of shard reports re-judges over the whole family.
+pub fn judge_statistical(records: &mut [CheckRecord]) -> (usize, f64) {
     let k = records.iter().filter(|r| r.is_statistical()).count();
     let alpha = sidak_alpha(STATISTICAL_ALPHA.value, k);
+    judge_at(records, alpha);
+    (k, alpha)
+}
+
+/// Judges the statistical records at the level `alpha` (see [`judge_statistical`]).
+pub fn judge_at(records: &mut [CheckRecord], alpha: f64) {
     for r in records.iter_mut() {
         if let Some(Measured::PValue {
             p, statistic, dof, ..
@@ -343,7 +363,6 @@ pub fn run_plan(
             }
         }
     }
-    (records, k, alpha)
 }
 
 /// The family of a record's model (its `family` key), or the check's family for non-NDF checks.
@@ -423,12 +442,14 @@ pub fn audit_scene(scene: &Scene, scene_path: Option<&str>, options: &AuditOptio
     let t = Instant::now();
     let planned = plan(scene, options.profile);
     let (records, k, alpha) = run_plan(&planned, options);
-    AuditReport::from_records(
+    let mut report = AuditReport::from_records(
         scene.name.clone(),
         options,
         reproduce_command(scene_path, options),
         records,
         (k, alpha),
         t.elapsed().as_secs_f64(),
-    )
+    );
+    report.not_audited = scene.not_audited.clone();
+    report
 }

@@ -5,23 +5,25 @@
 //! on their models, which implement the traits of [`model`].
 
 pub mod audit;
+pub mod baseline;
 pub mod check;
-/// Compatibility path for `check::sampling`'s artefact writing, which moves to the report
-/// sinks (issue 11); remove with that move.
-#[doc(hidden)]
-pub use cli::chi2 as chi2_command;
 pub mod chi2_run;
 pub mod cli;
 pub mod eval;
 pub mod eval_sg;
 pub mod gate;
+pub mod merge;
 pub mod messages;
+pub mod mitsuba;
 pub mod oracle;
 pub mod plan;
+pub mod plan_table;
 pub mod random;
+pub mod readback;
 pub mod record;
 pub mod report;
 pub mod scene;
+pub mod shard;
 pub mod subject;
 pub mod tolerance;
 

@@ -1,7 +1,8 @@
 //! CheckRecord: what one check of one property of one model at one case found, and the schema
 //! version of the records (DESIGN.md, "Checks and records").
 
-use serde::Serialize;
+use crate::readback::{interned, nullable_f64};
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 /// The version of the record schema written into `report.json`; bump it when a field changes
@@ -9,7 +10,7 @@ use serde_json::Value;
 pub const SCHEMA_VERSION: u32 = 1;
 
 /// The outcome of a check.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "verdict", rename_all = "snake_case")]
 pub enum Verdict {
     /// The property holds within the tolerance.
@@ -65,46 +66,56 @@ impl Verdict {
 }
 
 /// The oracle's value with its own uncertainty.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct OracleValue {
     /// The value.
+    #[serde(deserialize_with = "nullable_f64")]
     pub value: f64,
     /// The bound on the oracle's error (quadrature) or its standard error (Monte Carlo).
+    #[serde(deserialize_with = "nullable_f64")]
     pub uncertainty: f64,
     /// What the uncertainty is: `error_bound` or `standard_error`.
-    pub kind: &'static str,
+    #[serde(deserialize_with = "interned")]
+    pub kind: crate::readback::StaticStr,
 }
 
 /// The measured discrepancy.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Measured {
     /// |value − oracle|.
     Absolute {
         /// The error.
+        #[serde(deserialize_with = "nullable_f64")]
         error: f64,
     },
     /// |value − oracle| / |oracle|.
     Relative {
         /// The error.
+        #[serde(deserialize_with = "nullable_f64")]
         error: f64,
     },
     /// A statistical test.
     PValue {
         /// The p-value.
+        #[serde(deserialize_with = "nullable_f64")]
         p: f64,
         /// The test statistic.
+        #[serde(deserialize_with = "nullable_f64")]
         statistic: f64,
         /// Degrees of freedom (0 where the test has none, e.g. Kolmogorov–Smirnov).
         dof: usize,
         /// The level the verdict was taken at (after the Šidák correction).
+        #[serde(deserialize_with = "nullable_f64")]
         alpha: f64,
     },
     /// An estimated rate (e.g. the exponent of a convergence law).
     Rate {
         /// The measured exponent.
+        #[serde(deserialize_with = "nullable_f64")]
         exponent: f64,
         /// The expected exponent.
+        #[serde(deserialize_with = "nullable_f64")]
         expected: f64,
     },
 }
@@ -121,20 +132,24 @@ impl Measured {
 }
 
 /// The tolerance a check applied, with its reason (from [`crate::tolerance`]).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AppliedTolerance {
     /// The tolerance's name in the table.
-    pub name: &'static str,
+    #[serde(deserialize_with = "interned")]
+    pub name: crate::readback::StaticStr,
     /// The allowed error (relative or absolute as `measured` says; for p-values, α).
+    #[serde(deserialize_with = "nullable_f64")]
     pub value: f64,
     /// Why this tolerance.
-    pub reason: &'static str,
+    #[serde(deserialize_with = "interned")]
+    pub reason: crate::readback::StaticStr,
 }
 
 /// What a check cost.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Cost {
     /// Wall time, seconds.
+    #[serde(deserialize_with = "nullable_f64")]
     pub wall_seconds: f64,
     /// Function evaluations of the oracle.
     pub evaluations: u64,
@@ -143,7 +158,7 @@ pub struct Cost {
 }
 
 /// One check of one property of one model at one case.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CheckRecord {
     /// The check id, `family.property` (e.g. `smith.lambda_integral`).
     pub check: String,

@@ -111,6 +111,32 @@ pub struct Scene {
     /// The incidence range (θ_max = π/2 when absent).
     #[serde(default)]
     pub incidence: Incidence,
+    /// What the scene file holds that is not audited, and why (Mitsuba scenes: every plugin
+    /// that is not a microfacet BSDF). Never dropped silently: `mfh plan` and the report list it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub not_audited: Vec<NotAudited>,
+}
+
+/// A part of a scene file that is not audited, with the reason.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NotAudited {
+    /// The plugin (`diffuse`, `shape obj`, …).
+    pub plugin: String,
+    /// Its id in the file (or `type@line:column` when it has none; `outer/inner` when nested).
+    pub id: String,
+    /// Why it is not audited (`has no microfacet model`, …).
+    pub reason: String,
+}
+
+impl std::fmt::Display for NotAudited {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "not audited: {} ({}) {}",
+            self.plugin, self.id, self.reason
+        )
+    }
 }
 
 /// Why a scene was rejected.
@@ -141,6 +167,14 @@ pub enum SceneError {
     NoMaterials {
         /// The file.
         origin: String,
+    },
+    /// A scene file (Mitsuba) has no material mfh can audit.
+    #[error("{origin}: no BSDF with a microfacet model to audit ({not_audited})")]
+    NothingToAudit {
+        /// The file.
+        origin: String,
+        /// What it holds instead, `; `-separated.
+        not_audited: String,
     },
     /// Two materials share a name.
     #[error("{origin}: two materials are named `{name}`")]
@@ -224,7 +258,21 @@ impl Scene {
             column: e.column(),
             message: crate::messages::json_error_message(&e),
         })?;
+        scene.validate(origin)
+    }
+
+    /// Checks what serde cannot: at least one material, unique names, valid model parameters,
+    /// θ_max in (0, π/2].
+    pub fn validate(self, origin: &str) -> Result<Scene, SceneError> {
+        let scene = self;
         let origin = origin.to_string();
+        if scene.materials.is_empty() && !scene.not_audited.is_empty() {
+            let list: Vec<String> = scene.not_audited.iter().map(|n| n.to_string()).collect();
+            return Err(SceneError::NothingToAudit {
+                origin,
+                not_audited: list.join("; "),
+            });
+        }
         if scene.materials.is_empty() {
             return Err(SceneError::NoMaterials { origin });
         }
@@ -274,7 +322,8 @@ impl Scene {
     }
 
     /// Reads a scene file of at most [`MAX_SCENE_BYTES`] (read bounded: a larger file or an
-    /// endless stream is refused after the limit).
+    /// endless stream is refused after the limit): `.xml` is a Mitsuba 3 scene
+    /// ([`crate::mitsuba`]), anything else mfh's JSON.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         use std::io::Read;
         let unreadable = |e: std::io::Error| SceneError::Unreadable {
@@ -299,6 +348,12 @@ impl Scene {
                 e.utf8_error().valid_up_to()
             ),
         })?;
+        let is_xml = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
+        if is_xml {
+            return crate::mitsuba::parse(&text, &path.display().to_string());
+        }
         Scene::parse(&text, &path.display().to_string())
     }
 

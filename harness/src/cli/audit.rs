@@ -28,6 +28,61 @@ pub struct AuditArgs {
     /// No progress bar (it is shown only when standard error is a terminal anyway).
     #[arg(long, short)]
     pub quiet: bool,
+    /// Run only shard i of n (1 ≤ i ≤ n) of the plan, balanced by estimated cost; writes
+    /// shard.json beside report.json for `mfh merge`.
+    #[arg(long)]
+    pub shard: Option<crate::shard::ShardSpec>,
+    /// Comparison with a saved run.
+    #[command(flatten)]
+    pub baseline: BaselineArgs,
+}
+
+/// Comparison with a saved run (`mfh audit` and `mfh merge`).
+#[derive(Debug, Clone, Args)]
+pub struct BaselineArgs {
+    /// A saved report.json: report checks whose error grew or whose cost rose by more than the
+    /// factors of `baseline.rs` (error ×2, cost ×3).
+    #[arg(long)]
+    pub baseline: Option<PathBuf>,
+    /// Exit 1 when the baseline comparison finds a regression.
+    #[arg(long, requires = "baseline")]
+    pub fail_on_regression: bool,
+}
+
+/// The options of `mfh merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The shard output folders.
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// Output folder.
+    #[arg(long, default_value = "reports/merged")]
+    pub out: PathBuf,
+    /// Print report.json to standard output instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+    /// Comparison with a saved run.
+    #[command(flatten)]
+    pub baseline: BaselineArgs,
+}
+
+/// Runs `mfh merge`; returns the exit status (0 pass, 1 a check failed, 2 bad input).
+pub fn run_merge(args: MergeArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32 {
+    match crate::merge::merge_dirs(&args.dirs) {
+        Ok(report) => finish_report(
+            &report,
+            &args.out,
+            args.json,
+            &args.baseline,
+            "merge",
+            stdout,
+            stderr,
+        ),
+        Err(e) => {
+            let _ = writeln!(stderr, "mfh merge: {e}");
+            EXIT_BAD_INPUT
+        }
+    }
 }
 
 /// Runs `mfh audit`; returns the exit status (0 pass, 1 a check failed, 2 bad input).
@@ -71,30 +126,89 @@ pub fn run(args: AuditArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i
             b.update(p.done as u64, format!(", {} failed", p.failures));
         })));
     }
-    let report = crate::audit::audit_scene(&scene, scene_name.as_deref(), &options);
+    let report = match args.shard {
+        None => crate::audit::audit_scene(&scene, scene_name.as_deref(), &options),
+        Some(spec) => {
+            let (report, info) =
+                crate::shard::audit_shard(&scene, scene_name.as_deref(), &options, spec);
+            let path = out.join(crate::shard::SHARD_FILE);
+            let text = serde_json::to_string_pretty(&info).unwrap_or_default();
+            if let Err(e) = std::fs::write(&path, text + "\n") {
+                let _ = writeln!(stderr, "mfh audit: cannot write {}: {e}", path.display());
+                return EXIT_BAD_INPUT;
+            }
+            report
+        }
+    };
     bar.finish();
-    let written = match crate::report::write_all(&report, &out) {
+    finish_report(
+        &report,
+        &out,
+        args.json,
+        &args.baseline,
+        "audit",
+        stdout,
+        stderr,
+    )
+}
+
+/// Writes the report's sinks into `out`, prints the summary (or the JSON), the not-audited
+/// list and the baseline comparison; returns the exit status.
+fn finish_report(
+    report: &crate::audit::AuditReport,
+    out: &std::path::Path,
+    json: bool,
+    baseline: &BaselineArgs,
+    command: &str,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> i32 {
+    let old = match &baseline.baseline {
+        Some(path) => match crate::readback::read_report(path) {
+            Ok(r) => Some((path.display().to_string(), r)),
+            Err(e) => {
+                let _ = writeln!(stderr, "mfh {command}: --baseline: {e}");
+                return EXIT_BAD_INPUT;
+            }
+        },
+        None => None,
+    };
+    let written = match crate::report::write_all(report, out) {
         Ok(w) => w,
         Err(e) => {
             let _ = writeln!(
                 stderr,
-                "mfh audit: cannot write the report into {}: {e}",
+                "mfh {command}: cannot write the report into {}: {e}",
                 out.display()
             );
             return EXIT_BAD_INPUT;
         }
     };
-    if args.json {
-        let _ = writeln!(stdout, "{}", crate::report::json::to_string(&report));
+    if json {
+        let _ = writeln!(stdout, "{}", crate::report::json::to_string(report));
     } else {
-        let _ = write!(stdout, "{}", crate::report::terminal::render(&report, 20));
+        let _ = write!(stdout, "{}", crate::report::terminal::render(report, 20));
+        for n in &report.not_audited {
+            let _ = writeln!(stdout, "{n}");
+        }
         for p in written {
             let _ = writeln!(stdout, "wrote {}", p.display());
         }
     }
-    if report.passed() {
-        EXIT_PASS
-    } else {
+    let mut regressed = false;
+    if let Some((name, old)) = old {
+        let c = crate::baseline::compare(&old, report);
+        regressed = !c.regressions.is_empty();
+        let text = crate::baseline::render(&c, &name, 20);
+        let _ = if json {
+            write!(stderr, "{text}")
+        } else {
+            write!(stdout, "{text}")
+        };
+    }
+    if !report.passed() || (regressed && baseline.fail_on_regression) {
         EXIT_FAIL
+    } else {
+        EXIT_PASS
     }
 }

@@ -95,6 +95,11 @@ pub enum Command {
     /// Exit status 0 if every check passes (expected failures included), 1 if one fails, 2 on
     /// bad input.
     Audit(audit::AuditArgs),
+    /// Merge the output folders of `mfh audit --shard i/n` (every i of one n) into the
+    /// unsharded report: report.json and junit.xml in --out.
+    ///
+    /// Exit status 0 if every check passes, 1 if one fails, 2 on bad input.
+    Merge(audit::MergeArgs),
     /// Print the plan of a scene: one JSON line per check, with the reason it is planned.
     Plan(plan::PlanArgs),
     /// Chi-square test of a model's normal sampler (sample_wm) against its pdf (pdf_wm) over
@@ -131,6 +136,7 @@ where
     };
     match cli.command {
         Command::Audit(args) => audit::run(args, stdout, stderr),
+        Command::Merge(args) => audit::run_merge(args, stdout, stderr),
         Command::Plan(args) => plan::run(args, stdout, stderr),
         Command::Chi2(args) => chi2::run(args, stdout, stderr),
         Command::Eval(args) => eval::run(args, stdin, stdout, stderr),

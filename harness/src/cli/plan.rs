@@ -15,6 +15,18 @@ pub struct PlanArgs {
     /// The profile.
     #[arg(long, value_enum, default_value = "quick")]
     pub profile: ProfileArg,
+    /// JSON lines (for machines) or a table (for people).
+    #[arg(long, value_enum, default_value = "jsonl")]
+    pub format: PlanFormat,
+}
+
+/// The output format of `mfh plan`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PlanFormat {
+    /// One JSON object per line.
+    Jsonl,
+    /// A text table.
+    Table,
 }
 
 /// Runs `mfh plan`; returns the exit status (0, or 2 on bad input).
@@ -33,8 +45,20 @@ pub fn run(args: PlanArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
         let _ = writeln!(stderr, "mfh plan: {e}");
         return EXIT_BAD_INPUT;
     }
-    for line in crate::plan::describe(&plan) {
-        let _ = writeln!(stdout, "{line}");
+    match args.format {
+        PlanFormat::Table => {
+            let table = crate::plan_table::plan_table(&plan, &scene.not_audited);
+            let _ = write!(stdout, "{table}");
+        }
+        PlanFormat::Jsonl => {
+            for line in crate::plan::describe(&plan) {
+                let _ = writeln!(stdout, "{line}");
+            }
+            for n in &scene.not_audited {
+                let line = serde_json::json!({"not_audited": n, "why": n.to_string()});
+                let _ = writeln!(stdout, "{line}");
+            }
+        }
     }
     let _ = writeln!(
         stderr,

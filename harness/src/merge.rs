@@ -1,0 +1,209 @@
+//! `mfh merge DIR…`: combines the reports of `mfh audit --shard i/n` into the report of the
+//! unsharded audit — records back in plan order, statistical verdicts re-judged at the Šidák
+//! level of the whole family, counts and per-check totals recomputed from the records — so
+//! that the merged `report.json` equals the unsharded run's, timings aside (the merged wall
+//! time is the longest shard's: the shards ran in parallel).
+//!
+//! Refused, with the shard folder named: a missing or duplicated shard, shards of different
+//! plans (fingerprint), seeds, profiles, scenes or mfh versions, another schema version.
+
+use crate::audit::{judge_statistical, summarize, AuditReport};
+use crate::readback::{read_report, ReadError};
+use crate::record::{CheckRecord, SCHEMA_VERSION};
+use crate::shard::{ShardInfo, SHARD_FILE};
+use std::path::{Path, PathBuf};
+
+/// Why shard reports could not be merged.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MergeError {
+    /// A report could not be read.
+    #[error(transparent)]
+    Read(#[from] ReadError),
+    /// `shard.json` is missing or malformed.
+    #[error("{path}: {message}")]
+    ShardFile {
+        /// The path.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The shards do not make up one plan.
+    #[error("{0}")]
+    Inconsistent(String),
+}
+
+/// One shard's output folder, read back.
+#[derive(Debug, Clone)]
+pub struct ShardReport {
+    /// The folder.
+    pub dir: PathBuf,
+    /// Its `report.json`.
+    pub report: AuditReport,
+    /// Its `shard.json`.
+    pub info: ShardInfo,
+}
+
+/// Reads `dir/report.json` and `dir/shard.json`.
+pub fn read_shard(dir: &Path) -> Result<ShardReport, MergeError> {
+    let report = read_report(&dir.join("report.json"))?;
+    let path = dir.join(SHARD_FILE);
+    let shard_error = |message: String| MergeError::ShardFile {
+        path: path.display().to_string(),
+        message,
+    };
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        shard_error(format!(
+            "cannot read it ({e}): is {} the output of `mfh audit --shard i/n`?",
+            dir.display()
+        ))
+    })?;
+    let info: ShardInfo = serde_json::from_str(&text).map_err(|e| shard_error(e.to_string()))?;
+    if info.schema_version != SCHEMA_VERSION {
+        return Err(shard_error(format!(
+            "schema_version {}, but this mfh reads schema_version {SCHEMA_VERSION} only",
+            info.schema_version
+        )));
+    }
+    if info.indices.len() != report.records.len() {
+        return Err(shard_error(format!(
+            "lists {} plan indices but report.json has {} records",
+            info.indices.len(),
+            report.records.len()
+        )));
+    }
+    Ok(ShardReport {
+        dir: dir.to_path_buf(),
+        report,
+        info,
+    })
+}
+
+/// Merges shard reports (any order) into the unsharded report.
+pub fn merge(shards: Vec<ShardReport>) -> Result<AuditReport, MergeError> {
+    let bad = |m: String| Err(MergeError::Inconsistent(m));
+    let Some(first) = shards.first() else {
+        return bad("no shard folders given".to_string());
+    };
+    let n = first.info.count;
+    let plan_checks = first.info.plan_checks;
+    for s in &shards {
+        let (a, b) = (&first, s);
+        let differs = [
+            (
+                "shard count",
+                a.info.count.to_string(),
+                b.info.count.to_string(),
+            ),
+            (
+                "plan fingerprint",
+                a.info.plan_fingerprint.clone(),
+                b.info.plan_fingerprint.clone(),
+            ),
+            (
+                "plan size",
+                a.info.plan_checks.to_string(),
+                b.info.plan_checks.to_string(),
+            ),
+            ("seed", a.report.seed.to_string(), b.report.seed.to_string()),
+            (
+                "profile",
+                a.report.profile.name().to_string(),
+                b.report.profile.name().to_string(),
+            ),
+            ("scene", a.report.scene.clone(), b.report.scene.clone()),
+            (
+                "mfh version",
+                a.report.mfh_version.to_string(),
+                b.report.mfh_version.to_string(),
+            ),
+            (
+                "not-audited list",
+                format!("{:?}", a.report.not_audited),
+                format!("{:?}", b.report.not_audited),
+            ),
+        ]
+        .into_iter()
+        .find(|(_, x, y)| x != y);
+        if let Some((what, x, y)) = differs {
+            return bad(format!(
+                "{} and {} are not shards of one audit: {what} {x} ≠ {y}",
+                a.dir.display(),
+                b.dir.display()
+            ));
+        }
+    }
+    let mut seen = vec![None::<&Path>; n];
+    for s in &shards {
+        match seen.get_mut(s.info.index.wrapping_sub(1)) {
+            Some(Some(other)) => {
+                return bad(format!(
+                    "shard {}/{n} given twice: {} and {}",
+                    s.info.index,
+                    other.display(),
+                    s.dir.display()
+                ))
+            }
+            Some(slot) => *slot = Some(&s.dir),
+            None => {
+                return bad(format!(
+                    "{}: shard index {} of {n}",
+                    s.dir.display(),
+                    s.info.index
+                ))
+            }
+        }
+    }
+    let missing: Vec<String> = (1..=n)
+        .filter(|i| seen[i - 1].is_none())
+        .map(|i| format!("{i}/{n}"))
+        .collect();
+    if !missing.is_empty() {
+        return bad(format!("missing shard(s) {}", missing.join(", ")));
+    }
+    let mut slots: Vec<Option<CheckRecord>> = vec![None; plan_checks];
+    let mut wall: f64 = 0.0;
+    for s in &shards {
+        wall = wall.max(s.report.summary.wall_seconds);
+        for (&i, r) in s.info.indices.iter().zip(&s.report.records) {
+            match slots.get_mut(i) {
+                Some(slot @ None) => *slot = Some(r.clone()),
+                _ => {
+                    return bad(format!(
+                        "{}: plan index {i} is out of range or run by two shards",
+                        s.dir.display()
+                    ))
+                }
+            }
+        }
+    }
+    let mut records: Vec<CheckRecord> = Vec::with_capacity(plan_checks);
+    for (i, slot) in slots.into_iter().enumerate() {
+        match slot {
+            Some(r) => records.push(r),
+            None => return bad(format!("no shard ran plan index {i}")),
+        }
+    }
+    let statistical = judge_statistical(&mut records);
+    let summary = summarize(&records, statistical, wall);
+    let first = &shards[0];
+    Ok(AuditReport {
+        schema_version: SCHEMA_VERSION,
+        mfh_version: first.report.mfh_version,
+        scene: first.report.scene.clone(),
+        profile: first.report.profile,
+        seed: first.report.seed,
+        command: first.info.unsharded_command.clone(),
+        summary,
+        records,
+        not_audited: first.report.not_audited.clone(),
+    })
+}
+
+/// Reads and merges shard folders.
+pub fn merge_dirs(dirs: &[PathBuf]) -> Result<AuditReport, MergeError> {
+    let shards = dirs
+        .iter()
+        .map(|d| read_shard(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    merge(shards)
+}

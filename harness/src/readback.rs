@@ -1,0 +1,162 @@
+//! Reading `report.json` back (for `mfh merge` and `--baseline`): the schema-version gate and
+//! the two serde helpers the record types need to deserialize what they serialize.
+//!
+//! - Non-finite numbers: serde_json writes NaN and ±∞ as `null`; [`nullable_f64`] reads `null`
+//!   back as NaN, which serializes to `null` again, so a report read back and written again is
+//!   byte-identical (the sign of an infinite error is lost; both are "not finite").
+//! - `&'static str` fields (tolerance names and reasons, the oracle's uncertainty kind, the
+//!   mfh version) are built from constants by the checks; [`interned`] maps a read string to a
+//!   `&'static str` through a process-wide interner, so each distinct string is allocated once
+//!   (bounded by the distinct strings of the reports read, a few hundred), instead of changing
+//!   the field types every check constructs.
+
+use crate::audit::AuditReport;
+use crate::record::SCHEMA_VERSION;
+use serde::{Deserialize, Deserializer};
+use std::collections::BTreeSet;
+use std::path::Path;
+use std::sync::{Mutex, OnceLock};
+
+/// `&'static str` under another name: serde's derive borrows every field spelled `&str` from
+/// the input (and so would demand `'de: 'static`) even when `deserialize_with` is set; the
+/// alias is the same type, so the checks that build records are unaffected.
+pub type StaticStr = &'static str;
+
+/// Why a report could not be read back.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ReadError {
+    /// The file could not be read.
+    #[error("cannot read {path}: {message}")]
+    Unreadable {
+        /// The path.
+        path: String,
+        /// The I/O error.
+        message: String,
+    },
+    /// The JSON is malformed or does not have the shape of a report.
+    #[error("{path}: not an mfh report: {message}")]
+    Malformed {
+        /// The path.
+        path: String,
+        /// serde's message (with line and column where it has them).
+        message: String,
+    },
+    /// The report was written with another record schema.
+    #[error("{path}: schema_version {found}, but this mfh reads schema_version {expected} only (re-run the audit with this mfh)")]
+    SchemaVersion {
+        /// The path.
+        path: String,
+        /// The version in the file (`None`: the field is missing or not an integer).
+        found: String,
+        /// The version this mfh writes and reads.
+        expected: u32,
+    },
+}
+
+/// Reads `path` (a `report.json`, or a folder holding one) as an [`AuditReport`], refusing any
+/// schema version other than [`SCHEMA_VERSION`].
+pub fn read_report(path: &Path) -> Result<AuditReport, ReadError> {
+    let file = if path.is_dir() {
+        path.join("report.json")
+    } else {
+        path.to_path_buf()
+    };
+    let name = file.display().to_string();
+    let text = std::fs::read_to_string(&file).map_err(|e| ReadError::Unreadable {
+        path: name.clone(),
+        message: e.to_string(),
+    })?;
+    parse_report(&text, &name)
+}
+
+/// Parses report text; `origin` names it in errors.
+pub fn parse_report(text: &str, origin: &str) -> Result<AuditReport, ReadError> {
+    let value: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| ReadError::Malformed {
+            path: origin.to_string(),
+            message: e.to_string(),
+        })?;
+    match value
+        .get("schema_version")
+        .and_then(serde_json::Value::as_u64)
+    {
+        Some(v) if v == u64::from(SCHEMA_VERSION) => {}
+        other => {
+            return Err(ReadError::SchemaVersion {
+                path: origin.to_string(),
+                found: other.map_or_else(|| "missing".to_string(), |v| v.to_string()),
+                expected: SCHEMA_VERSION,
+            })
+        }
+    }
+    serde_json::from_value(value).map_err(|e| ReadError::Malformed {
+        path: origin.to_string(),
+        message: e.to_string(),
+    })
+}
+
+/// Deserializes an `f64` written by serde_json, where `null` stands for a non-finite value
+/// (read back as NaN).
+pub fn nullable_f64<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// Deserializes a string into a `&'static str` through [`intern`].
+pub fn interned<'de, D: Deserializer<'de>>(d: D) -> Result<&'static str, D::Error> {
+    Ok(intern(&String::deserialize(d)?))
+}
+
+/// The `&'static str` equal to `text`: allocated (and kept for the life of the process) the
+/// first time `text` is seen, shared afterwards.
+pub fn intern(text: &str) -> &'static str {
+    static TABLE: OnceLock<Mutex<BTreeSet<&'static str>>> = OnceLock::new();
+    let mut table = TABLE
+        .get_or_init(|| Mutex::new(BTreeSet::new()))
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    if let Some(s) = table.get(text) {
+        return s;
+    }
+    let s: &'static str = Box::leak(text.to_owned().into_boxed_str());
+    table.insert(s);
+    s
+}
+
+/// Deserializes a profile from its command-line name.
+pub fn profile<'de, D: Deserializer<'de>>(d: D) -> Result<crate::check::Profile, D::Error> {
+    let name = String::deserialize(d)?;
+    <crate::check::Profile as clap::ValueEnum>::from_str(&name, false).map_err(|_| {
+        serde::de::Error::custom(format!(
+            "profile `{name}` is not one of quick, standard, thorough"
+        ))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interning_returns_one_allocation_per_string() {
+        let a = intern(&String::from("closed_form"));
+        let b = intern("closed_form");
+        assert!(std::ptr::eq(a, b));
+        assert_eq!(a, "closed_form");
+    }
+
+    #[test]
+    fn other_schema_versions_are_refused_by_name() {
+        let e = parse_report(r#"{"schema_version": 2}"#, "old/report.json").unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("old/report.json")
+                && text.contains("schema_version 2")
+                && text.contains("reads schema_version 1"),
+            "{text}"
+        );
+        let e = parse_report(r#"{"records": []}"#, "r.json").unwrap_err();
+        assert!(e.to_string().contains("schema_version missing"), "{e}");
+        let e = parse_report("{", "r.json").unwrap_err();
+        assert!(matches!(e, ReadError::Malformed { .. }), "{e:?}");
+    }
+}

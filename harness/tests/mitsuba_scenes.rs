@@ -1,0 +1,301 @@
+//! The Mitsuba 3 example scenes under `examples/scenes/` plan what they should: which
+//! materials (NDF, masking, sampling), which checks for each, which plugins are not audited
+//! and why; malformed XML is an error at file:line:column (issue 13).
+
+use mfh_harness::check::Profile;
+use mfh_harness::cli::run;
+use mfh_harness::plan::plan;
+use mfh_harness::scene::{Sampling, Scene};
+use mfh_reference::{Masking, ModelSpec};
+use std::collections::BTreeSet;
+use std::path::PathBuf;
+
+fn example(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples/scenes")
+        .join(name)
+}
+
+fn load(name: &str) -> Scene {
+    Scene::load(&example(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// The check ids planned for one material.
+fn checks_of(scene: &Scene, material: &str) -> BTreeSet<String> {
+    let tag = format!("material `{material}` (");
+    plan(scene, Profile::Quick)
+        .iter()
+        .filter(|p| p.why.contains(&tag))
+        .map(|p| p.check.clone())
+        .collect()
+}
+
+fn not_audited(scene: &Scene) -> Vec<String> {
+    scene.not_audited.iter().map(|n| n.to_string()).collect()
+}
+
+const MASKING_CHECKS: &[&str] = &[
+    "smith.identities",
+    "smith.lambda_route",
+    "smith.white_furnace",
+];
+const NORMAL_SAMPLING: &[&str] = &[
+    "sampling.chi2",
+    "sampling.ks_marginals",
+    "sampling.lambda_monte_carlo",
+    "sampling.pdf_consistency",
+];
+const VISIBLE_SAMPLING: &[&str] = &[
+    "sampling.chi2_visible",
+    "sampling.pdf_visible_normalization",
+];
+const EVERY_MATERIAL: &[&str] = &["normalization.projected_area", "stability.extremes"];
+/// Certified double-double values of D and Λ: isotropic models only.
+const ISOTROPIC: &[&str] = &["precise.closed_form"];
+
+fn set(groups: &[&[&str]]) -> BTreeSet<String> {
+    groups
+        .iter()
+        .flat_map(|g| g.iter().map(|s| s.to_string()))
+        .collect()
+}
+
+#[test]
+fn conductor_plans_ggx_with_separable_masking_and_visible_normals() {
+    let s = load("conductor.xml");
+    assert_eq!(s.materials.len(), 1);
+    let m = &s.materials[0];
+    assert_eq!(m.name, "gold");
+    assert_eq!(
+        m.model,
+        ModelSpec::Ggx {
+            alpha: Some(0.2),
+            alpha_x: None,
+            alpha_y: None
+        }
+    );
+    assert_eq!(m.masking, Some(Masking::Uncorrelated));
+    assert_eq!(m.sampling, Some(Sampling::VisibleNormals));
+    assert_eq!(
+        checks_of(&s, "gold"),
+        set(&[
+            EVERY_MATERIAL,
+            ISOTROPIC,
+            MASKING_CHECKS,
+            NORMAL_SAMPLING,
+            VISIBLE_SAMPLING
+        ])
+    );
+    // Errata and claims of the document GGX comes from (seed 001), and nothing else.
+    let planned = plan(&s, Profile::Quick);
+    let others: BTreeSet<&str> = planned
+        .iter()
+        .filter(|p| !p.why.contains("material `gold`"))
+        .map(|p| p.check.split('.').next().unwrap())
+        .collect();
+    assert_eq!(others, BTreeSet::from(["claims", "errata"]));
+    assert!(planned
+        .iter()
+        .filter(|p| p.check.starts_with("errata."))
+        .all(|p| p.why.contains("001")));
+    assert_eq!(
+        not_audited(&s),
+        [
+            "not audited: shape sphere (ball) is not a BSDF",
+            "not audited: emitter constant (sky) is not a BSDF",
+        ]
+    );
+}
+
+#[test]
+fn mixed_scene_walks_wrappers_params_and_refs_and_lists_the_rest() {
+    let s = load("mixed.xml");
+    let names: Vec<&str> = s.materials.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["steel", "floor/floor_coat", "leaf/leaf_glass"]);
+    // $dist = ggx, α_u = 0.05, α_v = $floor_alpha = 0.3; referenced twice, planned once.
+    assert_eq!(
+        s.materials[0].model,
+        ModelSpec::Ggx {
+            alpha: None,
+            alpha_x: Some(0.05),
+            alpha_y: Some(0.3)
+        }
+    );
+    // roughplastic's default distribution is Beckmann.
+    assert_eq!(
+        s.materials[1].model,
+        ModelSpec::Beckmann {
+            alpha: Some(0.3),
+            alpha_x: None,
+            alpha_y: None
+        }
+    );
+    assert_eq!(s.materials[2].sampling, Some(Sampling::Normals));
+    assert!(s
+        .materials
+        .iter()
+        .all(|m| m.masking == Some(Masking::Uncorrelated)));
+    assert_eq!(
+        checks_of(&s, "leaf/leaf_glass"),
+        set(&[EVERY_MATERIAL, ISOTROPIC, MASKING_CHECKS, NORMAL_SAMPLING])
+    );
+    assert_eq!(
+        checks_of(&s, "steel"),
+        set(&[
+            EVERY_MATERIAL,
+            MASKING_CHECKS,
+            NORMAL_SAMPLING,
+            VISIBLE_SAMPLING
+        ])
+    );
+    let na = not_audited(&s);
+    for expected in [
+        "not audited: integrator path (path@9:5) is not a BSDF",
+        "not audited: sensor perspective (camera) is not a BSDF",
+        "not audited: sampler independent (independent@15:9) is not a BSDF",
+        "not audited: film hdrfilm (hdrfilm@18:9) is not a BSDF",
+        "not audited: diffuse (worn/dust) has no microfacet model",
+        "not audited: dielectric (glass) has no microfacet model",
+        "not audited: diffuse (wall) has no microfacet model",
+        "not audited: shape obj (pot) is not a BSDF",
+        "not audited: emitter area (area@72:9) is not a BSDF",
+    ] {
+        assert!(
+            na.iter().any(|n| n == expected),
+            "{expected} not in {na:#?}"
+        );
+    }
+    let scratched = na.iter().find(|n| n.contains("(scratched)")).unwrap();
+    assert!(
+        scratched.contains("`alpha` is a texture (bitmap)"),
+        "{scratched}"
+    );
+    assert_eq!(na.len(), 12, "{na:#?}");
+}
+
+#[test]
+fn anisotropic_principled_plans_its_ggx_lobe_and_gtr1_clear_coat() {
+    let s = load("principled.xml");
+    let aspect = (1.0f64 - 0.9 * 0.75).sqrt();
+    match &s.materials[0].model {
+        ModelSpec::Ggx {
+            alpha: None,
+            alpha_x: Some(x),
+            alpha_y: Some(y),
+        } => {
+            assert!((x - 0.25 / aspect).abs() < 1e-15 && (y - 0.25 * aspect).abs() < 1e-15)
+        }
+        other => panic!("{other:?}"),
+    }
+    let cc = &s.materials[1];
+    assert_eq!(cc.name, "car_paint/clearcoat");
+    match cc.model {
+        ModelSpec::Gtr { gamma, alpha } => {
+            assert_eq!(gamma, 1.0);
+            assert!((alpha - 0.0604).abs() < 1e-15, "{alpha}");
+        }
+        ref other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        checks_of(&s, "car_paint"),
+        set(&[
+            EVERY_MATERIAL,
+            MASKING_CHECKS,
+            NORMAL_SAMPLING,
+            VISIBLE_SAMPLING
+        ])
+    );
+    // The clear coat samples normals and its masking (a GGX G1 at α = 0.25) is not audited.
+    assert_eq!(
+        checks_of(&s, "car_paint/clearcoat"),
+        set(&[EVERY_MATERIAL, NORMAL_SAMPLING])
+    );
+    let na = not_audited(&s);
+    assert!(na[0].starts_with("not audited: principled clearcoat masking (car_paint/clearcoat)"));
+    assert_eq!(na[1], "not audited: shape ply (body) is not a BSDF");
+    // GTR1 comes from seed 004: its errata and claims are planned too.
+    assert!(plan(&s, Profile::Quick)
+        .iter()
+        .any(|p| p.check.starts_with("claims.gtr")));
+}
+
+#[test]
+fn malformed_xml_names_file_line_and_column() {
+    let dir = std::env::temp_dir().join(format!("mfh-mitsuba-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("broken.xml");
+    std::fs::write(
+        &path,
+        "<scene version=\"3.0.0\">\n  <bsdf type=\"roughconductor\">\n    <float name=\"alpha\" value=\"0.1\">\n  </bsdf>\n</scene>\n",
+    )
+    .unwrap();
+    let e = Scene::load(&path).unwrap_err().to_string();
+    // The closing </bsdf> at line 4, column 3 does not match the open <float>.
+    let prefix = format!("{}:4:3:", path.display());
+    assert!(e.starts_with(&prefix), "{e}");
+    // The same through the CLI: exit 2, the position on standard error.
+    let (mut out, mut err) = (Vec::new(), Vec::new());
+    let code = run(
+        ["mfh", "plan", "--scene", path.to_str().unwrap()],
+        &mut std::io::empty(),
+        &mut out,
+        &mut err,
+    );
+    assert_eq!(code, 2);
+    assert!(String::from_utf8(err).unwrap().contains(&prefix));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn plan_lists_not_audited_plugins_as_json_lines_and_in_the_table() {
+    let scene = example("conductor.xml");
+    let scene = scene.to_str().unwrap();
+    let mut out = Vec::new();
+    let code = run(
+        ["mfh", "plan", "--scene", scene],
+        &mut std::io::empty(),
+        &mut out,
+        &mut Vec::new(),
+    );
+    assert_eq!(code, 0);
+    let text = String::from_utf8(out).unwrap();
+    let lines: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let na: Vec<&serde_json::Value> = lines
+        .iter()
+        .filter(|l| l["not_audited"].is_object())
+        .collect();
+    assert_eq!(na.len(), 2);
+    assert_eq!(na[0]["not_audited"]["id"], "ball");
+    assert_eq!(
+        na[0]["why"],
+        "not audited: shape sphere (ball) is not a BSDF"
+    );
+    let mut out = Vec::new();
+    let code = run(
+        ["mfh", "plan", "--scene", scene, "--format", "table"],
+        &mut std::io::empty(),
+        &mut out,
+        &mut Vec::new(),
+    );
+    assert_eq!(code, 0);
+    let table = String::from_utf8(out).unwrap();
+    assert!(
+        table.contains("sampling.chi2_visible") && table.contains("2 not audited:"),
+        "{table}"
+    );
+    assert_eq!(
+        table
+            .lines()
+            .filter(|l| l.contains("material `gold` (ggx)"))
+            .count(),
+        lines.len()
+            - 2
+            - plan(&load("conductor.xml"), Profile::Quick)
+                .iter()
+                .filter(|p| !p.why.contains("gold"))
+                .count()
+    );
+}

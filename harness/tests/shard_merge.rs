@@ -1,0 +1,248 @@
+//! Sharded-then-merged equals unsharded (issue 13, "Beyond one machine"): the audit of a small
+//! scene run whole, and run as n = 1, 3, 7 shards by `examples/ci/shard.sh` and merged by
+//! `examples/ci/merge.sh` — the scripts the GitHub Actions and Slurm examples call — gives the
+//! same report.json, timings and artefact folders aside. Also: merge refuses a missing shard,
+//! shards of another seed and another schema version; `--baseline` finds a grown error.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mfh-shard-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs `bash script args…` from the repository root with `MFH` set to the built binary.
+fn script(name: &str, args: &[&str]) -> (i32, String) {
+    let out = Command::new("bash")
+        .arg(root().join("examples/ci").join(name))
+        .args(args)
+        .current_dir(root())
+        .env("MFH", env!("CARGO_BIN_EXE_mfh"))
+        .output()
+        .expect("bash runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.code().unwrap_or(-1), text)
+}
+
+fn mfh(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_mfh"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("mfh runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.code().unwrap_or(-1), text)
+}
+
+fn read(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The report without what may differ between runs: wall times, and the output folder in
+/// artefact paths.
+fn normalized(mut v: Value) -> Value {
+    v["summary"]["wall_seconds"] = Value::Null;
+    if let Some(by) = v["summary"]["by_check"].as_object_mut() {
+        for c in by.values_mut() {
+            c["seconds"] = Value::Null;
+        }
+    }
+    for r in v["records"].as_array_mut().unwrap() {
+        r["cost"]["wall_seconds"] = Value::Null;
+        if let Some(a) = r["artefacts"].as_array_mut() {
+            for p in a.iter_mut() {
+                let s = p.as_str().unwrap_or("");
+                *p = Value::from(s.find("chi2/").map_or(s, |i| &s[i..]));
+            }
+        }
+    }
+    v
+}
+
+const SCENE: &str = "examples/scenes/conductor.xml";
+
+#[test]
+fn sharded_then_merged_equals_unsharded_for_1_3_7_shards() {
+    let dir = temp("equal");
+    let whole = dir.join("whole");
+    let (code, text) = mfh(&[
+        "audit",
+        "--scene",
+        SCENE,
+        "--seed",
+        "5",
+        "--out",
+        whole.to_str().unwrap(),
+    ]);
+    assert!(code == 0 || code == 1, "{text}");
+    let expected = read(&whole.join("report.json"));
+    let statistical = expected["summary"]["statistical"][0].as_u64().unwrap();
+    assert!(statistical > 0, "the scene has statistical checks");
+    for n in [1usize, 3, 7] {
+        let out = dir.join(format!("n{n}"));
+        let out_s = out.to_str().unwrap();
+        let mut records = 0;
+        for i in 1..=n {
+            let (c, text) = script(
+                "shard.sh",
+                &[
+                    &i.to_string(),
+                    &n.to_string(),
+                    out_s,
+                    "--scene",
+                    SCENE,
+                    "--seed",
+                    "5",
+                ],
+            );
+            assert!(c == 0 || c == 1, "shard {i}/{n}: {text}");
+            let shard = read(&out.join(format!("shard-{i}/report.json")));
+            records += shard["records"].as_array().unwrap().len();
+            assert!(
+                shard["command"]
+                    .as_str()
+                    .unwrap()
+                    .ends_with(&format!("--shard {i}/{n}")),
+                "{shard}"
+            );
+        }
+        assert_eq!(
+            records,
+            expected["records"].as_array().unwrap().len(),
+            "n = {n}"
+        );
+        let (c, text) = script("merge.sh", &[&n.to_string(), out_s]);
+        assert_eq!(c, code, "n = {n}: {text}");
+        let merged = read(&out.join("merged/report.json"));
+        assert_eq!(
+            merged["summary"]["statistical"], expected["summary"]["statistical"],
+            "n = {n}: Šidák level over the whole family"
+        );
+        let (m, e) = (normalized(merged), normalized(expected.clone()));
+        if m != e {
+            for (a, b) in m["records"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .zip(e["records"].as_array().unwrap())
+            {
+                assert_eq!(a, b, "n = {n}: first differing record");
+            }
+            panic!("n = {n}: merged ≠ unsharded:\n{m}\n{e}");
+        }
+        assert!(out.join("merged/junit.xml").exists());
+    }
+
+    // A missing shard, a shard of another seed: exit 2 naming the problem.
+    let n3 = dir.join("n3");
+    let (c, text) = mfh(&[
+        "merge",
+        n3.join("shard-1").to_str().unwrap(),
+        n3.join("shard-3").to_str().unwrap(),
+        "--out",
+        dir.join("bad").to_str().unwrap(),
+    ]);
+    assert_eq!(c, 2);
+    assert!(text.contains("missing shard(s) 2/3"), "{text}");
+    let other = dir.join("other");
+    let (c, _) = script(
+        "shard.sh",
+        &[
+            "2",
+            "3",
+            other.to_str().unwrap(),
+            "--scene",
+            SCENE,
+            "--seed",
+            "6",
+        ],
+    );
+    assert!(c == 0 || c == 1);
+    let (c, text) = mfh(&[
+        "merge",
+        n3.join("shard-1").to_str().unwrap(),
+        other.join("shard-2").to_str().unwrap(),
+        n3.join("shard-3").to_str().unwrap(),
+        "--out",
+        dir.join("bad").to_str().unwrap(),
+    ]);
+    assert_eq!(c, 2);
+    assert!(
+        text.contains("not shards of one audit: seed 5 ≠ 6"),
+        "{text}"
+    );
+    // Another schema version is refused by name.
+    let old = dir.join("old");
+    std::fs::create_dir_all(&old).unwrap();
+    let mut v = read(&n3.join("shard-2/report.json"));
+    v["schema_version"] = Value::from(99);
+    std::fs::write(old.join("report.json"), v.to_string()).unwrap();
+    std::fs::copy(n3.join("shard-2/shard.json"), old.join("shard.json")).unwrap();
+    let (c, text) = mfh(&[
+        "merge",
+        n3.join("shard-1").to_str().unwrap(),
+        old.to_str().unwrap(),
+        n3.join("shard-3").to_str().unwrap(),
+    ]);
+    assert_eq!(c, 2);
+    assert!(text.contains("schema_version 99"), "{text}");
+
+    // --baseline: a baseline whose first error-measuring record had a tenth of today's error
+    // (and slow checks everywhere, so cost cannot regress) makes that record regress.
+    let mut base = expected.clone();
+    let records = base["records"].as_array_mut().unwrap();
+    let mut target = None;
+    for r in records.iter_mut() {
+        r["cost"]["wall_seconds"] = Value::from(1e9);
+        r["cost"]["samples"] = Value::from(u64::MAX / 4);
+        r["cost"]["evaluations"] = Value::from(u64::MAX / 4);
+        let e = r["measured"]["error"].as_f64().unwrap_or(0.0);
+        if target.is_none() && e > 1e-12 && e.is_finite() {
+            r["measured"]["error"] = Value::from(e / 10.0);
+            target = Some(r["check"].as_str().unwrap().to_string());
+        }
+    }
+    let target = target.expect("a record with an error above 1e-12");
+    let base_path = dir.join("baseline.json");
+    std::fs::write(&base_path, base.to_string()).unwrap();
+    let merged = n3.join("merged");
+    let baseline_args = [
+        "merge",
+        n3.join("shard-1").to_str().unwrap(),
+        n3.join("shard-2").to_str().unwrap(),
+        n3.join("shard-3").to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+        "--baseline",
+        base_path.to_str().unwrap(),
+    ]
+    .map(String::from);
+    let args: Vec<&str> = baseline_args.iter().map(String::as_str).collect();
+    let (c, text) = mfh(&args);
+    assert_eq!(c, code, "{text}");
+    assert!(
+        text.contains("1 regression(s)") && text.contains(&target),
+        "{text}"
+    );
+    let mut strict = args.clone();
+    strict.push("--fail-on-regression");
+    let (c, text) = mfh(&strict);
+    assert_eq!(c, 1, "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
