@@ -125,9 +125,9 @@ pub fn intern(text: &str) -> &'static str {
 /// Deserializes a profile from its command-line name.
 pub fn profile<'de, D: Deserializer<'de>>(d: D) -> Result<crate::check::Profile, D::Error> {
     let name = String::deserialize(d)?;
-    <crate::check::Profile as clap::ValueEnum>::from_str(&name, false).map_err(|_| {
+    crate::check::Profile::from_name(&name).ok_or_else(|| {
         serde::de::Error::custom(format!(
-            "profile `{name}` is not one of quick, standard, thorough"
+            "profile `{name}` is not one of ci, quick, standard, thorough"
         ))
     })
 }

@@ -196,7 +196,7 @@ pub struct CheckRecord {
 
 /// The data a check measured beyond one number: what the sinks (`crate::report`) write as
 /// artefact files and draw as plots.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum RecordData {
     /// The observed and expected counts of a chi-square test over the (φ, cos θ) grid of the

@@ -16,7 +16,7 @@
 use crate::audit::{
     fnv1a, judge_at, reproduce_command, run_plan, summarize, AuditOptions, AuditReport,
 };
-use crate::check::{Planned, Profile, SLOW_SAMPLERS};
+use crate::check::{Planned, PlannedCheck, Profile};
 use crate::oracle::chi2::sidak_alpha;
 use crate::plan::plan;
 use crate::record::SCHEMA_VERSION;
@@ -91,16 +91,17 @@ pub struct ShardInfo {
 /// - sampling checks draw the profile's samples at ~0.1 µs each (`sampling.chi2*`: chi-square
 ///   samples plus ~0.2 s of expected-count cubature; `sampling.ks_marginals`, the Monte Carlo
 ///   Λ and the pseudo-VNIS bias: the profile's KS samples); slow samplers
-///   ([`SLOW_SAMPLERS`], ~30 µs a sample) cost 300× a sample;
+///   (the registry's `slow_sampler` families, ~30 µs a sample) cost 300× a sample;
 /// - quadrature-heavy checks (`precise.*`, `smith.*`, `ds.*`, errata demonstrations, claims)
 ///   0.05 s; everything else 0.01 s.
-pub fn estimated_cost(planned: &Planned, profile: Profile) -> f64 {
+pub fn estimated_cost(planned: &PlannedCheck<'_>, profile: Profile) -> f64 {
     let family = planned
         .model
         .get("family")
         .and_then(|f| f.as_str())
         .unwrap_or("");
-    let per_sample = if SLOW_SAMPLERS.contains(&family) {
+    let slow = mfh_reference::registry::by_name(family).is_some_and(|f| f.slow_sampler);
+    let per_sample = if slow {
         3e-5
     } else {
         1e-7
@@ -112,7 +113,7 @@ pub fn estimated_cost(planned: &Planned, profile: Profile) -> f64 {
         || id == "sampling.lambda_monte_carlo"
         || id == "sampling.pseudo_vnis"
     {
-        profile.ks_samples(family) as f64 * per_sample
+        profile.ks_samples(slow) as f64 * per_sample
     } else if ["precise.", "smith.", "ds.", "errata.", "claims."]
         .iter()
         .any(|p| id.starts_with(p))

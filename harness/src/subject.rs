@@ -3,11 +3,10 @@
 //! its registry entry and spec for a reference model, the user's hints, and what the oracles
 //! measure from D itself. Checks never ask a subject for a family name to decide what to do.
 
-use mfh_reference::geometry::from_spherical;
+use crate::oracle::lobe::{self, Lobe, Options};
 use mfh_reference::registry::{self, FamilyInfo};
 use mfh_reference::{Model, ModelSpec, Ndf, ParamError};
 use serde_json::{json, Value};
-use std::f64::consts::{FRAC_PI_2, PI};
 use std::sync::{Arc, OnceLock};
 
 /// What a user may state about a model to speed the oracles up. Never needed for
@@ -33,15 +32,6 @@ pub struct Subject<'a> {
     /// What the user stated.
     pub hints: Hints,
     measured: OnceLock<Lobe>,
-}
-
-/// What the oracles know of a lobe.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Lobe {
-    /// The narrowest angular width over the azimuths (radians).
-    pub width: f64,
-    /// Whether D depends on the azimuth.
-    pub anisotropic: bool,
 }
 
 impl std::fmt::Debug for Subject<'_> {
@@ -118,23 +108,24 @@ impl<'a> Subject<'a> {
         self.reference.as_ref().map(|(s, _)| s)
     }
 
-    /// The lobe: stated by hints where given, otherwise measured from D (once).
-    pub fn lobe(&self) -> Lobe {
-        let measured = || {
-            *self
-                .measured
-                .get_or_init(|| measure_lobe(self.model.as_ref()))
-        };
-        Lobe {
-            width: match self.hints.lobe_width {
-                Some(w) if w > 0.0 && w.is_finite() => w,
-                _ => measured().width,
-            },
-            anisotropic: match self.hints.anisotropic {
-                Some(a) => a,
-                None => measured().anisotropic,
-            },
-        }
+    /// The lobe, measured from D once ([`crate::oracle::lobe`]; a stated width only speeds the
+    /// measurement up).
+    pub fn lobe(&self) -> &Lobe {
+        self.measured.get_or_init(|| {
+            lobe::measure_with(
+                &|m| self.model.d(m) * m[2],
+                &Options {
+                    hint: self.hints.lobe_width,
+                    ..Options::default()
+                },
+            )
+        })
+    }
+
+    /// Whether D depends on the azimuth: as stated (or known from a reference spec); a user's
+    /// model that states nothing is treated as anisotropic (checks then run at two azimuths).
+    pub fn anisotropic(&self) -> bool {
+        self.hints.anisotropic.unwrap_or(true)
     }
 
     /// The polar kinks of D (hinted; none for a model that states none).
@@ -212,78 +203,23 @@ fn spec_anisotropic(spec: &ModelSpec) -> bool {
     has("alpha_x") || (has("y") && has("x")) || has("cov") || has("mean")
 }
 
-/// Measures the lobe from D alone: along 8 azimuths, the polar angle θ* where the projected
-/// density D(θ, φ) cos θ sin θ peaks on a log-spaced grid from 1e-9 to π/2 (α/√3 for GGX,
-/// α/√2 for Beckmann); the width is the smallest θ*, and the lobe is anisotropic when D at a
-/// common θ differs between azimuths by more than 1e-9 relative. A few thousand evaluations.
-pub fn measure_lobe(model: &dyn Ndf) -> Lobe {
-    const N: usize = 400;
-    let thetas: Vec<f64> = (0..N)
-        .map(|i| 1e-9 * (FRAC_PI_2 / 1e-9).powf(i as f64 / (N - 1) as f64))
-        .collect();
-    let mut width = f64::INFINITY;
-    let mut reference: Option<Vec<f64>> = None;
-    let mut anisotropic = false;
-    for k in 0..8 {
-        let phi = k as f64 * PI / 4.0 + 0.1;
-        let values: Vec<f64> = thetas
-            .iter()
-            .map(|&t| {
-                let d = model.d(from_spherical(t.min(FRAC_PI_2 - 1e-9), phi));
-                if d.is_finite() {
-                    d
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        let best = thetas
-            .iter()
-            .zip(&values)
-            .map(|(t, d)| (t, d * t.cos() * t.sin()))
-            .fold(
-                (0.3, 0.0),
-                |acc, (t, v)| if v > acc.1 { (*t, v) } else { acc },
-            );
-        width = width.min(best.0);
-        match &reference {
-            None => reference = Some(values),
-            Some(r) => {
-                anisotropic |= r
-                    .iter()
-                    .zip(&values)
-                    .any(|(a, b)| (a - b).abs() > 1e-9 * a.abs().max(b.abs()));
-            }
-        }
-    }
-    Lobe {
-        width: if width.is_finite() { width } else { 0.3 },
-        anisotropic,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn the_measured_lobe_follows_roughness_and_anisotropy() {
-        for (spec, lo, hi, aniso) in [
-            (r#"{"family":"ggx","alpha":0.3}"#, 0.1, 0.3, false),
-            (r#"{"family":"ggx","alpha":1e-4}"#, 3e-5, 1e-4, false),
-            (r#"{"family":"beckmann","alpha":1e-3}"#, 4e-4, 1e-3, false),
-            (
-                r#"{"family":"ggx","alpha_x":0.01,"alpha_y":1.0}"#,
-                3e-3,
-                1e-2,
-                true,
-            ),
+    fn the_measured_lobe_follows_roughness() {
+        for (spec, lo, hi) in [
+            (r#"{"family":"ggx","alpha":0.3}"#, 0.1, 0.3),
+            (r#"{"family":"ggx","alpha":1e-4}"#, 3e-5, 1e-4),
+            (r#"{"family":"beckmann","alpha":1e-3}"#, 4e-4, 1e-3),
         ] {
             let spec: ModelSpec = serde_json::from_str(spec).unwrap();
-            let m = spec.build().unwrap();
-            let lobe = measure_lobe(m.as_ref());
-            assert!(lobe.width > lo && lobe.width < hi, "{spec:?}: {lobe:?}");
-            assert_eq!(lobe.anisotropic, aniso, "{spec:?}");
+            let user = Subject::user(Arc::new(spec.build().unwrap()), "u", Hints::default());
+            let w = user.lobe().width();
+            assert!(w > lo && w < hi, "{spec:?}: {w}");
+            assert!(user.anisotropic());
+            assert_eq!(Subject::reference(&spec).unwrap().anisotropic(), false);
         }
     }
 }

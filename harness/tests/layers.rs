@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 /// The layer of each top-level module of the harness (lower imports nothing higher).
 fn layer(module: &str) -> Option<u32> {
     Some(match module {
-        "record" | "tolerance" | "random" | "subject" => 0,
+        "record" | "tolerance" | "random" | "messages" => 0,
         "oracle" => 1,
-        "check" => 2,
+        "check" | "subject" => 2,
         "scene" | "mitsuba" | "plan" | "plan_table" | "shard" => 3,
-        "audit" | "gate" | "merge" | "baseline" | "cost" | "chi2_run" => 4,
+        "audit" | "gate" | "merge" | "baseline" | "cost" | "chi2_run" | "readback" => 4,
         "report" | "heatmap" => 5,
         "cli" | "chi2_command" | "eval" | "eval_sg" | "main" | "lib" => 6,
         _ => return None,

@@ -54,7 +54,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> 
                         );
                         r.covers = vec![covers(family, closed, "default")];
                         let slopes = m.model.as_slopes().expect("planned for slope models");
-                        let scale = m.lobe().width.tan().max(1e-6);
+                        let scale = m.lobe().width().tan().max(1e-6);
                         let acc = Accuracy::relative(1e-12);
                         let raw = |k: i32| {
                             integrate_line(&|q| q.powi(k) * slopes.p2(q, phi), 0.0, scale, acc)

@@ -1,7 +1,7 @@
 //! Normalization: ∫ D(m)(m·n) dm = 1 over the hemisphere, by nested adaptive quadrature.
 
 use super::{compare, covers, timed, PlannedCheck};
-use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
+use crate::oracle::quadrature::{integrate_hemisphere_lobe, Accuracy, Cuts};
 use crate::oracle::Estimate;
 use crate::record::CheckRecord;
 use crate::subject::Subject;
@@ -31,9 +31,9 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> 
                 );
                 r.covers = vec![covers(family, "d", "default")];
                 let kinks = s.theta_kinks();
-                let e = integrate_hemisphere(
+                let e = integrate_hemisphere_lobe(
                     &|w| s.model.d(w) * w[2],
-                    s.lobe().width,
+                    s.lobe(),
                     Some(Cuts {
                         theta: &|_| kinks.clone(),
                         phi: &[],

@@ -8,9 +8,10 @@
 
 use super::{applied, compare, compare_exact, covers, timed, Planned, PlannedCheck, Profile};
 use crate::oracle::chi2::{
-    chi2_test_sampler, chi2_test_to, Chi2Config, KINKED_CELL_RELATIVE_TOLERANCE,
+    chi2_test_batch_in, chi2_test_to, Chi2Config, CELL_RELATIVE_TOLERANCE,
+    KINKED_CELL_RELATIVE_TOLERANCE,
 };
-use crate::oracle::ks::{self, ks_test_sampler, KsConfig, LobeHints, Marginal};
+use crate::oracle::ks::{self, KsConfig, LobeHints, Marginal};
 use crate::oracle::monte_carlo::{estimate, two_sided_p};
 use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
@@ -63,7 +64,13 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                         seed: ctx.seed,
                         alpha: STATISTICAL_ALPHA.value,
                     };
-                    let result = chi2_test_sampler(sampler, &config);
+                    let result = chi2_test_batch_in(
+                        &|u: &[[f64; 2]], out: &mut [Vec3]| sampler.sample_wm_batch(u, out),
+                        &|mm| sampler.pdf_wm(mm),
+                        &config,
+                        CELL_RELATIVE_TOLERANCE,
+                        Some(m.lobe()),
+                    );
                     fill_chi2(&mut r, &result, ctx, samples);
                     r
                 })
@@ -319,7 +326,6 @@ pub fn plan_visible<'a>(
     }
     let samples = profile.chi2_samples();
     let resolution = 16;
-    let width = subject.lobe().width;
     let mut out = Vec::new();
     for &(theta, phi) in &VISIBLE_INCIDENCES {
         let (m, spec_run) = (subject.clone(), spec.clone());
@@ -397,7 +403,7 @@ pub fn plan_visible<'a>(
                     let kinks = |p: f64| visible_kinks(wi, p);
                     let e = integrate_hemisphere(
                         &|mm| v.pdf_wm_visible(wi, mm),
-                        width,
+                        m.lobe().width(),
                         Some(Cuts {
                             theta: &kinks,
                             phi: &terminator_azimuths(phi),
@@ -661,7 +667,7 @@ fn plan_ks<'a>(
     let model = subject.clone();
     let case = json!({"marginal": marginal.name(), "samples": samples});
     let (spec_run, case_run) = (spec.clone(), case.clone());
-    let (width, kinks) = (subject.lobe().width, subject.theta_kinks());
+    let kinks = subject.theta_kinks();
     PlannedCheck {
         check: "sampling.ks_marginals".into(),
         model: spec.clone(),
@@ -688,17 +694,24 @@ fn plan_ks<'a>(
                     };
                     return r;
                 };
-                let hints = LobeHints {
-                    width,
-                    theta_kinks: &kinks,
-                };
                 let config = KsConfig {
                     samples,
                     seed: ctx.seed,
                     alpha: STATISTICAL_ALPHA.value,
                 };
-                let result = ks_test_sampler(sampler, marginal, &hints, &config);
+                let result = ks::ks_test_lobe(
+                    &|u| sampler.sample_wm(u),
+                    &|m| sampler.pdf_wm(m),
+                    marginal,
+                    model.lobe(),
+                    &kinks,
+                    &config,
+                );
                 fill_ks(&mut r, &result);
+                let hints = LobeHints {
+                    width: model.lobe().width(),
+                    theta_kinks: &kinks,
+                };
                 r.data = ks_marginal_data(sampler, marginal, &hints, &config, &result);
                 r
             })
@@ -921,7 +934,7 @@ mod tests {
     #[test]
     fn the_ks_curves_show_the_samples_the_test_judged() {
         let (_, m) = model(r#"{"family":"ggx","alpha_x":0.1,"alpha_y":0.4}"#);
-        let sampler = m.as_sampler().unwrap();
+        let sampler = m.model.as_sampler().unwrap();
         for marginal in [Marginal::CosTheta, Marginal::Phi] {
             let hints = LobeHints {
                 width: 0.1f64.atan(),
@@ -932,7 +945,7 @@ mod tests {
                 seed: 11,
                 alpha: STATISTICAL_ALPHA.value,
             };
-            let result = ks_test_sampler(sampler, marginal, &hints, &config);
+            let result = ks::ks_test_sampler(sampler, marginal, &hints, &config);
             let values = ks_redraw(sampler, marginal, &config);
             let table = ks::marginal_cdf(&|w| sampler.pdf_wm(w), marginal, &hints);
             let (d, at) = ks::ks_statistic(&values, &|x| table.cdf(x));

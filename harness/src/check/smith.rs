@@ -108,7 +108,7 @@ pub fn lambda_oracle_for(subject: &Subject, w: Vec3) -> Estimate {
                 return e;
             }
         }
-        let scale = subject.lobe().width.tan().max(1e-6);
+        let scale = subject.lobe().width().tan().max(1e-6);
         let e = integrate_upper(&|q| (q - mu) * slopes.p2(q, phi), mu, scale, accuracy);
         return Estimate {
             value: e.value / mu,
@@ -213,7 +213,7 @@ pub fn plan<'a>(
     // One oracle per direction, shared by every route checked there (computed by whichever
     // route check runs first; the others wait for it).
     let oracles: Vec<((f64, f64), SharedOracle)> = directions(
-        subject.hints.anisotropic.unwrap_or(true),
+        subject.anisotropic(),
         profile,
         theta_max,
     )
@@ -320,7 +320,7 @@ pub fn plan<'a>(
                                 0.0
                             }
                         },
-                        m.lobe().width,
+                        m.lobe().width(),
                         Some(Cuts {
                             theta: &theta_cut,
                             phi: &phis,

@@ -6,7 +6,7 @@ use super::{resolve_seed, SamplingArg, EXIT_BAD_INPUT, EXIT_FAIL, EXIT_PASS};
 use crate::chi2_run::{self, Chi2Request};
 use crate::oracle::chi2::{Chi2Result, Verdict};
 use clap::Args;
-use serde_json::json;
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
