@@ -717,6 +717,22 @@ mod tests {
                 r.expected_mass
             );
         }
+        // 10⁴ cells (R = 71: 10 082) for GGX α = 1e-4: the mass and the cost, printed.
+        let m = model(r#"{"family":"ggx","alpha":0.0001}"#);
+        let s = m.as_sampler().unwrap();
+        let t = Instant::now();
+        let e = expected_mass(&|w| s.pdf_wm(w), HemisphereGrid::new(71).unwrap());
+        eprintln!(
+            "R = 71 (10 082 cells), GGX α = 1e-4: mass {} ± {:.1e}, {} evaluations, {:.3} s",
+            e.total,
+            e.error_bound,
+            e.evaluations,
+            t.elapsed().as_secs_f64()
+        );
+        assert!(
+            (e.total - 1.0).abs() < 1e-9 && e.error_bound < 1e-8,
+            "{e:?}"
+        );
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! within 1e-9, for α from 1e-4 to 2 (GGX, Beckmann, STD γ = 2.5), isotropic and at
 //! anisotropy 1:100, with the oracles placing their cuts from the lobe measured from D alone
 //! ([`lobe::measure`]); a sampler of α off by 5 % still fails. The CI subset is the extremes
-//! (α = 1e-4 and 2, isotropic, and one 1:100 case at each end); `MFH_EXTENSIVE=1` runs all 36.
+//! (α = 1e-4 and 2 isotropic, and GGX 1e-4 : 1e-2); `MFH_EXTENSIVE=1` runs all 36.
 
 use super::chi2::{chi2_test_in, Chi2Config, Verdict, CELL_RELATIVE_TOLERANCE};
 use super::ks::{ks_test_lobe, KsConfig, Marginal};
@@ -153,12 +153,12 @@ fn sweep_correct_samplers_pass_from_alpha_1e_4_to_2() {
     ] {
         for a in [1e-4, 1e-3, 1e-2, 0.3, 1.0, 2.0] {
             for (ax, ay) in roughness(a) {
-                // CI: the extremes, isotropic for every family, at 1:100 for GGX α = 1e-4 and
-                // Beckmann α = 2 (an anisotropic case costs ~40 s of quadrature on a loaded
-                // 2-core machine, mostly the 1e-9 normalization integral).
+                // CI: the extremes, isotropic for every family, and 1:100 for GGX α = 1e-4 (an
+                // anisotropic case costs 70–270 s on the loaded shared 2-core machine, mostly
+                // the 1e-9 normalization integral and the KS φ table).
                 let ci = (ax == ay && (a == 1e-4 || a == 2.0))
-                    || (ax != ay && a == 1e-4 && family.contains("ggx"))
-                    || (ax != ay && a == 2.0 && family.contains("beckmann"));
+                    || (ax != ay && a == 1e-4 && family.contains("ggx"));
+
                 if !(ci || extensive()) {
                     continue;
                 }
@@ -209,7 +209,9 @@ fn sweep_narrow_sampler_off_by_five_percent_fails() {
             r#"{"family":"std","gamma":2.5,"alpha_x":0.000105,"alpha_y":0.0105}"#,
         ),
     ];
-    let rows: Vec<Row> = cases
+    // The anisotropic case only with MFH_EXTENSIVE=1 (its quadrature is slow, above).
+    let n = if extensive() { cases.len() } else { 2 };
+    let rows: Vec<Row> = cases[..n]
         .par_iter()
         .map(|(pdf, sampler)| run(pdf, sampler, 77))
         .collect();
