@@ -60,11 +60,13 @@ fn sin_cos_turns_block(u: &[f64], s: &mut [f64], c: &mut [f64]) {
         let tiny = x.abs() < TINY;
         let (sin, cos) = if tiny { (x, 1.0) } else { (sin, cos) };
         // Quadrant k mod 4 (k ∈ {0, …, 4}): 0 (s, c), 1 (c, −s), 2 (−s, −c), 3 (−c, s).
-        let odd = k == 1.0 || k == 3.0;
-        let high = k == 2.0 || k == 3.0;
+        // `|` and `^`, not `||` and `!=`: no short-circuit branch, so the loop vectorizes
+        // (checked in the asm: packed mulpd/addpd on the baseline x86-64 target).
+        let odd = (k == 1.0) | (k == 3.0);
+        let high = (k == 2.0) | (k == 3.0);
         let (a, b) = if odd { (cos, sin) } else { (sin, cos) };
         *s = if high { -a } else { a };
-        *c = if odd != high { -b } else { b };
+        *c = if odd ^ high { -b } else { b };
     }
 }
 
