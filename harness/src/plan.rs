@@ -63,6 +63,10 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
                 theta_max,
                 &format!("{why} masks ({masking:?})"),
             ));
+            out.extend(crate::check::route_stress::plan(
+                model.as_ref(),
+                &format!("{why} masks"),
+            ));
         }
         if let Some(s) = material.sampling {
             let samples = format!("{why} samples ({s:?})");
