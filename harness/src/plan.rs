@@ -105,6 +105,12 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
                 &format!("{why} samples (PseudoVnis)"),
             ));
         }
+        if material.masking.is_some() {
+            out.extend(crate::check::route_stress::plan(
+                model.as_ref(),
+                &format!("{why} masks"),
+            ));
+        }
         if scene.filtering.gaussian_slopes {
             out.extend(ds::plan(
                 model.clone(),

@@ -138,9 +138,9 @@ pub fn term_magnitude(name: &str, c: f64, x: f64) -> Option<f64> {
     match name {
         "default" | "stable" | "2f1_algorithm2_corrected" => None,
         // A − ½ + N x F, with 0 < N x F < ½.
-        "2f1" | "2f1_algorithm2" | "incomplete_beta" | "table1" | "table1_printed" => {
-            Some(first + 1.0)
-        }
+        "2f1" | "2f1_algorithm2" | "table1" | "table1_printed" => Some(first + 1.0),
+        // A − ½ I_w(C−1, ½), with 0 < ½ I_w ≤ A (Λ ≥ 0): no ½ is subtracted.
+        "incomplete_beta" => Some(2.0 * first),
         "integer" => {
             // (C−1) A1 (first − A2), A2 an alternating sum of C(n, k)/(2k+1) terms.
             let n = (c as u64).saturating_sub(2);
