@@ -2,6 +2,8 @@
 //! D, Λ and normal sampling (reference GGX α = 0.3, checked against its own spec). Target:
 //! ≤ 10 s on 2 cores. `cargo bench -p mfh-harness --bench gate`.
 
+#![allow(missing_docs)] // criterion_group! generates undocumented items
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use mfh_harness::{Audit, Profile};
 use mfh_reference::ndf::Ggx;

@@ -101,11 +101,7 @@ pub fn estimated_cost(planned: &PlannedCheck<'_>, profile: Profile) -> f64 {
         .and_then(|f| f.as_str())
         .unwrap_or("");
     let slow = mfh_reference::registry::by_name(family).is_some_and(|f| f.slow_sampler);
-    let per_sample = if slow {
-        3e-5
-    } else {
-        1e-7
-    };
+    let per_sample = if slow { 3e-5 } else { 1e-7 };
     let id = planned.check.as_str();
     if id.starts_with("sampling.chi2") {
         0.2 + profile.chi2_samples() as f64 * per_sample

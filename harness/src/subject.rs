@@ -219,7 +219,7 @@ mod tests {
             let w = user.lobe().width();
             assert!(w > lo && w < hi, "{spec:?}: {w}");
             assert!(user.anisotropic());
-            assert_eq!(Subject::reference(&spec).unwrap().anisotropic(), false);
+            assert!(!Subject::reference(&spec).unwrap().anisotropic());
         }
     }
 }

@@ -105,9 +105,14 @@ impl Profile {
 
     /// The profile of a name as on the command line.
     pub fn from_name(name: &str) -> Option<Profile> {
-        [Profile::Ci, Profile::Quick, Profile::Standard, Profile::Thorough]
-            .into_iter()
-            .find(|p| p.name() == name)
+        [
+            Profile::Ci,
+            Profile::Quick,
+            Profile::Standard,
+            Profile::Thorough,
+        ]
+        .into_iter()
+        .find(|p| p.name() == name)
     }
 
     /// The name as on the command line.

@@ -212,14 +212,11 @@ pub fn plan<'a>(
     let mut out = Vec::new();
     // One oracle per direction, shared by every route checked there (computed by whichever
     // route check runs first; the others wait for it).
-    let oracles: Vec<((f64, f64), SharedOracle)> = directions(
-        subject.anisotropic(),
-        profile,
-        theta_max,
-    )
-    .into_iter()
-    .map(|d| (d, Arc::new(OnceLock::new())))
-    .collect();
+    let oracles: Vec<((f64, f64), SharedOracle)> =
+        directions(subject.anisotropic(), profile, theta_max)
+            .into_iter()
+            .map(|d| (d, Arc::new(OnceLock::new())))
+            .collect();
     // A user's model is audited through the method a renderer calls; the other routes of a
     // reference model are the reference's own business (each against the same oracle).
     let routes = if subject.reference.is_some() {

@@ -660,6 +660,46 @@ impl Model for PiecewiseLinear {
     }
 }
 
+/// The registry entry of the piecewise-linear NDF ([`crate::registry`]).
+pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+    name: "piecewise_linear",
+    documents: &["000"],
+    source: "seed 000 eq 1–5",
+    domain: "profiles: θ strictly increasing from 0 to π/2, values ≥ 0 and finite, not all 0",
+    examples: &[
+        r#"{"family": "piecewise_linear", "x": {"theta": [0.0, 0.3, 0.8, 1.2, 1.5707963267948966], "value": [3.0, 2.0, 0.6, 0.1, 0.0]}}"#,
+        r#"{"family": "piecewise_linear", "x": {"theta": [0.0, 0.3, 0.8, 1.2, 1.5707963267948966], "value": [3.0, 2.0, 0.6, 0.1, 0.0]}, "y": {"theta": [0.0, 0.5, 1.0, 1.5707963267948966], "value": [1.5, 1.2, 0.3, 0.05]}}"#,
+    ],
+    stress_alpha: &[],
+    stress_gamma: &[],
+    stress_specs: &[],
+    lambda_numerical: true,
+    slow_sampler: true,
+    beckmann_limit: false,
+    intrinsic_moments: false,
+    tail_exponent: crate::registry::no_tail,
+    theta_kinks: profile_kinks,
+    mean_slope: crate::registry::zero_mean,
+};
+
+/// The interior breakpoints of a piecewise-linear spec's profiles (both of the anisotropic
+/// blend, whose weights depend on φ only): D has kinks there for every azimuth.
+pub fn profile_kinks(spec: &crate::ModelSpec) -> Vec<f64> {
+    let crate::ModelSpec::PiecewiseLinear { x, y } = spec else {
+        return Vec::new();
+    };
+    let mut out: Vec<f64> = x
+        .theta
+        .iter()
+        .chain(y.iter().flat_map(|p| p.theta.iter()))
+        .copied()
+        .filter(|t| *t > 0.0 && *t < std::f64::consts::FRAC_PI_2)
+        .collect();
+    out.sort_by(f64::total_cmp);
+    out.dedup();
+    out
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
@@ -1779,44 +1819,4 @@ pub(crate) mod tests {
             assert!(worst(10) > 1e-3 && worst(10) < 5e-2, "{:e}", worst(10));
         }
     }
-}
-
-/// The registry entry of the piecewise-linear NDF ([`crate::registry`]).
-pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
-    name: "piecewise_linear",
-    documents: &["000"],
-    source: "seed 000 eq 1–5",
-    domain: "profiles: θ strictly increasing from 0 to π/2, values ≥ 0 and finite, not all 0",
-    examples: &[
-        r#"{"family": "piecewise_linear", "x": {"theta": [0.0, 0.3, 0.8, 1.2, 1.5707963267948966], "value": [3.0, 2.0, 0.6, 0.1, 0.0]}}"#,
-        r#"{"family": "piecewise_linear", "x": {"theta": [0.0, 0.3, 0.8, 1.2, 1.5707963267948966], "value": [3.0, 2.0, 0.6, 0.1, 0.0]}, "y": {"theta": [0.0, 0.5, 1.0, 1.5707963267948966], "value": [1.5, 1.2, 0.3, 0.05]}}"#,
-    ],
-    stress_alpha: &[],
-    stress_gamma: &[],
-    stress_specs: &[],
-    lambda_numerical: true,
-    slow_sampler: true,
-    beckmann_limit: false,
-    intrinsic_moments: false,
-    tail_exponent: crate::registry::no_tail,
-    theta_kinks: profile_kinks,
-    mean_slope: crate::registry::zero_mean,
-};
-
-/// The interior breakpoints of a piecewise-linear spec's profiles (both of the anisotropic
-/// blend, whose weights depend on φ only): D has kinks there for every azimuth.
-pub fn profile_kinks(spec: &crate::ModelSpec) -> Vec<f64> {
-    let crate::ModelSpec::PiecewiseLinear { x, y } = spec else {
-        return Vec::new();
-    };
-    let mut out: Vec<f64> = x
-        .theta
-        .iter()
-        .chain(y.iter().flat_map(|p| p.theta.iter()))
-        .copied()
-        .filter(|t| *t > 0.0 && *t < std::f64::consts::FRAC_PI_2)
-        .collect();
-    out.sort_by(f64::total_cmp);
-    out.dedup();
-    out
 }
