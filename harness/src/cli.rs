@@ -100,6 +100,37 @@ pub enum Command {
         #[arg(long, default_value_t = 0.0)]
         azimuth: f64,
     },
+    /// Audit an implementation in any language: start `--cmd` (with `sh -c`), speak the
+    /// external protocol with it over stdin / stdout (README, "Audit an implementation in any
+    /// language"), and run the checks its declared capabilities call for.
+    ///
+    /// Exit status 0 if every check passes, 1 if one fails (a protocol error during the audit
+    /// is an `external.protocol` error record), 2 if the child cannot start or describe itself.
+    AuditExternal {
+        /// The command that starts the implementation, run with `sh -c`, e.g.
+        /// "python3 examples/external/ggx.py".
+        #[arg(long)]
+        cmd: String,
+        /// How hard to look.
+        #[arg(long, value_enum, default_value = "ci")]
+        profile: crate::check::Profile,
+        /// Also compare value by value with this reference spec (JSON), e.g.
+        /// '{"family":"ggx","alpha":0.3}'.
+        #[arg(long)]
+        against: Option<String>,
+        /// Seconds to wait for each answer before the child is killed.
+        #[arg(long, default_value_t = crate::external::DEFAULT_TIMEOUT_SECONDS)]
+        timeout: f64,
+        /// The audit seed (default: MFH_SEED, else a fixed seed).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Output folder (report.json, junit.xml).
+        #[arg(long, default_value = "reports/external")]
+        out: PathBuf,
+        /// Print report.json to standard output instead of the summary.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 /// Runs the command line `args` (including the program name) with the given streams and
@@ -182,6 +213,39 @@ where
             stdout,
             stderr,
         ),
+        Command::AuditExternal {
+            cmd,
+            profile,
+            against,
+            timeout,
+            seed,
+            out,
+            json,
+        } => {
+            let seed = match resolve_seed(seed) {
+                Ok(s) => s,
+                Err(e) => {
+                    let _ = writeln!(stderr, "mfh audit-external: {e}");
+                    return EXIT_BAD_INPUT;
+                }
+            };
+            if !(timeout > 0.0 && timeout <= 86_400.0) {
+                let _ = writeln!(
+                    stderr,
+                    "mfh audit-external: --timeout {timeout} is outside (0, 86400] seconds"
+                );
+                return EXIT_BAD_INPUT;
+            }
+            let request = crate::external::ExternalAudit {
+                command: cmd,
+                profile,
+                seed,
+                against,
+                timeout: std::time::Duration::from_secs_f64(timeout),
+                out: Some(out),
+            };
+            run_audit_external(&request, json, stdout, stderr)
+        }
         Command::Eval { input } => {
             let result = match input {
                 Some(path) => match std::fs::File::open(&path) {
@@ -277,6 +341,55 @@ fn run_audit(
             let _ = writeln!(
                 stderr,
                 "mfh audit: cannot write the report into {}: {e}",
+                out.display()
+            );
+            return EXIT_BAD_INPUT;
+        }
+    };
+    if json {
+        let _ = writeln!(stdout, "{}", crate::report::json::to_string(&report));
+    } else {
+        let _ = write!(stdout, "{}", crate::report::terminal::render(&report, 20));
+        for p in written {
+            let _ = writeln!(stdout, "wrote {}", p.display());
+        }
+    }
+    if report.passed() {
+        0
+    } else {
+        1
+    }
+}
+
+/// `mfh audit-external`: audits the child, writes the report, maps the outcome to 0 / 1 / 2.
+fn run_audit_external(
+    request: &crate::external::ExternalAudit,
+    json: bool,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> i32 {
+    let out = request.out.clone().unwrap_or_else(|| PathBuf::from("."));
+    if let Err(e) = std::fs::create_dir_all(&out) {
+        let _ = writeln!(
+            stderr,
+            "mfh audit-external: cannot create {}: {e}",
+            out.display()
+        );
+        return EXIT_BAD_INPUT;
+    }
+    let report = match crate::external::audit(request) {
+        Ok(r) => r,
+        Err(e) => {
+            let _ = writeln!(stderr, "mfh audit-external: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let written = match crate::report::write_all(&report, &out) {
+        Ok(w) => w,
+        Err(e) => {
+            let _ = writeln!(
+                stderr,
+                "mfh audit-external: cannot write the report into {}: {e}",
                 out.display()
             );
             return EXIT_BAD_INPUT;

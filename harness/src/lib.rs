@@ -10,6 +10,7 @@ pub mod chi2_command;
 pub mod cli;
 pub mod eval;
 pub mod eval_sg;
+pub mod external;
 pub mod gate;
 pub mod heatmap;
 pub mod oracle;
