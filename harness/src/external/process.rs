@@ -127,9 +127,12 @@ impl Session {
     /// Starts `command` with `sh -c`, its stdin and stdout piped, its stderr captured (the last
     /// bytes are quoted in errors).
     pub fn start(command: &str, timeout: Duration) -> Result<Self, ExternalError> {
-        let mut child = Command::new("sh")
-            .arg("-c")
-            .arg(command)
+        let mut builder = Command::new("sh");
+        builder.arg("-c").arg(command);
+        // Its own process group, so that killing it also ends what `sh -c` started.
+        #[cfg(unix)]
+        std::os::unix::process::CommandExt::process_group(&mut builder, 0);
+        let mut child = builder
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
@@ -300,6 +303,16 @@ impl Session {
 
     fn kill(&mut self) {
         self.to_child = None;
+        if let Ok(None) = self.child.try_wait() {
+            // std has no killpg: the `kill` utility ends the whole group (the shell's children).
+            #[cfg(unix)]
+            let _ = Command::new("kill")
+                .args(["-KILL", "--", &format!("-{}", self.child.id())])
+                .stdin(Stdio::null())
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .status();
+        }
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
