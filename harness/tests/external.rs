@@ -125,6 +125,19 @@ fn batch_throughput_of_the_pure_python_example() {
         b / n as f64
     );
     assert!((a - b).abs() / (n as f64) < 1e-12, "same u, same sampler");
+    // A scalar trait call is one round trip: its cost, measured.
+    let calls = 2000;
+    let t = Instant::now();
+    let mut sum = 0.0;
+    for i in 0..calls {
+        sum += model.d([0.0, (i as f64 * 1e-4).sin(), (i as f64 * 1e-4).cos()]);
+    }
+    let per_call = t.elapsed().as_secs_f64() / calls as f64;
+    assert!(sum.is_finite() && sum > 0.0, "{sum}");
+    eprintln!(
+        "pure-Python ggx.py: one scalar round trip (d) costs {:.1} µs (mean of {calls})",
+        per_call * 1e6
+    );
     model.shutdown();
 }
 
@@ -331,4 +344,35 @@ fn numpy_example_agrees_and_its_throughput_is_printed() {
         n as f64 / seconds
     );
     model.shutdown();
+}
+
+/// `mfh audit-external`: a child that cannot describe itself, or a bad --timeout, is bad input
+/// (exit 2) with a message naming the request or the flag.
+#[test]
+fn audit_external_cli_bad_input_exits_2() {
+    let run = |args: &[&str]| {
+        let (mut out, mut err) = (Vec::new(), Vec::new());
+        let code = mfh_harness::cli::run(
+            std::iter::once("mfh").chain(args.iter().copied()),
+            &mut std::io::empty(),
+            &mut out,
+            &mut err,
+        );
+        (code, String::from_utf8(err).unwrap())
+    };
+    let out = std::env::temp_dir().join(format!("mfh-external-cli-{}", std::process::id()));
+    let out = out.to_str().unwrap();
+    let (code, err) = run(&[
+        "audit-external",
+        "--cmd",
+        "/nonexistent/mfh-no-such-program",
+        "--out",
+        out,
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("describe") && err.contains("127"), "{err}");
+    let (code, err) = run(&["audit-external", "--cmd", "true", "--timeout", "0"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--timeout"), "{err}");
+    let _ = std::fs::remove_dir_all(out);
 }
