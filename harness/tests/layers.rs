@@ -59,10 +59,7 @@ fn no_module_imports_a_layer_above_its_own() {
     for file in &files {
         let module = module_of(&src, file);
         let Some(own) = layer(&module) else {
-            violations.push(format!(
-                "{}: module `{module}` has no layer",
-                file.display()
-            ));
+            violations.push(format!("{}: module `{module}` has no layer", file.display()));
             continue;
         };
         let text = code(&std::fs::read_to_string(file).expect("readable"));
@@ -85,10 +82,7 @@ fn no_module_imports_a_layer_above_its_own() {
             violations.push(format!("{}: only the CLI may use clap", file.display()));
         }
         if own <= 2 && (text.contains("std::fs") || text.contains("File::")) {
-            violations.push(format!(
-                "{}: checks and oracles do no file I/O",
-                file.display()
-            ));
+            violations.push(format!("{}: checks and oracles do no file I/O", file.display()));
         }
     }
     violations.sort();

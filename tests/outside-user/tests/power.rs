@@ -74,10 +74,7 @@ fn the_ci_profile_catches_the_stated_defects_at_every_seed() {
         let f = failed(&ggx(0.0, 0.0, 1e-5), seed, true);
         assert!(f.contains(&"sampling.pdf_jacobian".into()), "{f:?}");
         let f = failed(&ggx(0.0, 1e-4, 0.0), seed, true);
-        assert!(
-            f.contains(&"sampling.pdf_jacobian".into()),
-            "seed {seed}: {f:?}"
-        );
+        assert!(f.contains(&"sampling.pdf_jacobian".into()), "seed {seed}: {f:?}");
         let f = failed(&ggx(0.0, 0.03, 0.0), seed, true);
         assert!(f.contains(&"sampling.chi2".into()), "seed {seed}: {f:?}");
     }
