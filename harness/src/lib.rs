@@ -11,6 +11,7 @@ pub mod chi2_run;
 pub mod cli;
 pub mod eval;
 pub mod eval_sg;
+pub mod external;
 pub mod gate;
 pub mod merge;
 pub mod messages;

@@ -11,7 +11,9 @@ fn layer(module: &str) -> Option<u32> {
         "oracle" => 1,
         "check" | "subject" => 2,
         "scene" | "mitsuba" | "plan" | "plan_table" | "shard" => 3,
-        "audit" | "gate" | "merge" | "baseline" | "cost" | "chi2_run" | "readback" => 4,
+        "audit" | "gate" | "external" | "merge" | "baseline" | "cost" | "chi2_run" | "readback" => {
+            4
+        }
         "report" | "heatmap" => 5,
         "cli" | "chi2_command" | "eval" | "eval_sg" | "main" | "lib" => 6,
         _ => return None,

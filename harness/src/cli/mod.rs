@@ -8,6 +8,7 @@
 pub mod audit;
 pub mod chi2;
 pub mod eval;
+pub mod external;
 pub mod plan;
 pub mod progress;
 
@@ -95,6 +96,13 @@ pub enum Command {
     /// Exit status 0 if every check passes (expected failures included), 1 if one fails, 2 on
     /// bad input.
     Audit(audit::AuditArgs),
+    /// Audit an implementation in any language: start `--cmd` (with `sh -c`), speak the
+    /// external protocol with it over stdin / stdout (README, "Audit an implementation in any
+    /// language"), and run the checks its declared capabilities call for.
+    ///
+    /// Exit status 0 if every check passes, 1 if one fails (a protocol error during the audit
+    /// is an `external.protocol` error record), 2 if the child cannot start or describe itself.
+    AuditExternal(external::ExternalArgs),
     /// Merge the output folders of `mfh audit --shard i/n` (every i of one n) into the
     /// unsharded report: report.json and junit.xml in --out.
     ///
@@ -136,6 +144,7 @@ where
     };
     match cli.command {
         Command::Audit(args) => audit::run(args, stdout, stderr),
+        Command::AuditExternal(args) => external::run(args, stdout, stderr),
         Command::Merge(args) => audit::run_merge(args, stdout, stderr),
         Command::Plan(args) => plan::run(args, stdout, stderr),
         Command::Chi2(args) => chi2::run(args, stdout, stderr),

@@ -1,0 +1,353 @@
+//! An external process as one more implementation of the capability traits: every trait
+//! method is a request to the child. Batches go through the inherent `*_batch` methods (split
+//! into requests of at most [`MAX_BATCH`] items); a scalar trait call is one round trip.
+//!
+//! Trait methods cannot return errors, so the first protocol error is recorded (see
+//! [`ExternalModel::first_error`]), the child is killed, and every later call answers NaN
+//! (values) or a NaN direction (samples) at once: the audit's checks fail quickly, and the
+//! runner appends an `external.protocol` error record with the message.
+
+use super::process::{ExternalError, Session};
+use super::protocol::{Answer, Description, Number, Request};
+use mfh_reference::model::{visible_domain, NormalSampler, Smith, VisibleNormalSampler};
+use mfh_reference::{Masking, Ndf, Vec3};
+use std::sync::Mutex;
+use std::time::Duration;
+
+/// The most items sent in one request.
+pub const MAX_BATCH: usize = 65_536;
+
+const NAN3: Vec3 = [f64::NAN; 3];
+
+/// A model implemented by a child process speaking the external protocol.
+pub struct ExternalModel {
+    session: Mutex<Session>,
+    description: Description,
+    first_error: Mutex<Option<ExternalError>>,
+}
+
+impl ExternalModel {
+    /// Starts `command` (with `sh -c`), asks for its description and validates it.
+    pub fn start(command: &str, timeout: Duration) -> Result<Self, ExternalError> {
+        let mut session = Session::start(command, timeout)?;
+        let description = session.describe()?;
+        if let Err(e) = description.validate() {
+            session.fail();
+            return Err(ExternalError::Describe(e));
+        }
+        Ok(Self {
+            session: Mutex::new(session),
+            description,
+            first_error: Mutex::new(None),
+        })
+    }
+
+    /// What the child said of itself.
+    pub fn description(&self) -> &Description {
+        &self.description
+    }
+
+    /// The first protocol error of the session, if any.
+    pub fn first_error(&self) -> Option<ExternalError> {
+        self.first_error.lock().ok().and_then(|e| e.clone())
+    }
+
+    /// Asks the child to exit and reaps it.
+    pub fn shutdown(&self) {
+        if let Ok(mut s) = self.session.lock() {
+            s.shutdown();
+        }
+    }
+
+    fn call(&self, request: &Request<'_>) -> Result<Answer, ExternalError> {
+        let mut session = self
+            .session
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        let result = session.call(request);
+        if let Err(e) = &result {
+            if let Ok(mut first) = self.first_error.lock() {
+                first.get_or_insert_with(|| e.clone());
+            }
+        }
+        result
+    }
+
+    /// Sends one request for scalar values and checks the answer: one finite-or-infinite
+    /// number per item, no NaN.
+    fn values(
+        &self,
+        request: &Request<'_>,
+        inputs: &dyn Fn(usize) -> String,
+    ) -> Result<Vec<f64>, ExternalError> {
+        let answer = self.call(request)?;
+        let label = || format!("{} ({} items)", request.op(), request.len());
+        let values = answer.values.ok_or_else(|| {
+            self.record(ExternalError::Malformed {
+                request: label(),
+                reason: "the answer has no \"values\" array".into(),
+                got: String::new(),
+            })
+        })?;
+        if values.len() != request.len() {
+            return Err(self.record(ExternalError::WrongLength {
+                request: label(),
+                asked: request.len(),
+                got: values.len(),
+            }));
+        }
+        let values: Vec<f64> = values.into_iter().map(Number::value).collect();
+        if let Some(index) = values.iter().position(|v| v.is_nan()) {
+            return Err(self.record(ExternalError::NotANumber {
+                request: label(),
+                index,
+                input: inputs(index),
+            }));
+        }
+        Ok(values)
+    }
+
+    /// Sends one sampling request and checks the answer: one direction per item, no NaN.
+    fn directions(
+        &self,
+        request: &Request<'_>,
+        inputs: &dyn Fn(usize) -> String,
+    ) -> Result<Vec<Vec3>, ExternalError> {
+        let answer = self.call(request)?;
+        let label = || format!("{} ({} items)", request.op(), request.len());
+        let m = answer.m.ok_or_else(|| {
+            self.record(ExternalError::Malformed {
+                request: label(),
+                reason: "the answer has no \"m\" array".into(),
+                got: String::new(),
+            })
+        })?;
+        if m.len() != request.len() {
+            return Err(self.record(ExternalError::WrongLength {
+                request: label(),
+                asked: request.len(),
+                got: m.len(),
+            }));
+        }
+        let m: Vec<Vec3> = m
+            .into_iter()
+            .map(|[x, y, z]| [x.value(), y.value(), z.value()])
+            .collect();
+        if let Some(index) = m.iter().position(|v| v.iter().any(|c| c.is_nan())) {
+            return Err(self.record(ExternalError::NotANumber {
+                request: label(),
+                index,
+                input: inputs(index),
+            }));
+        }
+        Ok(m)
+    }
+
+    /// Records an error found in an answer (the session itself is still alive: stop it).
+    fn record(&self, e: ExternalError) -> ExternalError {
+        if let Ok(mut first) = self.first_error.lock() {
+            first.get_or_insert_with(|| e.clone());
+        }
+        if let Ok(mut s) = self.session.lock() {
+            s.fail();
+        }
+        e
+    }
+
+    /// D(m) for a batch.
+    pub fn d_batch(&self, m: &[Vec3]) -> Result<Vec<f64>, ExternalError> {
+        chunked(m.len(), |r| {
+            self.values(&Request::D { m: &m[r.clone()] }, &|i| show(m[r.start + i]))
+        })
+    }
+
+    /// Λ(w) for a batch.
+    pub fn lambda_batch(&self, w: &[Vec3]) -> Result<Vec<f64>, ExternalError> {
+        chunked(w.len(), |r| {
+            self.values(&Request::Lambda { w: &w[r.clone()] }, &|i| {
+                show(w[r.start + i])
+            })
+        })
+    }
+
+    /// The density of `sample_wm` for a batch.
+    pub fn pdf_wm_batch(&self, m: &[Vec3]) -> Result<Vec<f64>, ExternalError> {
+        chunked(m.len(), |r| {
+            self.values(&Request::PdfWm { m: &m[r.clone()] }, &|i| {
+                show(m[r.start + i])
+            })
+        })
+    }
+
+    /// `sample_wm` for a batch of uniform pairs, written into `out` (same length as `u`). On a
+    /// protocol error `out` is filled with NaN directions and the error is recorded.
+    pub fn sample_wm_batch(&self, u: &[[f64; 2]], out: &mut [Vec3]) {
+        assert_eq!(
+            u.len(),
+            out.len(),
+            "sample_wm_batch: u and out differ in length"
+        );
+        for (start, chunk) in (0..u.len())
+            .step_by(MAX_BATCH)
+            .zip(out.chunks_mut(MAX_BATCH))
+        {
+            let r = start..start + chunk.len();
+            let got = self.directions(&Request::SampleWm { u: &u[r.clone()] }, &|i| {
+                format!("u = {:?}", u[r.start + i])
+            });
+            match got {
+                Ok(m) => chunk.copy_from_slice(&m),
+                Err(_) => {
+                    out[start..].fill(NAN3);
+                    return;
+                }
+            }
+        }
+    }
+
+    fn one_value(&self, request: Request<'_>, input: String) -> f64 {
+        self.values(&request, &|_| input.clone())
+            .map_or(f64::NAN, |v| v[0])
+    }
+}
+
+/// Runs `f` on consecutive ranges of at most [`MAX_BATCH`] items and concatenates.
+fn chunked(
+    n: usize,
+    f: impl Fn(std::ops::Range<usize>) -> Result<Vec<f64>, ExternalError>,
+) -> Result<Vec<f64>, ExternalError> {
+    let mut out = Vec::with_capacity(n);
+    for start in (0..n).step_by(MAX_BATCH) {
+        out.extend(f(start..(start + MAX_BATCH).min(n))?);
+    }
+    Ok(out)
+}
+
+fn show(v: Vec3) -> String {
+    format!("[{}, {}, {}]", v[0], v[1], v[2])
+}
+
+impl Ndf for ExternalModel {
+    fn d(&self, m: Vec3) -> f64 {
+        self.one_value(Request::D { m: &[m] }, format!("m = {}", show(m)))
+    }
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        self.description.has("lambda").then_some(self as &dyn Smith)
+    }
+    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+        self.description
+            .has("sample_wm")
+            .then_some(self as &dyn NormalSampler)
+    }
+    fn as_visible_sampler(&self) -> Option<&dyn VisibleNormalSampler> {
+        self.description
+            .has("sample_wm_visible")
+            .then_some(self as &dyn VisibleNormalSampler)
+    }
+}
+
+impl Smith for ExternalModel {
+    fn lambda(&self, w: Vec3) -> f64 {
+        self.one_value(Request::Lambda { w: &[w] }, format!("w = {}", show(w)))
+    }
+    fn g1(&self, w: Vec3, m: Vec3) -> f64 {
+        if !self.description.has("g1") {
+            return default_g1(self, w, m);
+        }
+        self.one_value(
+            Request::G1 { w: &[w], m: &[m] },
+            format!("w = {}, m = {}", show(w), show(m)),
+        )
+    }
+    fn g2(&self, wo: Vec3, wi: Vec3, m: Vec3, masking: Masking) -> f64 {
+        if !self.description.has("g2") {
+            return default_g2(self, wo, wi, m, masking);
+        }
+        self.one_value(
+            Request::G2 {
+                wo: &[wo],
+                wi: &[wi],
+                m: &[m],
+                masking,
+            },
+            format!("wo = {}, wi = {}, m = {}", show(wo), show(wi), show(m)),
+        )
+    }
+}
+
+/// The trait's default G1 (seed 001, eq 16), for a child without `g1`.
+fn default_g1(s: &ExternalModel, w: Vec3, m: Vec3) -> f64 {
+    if w[2] <= 0.0 || w[0] * m[0] + w[1] * m[1] + w[2] * m[2] <= 0.0 {
+        return 0.0;
+    }
+    1.0 / (1.0 + s.lambda(w))
+}
+
+/// The trait's default G2 (seed 001, eq 22 / 23), for a child without `g2`.
+fn default_g2(s: &ExternalModel, wo: Vec3, wi: Vec3, m: Vec3, masking: Masking) -> f64 {
+    match masking {
+        Masking::Uncorrelated => default_g1(s, wo, m) * default_g1(s, wi, m),
+        Masking::HeightCorrelated => {
+            let facing = |w: Vec3| w[2] > 0.0 && w[0] * m[0] + w[1] * m[1] + w[2] * m[2] > 0.0;
+            if facing(wo) && facing(wi) {
+                1.0 / (1.0 + s.lambda(wo) + s.lambda(wi))
+            } else {
+                0.0
+            }
+        }
+    }
+}
+
+impl NormalSampler for ExternalModel {
+    fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
+        let mut out = [NAN3];
+        ExternalModel::sample_wm_batch(self, &[u], &mut out);
+        out[0]
+    }
+    /// The batch capability through the protocol: up to 65 536 pairs per request.
+    fn sample_wm_batch(&self, u: &[[f64; 2]], out: &mut [Vec3]) {
+        ExternalModel::sample_wm_batch(self, u, out)
+    }
+    fn pdf_wm(&self, m: Vec3) -> f64 {
+        if !self.description.has("pdf_wm") {
+            return if m[2] <= 0.0 { 0.0 } else { self.d(m) * m[2] };
+        }
+        self.one_value(Request::PdfWm { m: &[m] }, format!("m = {}", show(m)))
+    }
+}
+
+impl VisibleNormalSampler for ExternalModel {
+    fn sample_wm_visible(&self, wi: Vec3, u: [f64; 2]) -> Vec3 {
+        // Outside the domain the contract is a NaN direction; the child is not asked.
+        if !visible_domain(wi) {
+            return NAN3;
+        }
+        self.directions(&Request::SampleWmVisible { wi: &[wi], u: &[u] }, &|_| {
+            format!("wi = {}, u = {u:?}", show(wi))
+        })
+        .map_or(NAN3, |m| m[0])
+    }
+    fn pdf_wm_visible(&self, wi: Vec3, m: Vec3) -> f64 {
+        if !visible_domain(wi) {
+            return 0.0;
+        }
+        if !self.description.has("pdf_wm_visible") {
+            if !(m[2] > 0.0) {
+                return 0.0;
+            }
+            let c = wi[0] * m[0] + wi[1] * m[1] + wi[2] * m[2];
+            if !(c > 0.0) {
+                return 0.0;
+            }
+            let d = self.d(m);
+            if d == 0.0 {
+                return 0.0;
+            }
+            return c * d / (wi[2] * (1.0 + self.lambda(wi)));
+        }
+        self.one_value(
+            Request::PdfWmVisible { wi: &[wi], m: &[m] },
+            format!("wi = {}, m = {}", show(wi), show(m)),
+        )
+    }
+}
