@@ -1,4 +1,4 @@
-//! `mfh eval`: the JSON-lines contract for evaluating closed forms (DESIGN.md, "Evaluating
+//! `mfh eval`: the JSON-lines contract for evaluating closed forms (ARCHITECTURE.md, "Evaluating
 //! closed forms"). One query per line in, one answer per line out, in order.
 //!
 //! Non-finite numbers, which JSON cannot carry, are written as the strings `"inf"`, `"-inf"`

@@ -1,5 +1,5 @@
 //! The planner: a scene's effects → the checks they call for, each with the reason it was
-//! planned; nothing the scene does not use is simulated (DESIGN.md, "Scenes").
+//! planned; nothing the scene does not use is simulated (ARCHITECTURE.md, "Scenes").
 
 use crate::check::{
     claims, ds, errata, limits, moments, normalization, precise, sampling, sg, smith, stability,

@@ -1,5 +1,5 @@
 //! Randomness for every statistical oracle (chi-square, Kolmogorov–Smirnov, Monte Carlo) and
-//! for the audit's per-check seeds: one leaf module, built on `rand_chacha` (DESIGN.md's choice
+//! for the audit's per-check seeds: one leaf module, built on `rand_chacha` (ARCHITECTURE.md's choice
 //! of the `rand` family).
 //!
 //! **Generator.** ChaCha with 8 rounds ([`rand_chacha::ChaCha8Rng`]): a counter-based generator,

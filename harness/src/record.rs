@@ -1,5 +1,5 @@
 //! CheckRecord: what one check of one property of one model at one case found, and the schema
-//! version of the records (DESIGN.md, "Checks and records").
+//! version of the records (ARCHITECTURE.md, "Checks and records").
 
 use crate::readback::{interned, nullable_f64};
 use serde::{Deserialize, Serialize};

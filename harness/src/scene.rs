@@ -1,6 +1,6 @@
 //! Scenes: what a renderer uses (materials with their masking and sampling, filtering, lighting,
 //! incidence range), read from JSON with typed errors that carry the line and column, and the
-//! embedded default scene that covers every model of the source documents (DESIGN.md, "Scenes").
+//! embedded default scene that covers every model of the source documents (ARCHITECTURE.md, "Scenes").
 
 use mfh_reference::{Masking, ModelSpec};
 use serde::{Deserialize, Serialize};

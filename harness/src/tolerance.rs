@@ -1,5 +1,5 @@
 //! The one table of tolerances, each with its reason, and the table of expected failures (known
-//! errata and known numerical limits of printed routes), each with its reason (DESIGN.md, style 5).
+//! errata and known numerical limits of printed routes), each with its reason (ARCHITECTURE.md, style 5).
 
 /// A named tolerance.
 #[derive(Debug, Clone, Copy, PartialEq)]

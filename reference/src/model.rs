@@ -1,5 +1,5 @@
 //! The model boundary: capability traits every NDF implements as far as it has a meaning for
-//! them (DESIGN.md, "The model boundary").
+//! them (ARCHITECTURE.md, "The model boundary").
 
 use crate::error::QueryError;
 use crate::geometry::dot;

@@ -12,7 +12,7 @@ use crate::spec::ModelSpec;
 pub struct FamilyInfo {
     /// The family name, as in specs (`"family": "ggx"`).
     pub name: &'static str,
-    /// The source documents (seed ids, `../shared/seeds/`) the family's closed forms come from.
+    /// The source documents (seed ids, the source documents, seeds 000–004) the family's closed forms come from.
     pub documents: &'static [&'static str],
     /// Where in the documents the family is defined.
     pub source: &'static str,

@@ -7,7 +7,7 @@ use crate::model::Model;
 use crate::ndf::{Beckmann, Blend, Ggx, PiecewiseLinear, Profile, Student};
 
 /// A model described as data, e.g. `{"family": "std", "gamma": 2.5, "alpha": 0.3}`
-/// (DESIGN.md, "Evaluating closed forms"). Unknown keys are errors.
+/// (ARCHITECTURE.md, "Evaluating closed forms"). Unknown keys are errors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "family", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ModelSpec {

@@ -1,4 +1,4 @@
-//! End to end: the `mfh eval` contract (DESIGN.md, "Evaluating closed forms"), driven through
+//! End to end: the `mfh eval` contract (ARCHITECTURE.md, "Evaluating closed forms"), driven through
 //! `mfh_harness::cli::run` exactly as the binary calls it. Every family × every quantity answers
 //! `{"value": …}` equal bit for bit to the reference library called directly, or an error of
 //! kind `unsupported`; malformed lines answer `parse`, `model`, `route` or `argument` errors;
@@ -110,7 +110,7 @@ fn profile(theta: &[f64], value: &[f64]) -> Value {
     json!({ "theta": theta, "value": value })
 }
 
-/// One model spec per family of DESIGN.md (and the special cases: STD with γ = ∞, STD with
+/// One model spec per family of ARCHITECTURE.md (and the special cases: STD with γ = ∞, STD with
 /// γ ≤ 3/2 where Λ diverges, anisotropic roughness, GTR at an integer and a fractional γ).
 fn families() -> Vec<Value> {
     let px = profile(&[0.0, 0.4, 1.0, FRAC_PI_2], &[2.0, 1.5, 0.2, 0.0]);
@@ -157,7 +157,7 @@ const QUANTITIES: [&str; 14] = [
     "pdf_wm_visible",
 ];
 
-/// The quantities a model has a meaning for (DESIGN.md and the source documents): everything
+/// The quantities a model has a meaning for (ARCHITECTURE.md and the source documents): everything
 /// for the elliptic slope families (but Λ, G1, G2 only where γ > 3/2); D, Smith and sampling for
 /// the piecewise-linear NDF; D and Smith for the blend (no closed-form sampler); D, Smith,
 /// slopes and sampling (Burley's inversion) for GTR; D, Smith, slopes and the moments of the
@@ -445,7 +445,7 @@ fn every_family_answers_every_quantity_as_the_library_does() {
         let model = build(&spec);
         let supported = supported(&spec);
         for quantity in QUANTITIES {
-            // The library and DESIGN.md agree on what the family supports.
+            // The library and ARCHITECTURE.md agree on what the family supports.
             let has = match quantity {
                 "d" => true,
                 "lambda" | "g1" | "g2" => model.as_smith().is_some(),

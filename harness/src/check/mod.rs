@@ -1,5 +1,5 @@
 //! Checks: one property family per file, each planning cases for a model and turning each case
-//! into a [`CheckRecord`] against an oracle (DESIGN.md, "Checks and records"). A check never
+//! into a [`CheckRecord`] against an oracle (ARCHITECTURE.md, "Checks and records"). A check never
 //! panics and never asserts; only the audit's verdicts decide.
 
 pub mod against;

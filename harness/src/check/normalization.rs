@@ -26,7 +26,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> 
                     "normalization.projected_area",
                     s.label.clone(),
                     json!({}),
-                    "DESIGN.md model boundary: ∫ D(m)(m·n) dm = 1 (seed 001 eq 3; seed 000 eq 2; \
+                    "ARCHITECTURE.md model boundary: ∫ D(m)(m·n) dm = 1 (seed 001 eq 3; seed 000 eq 2; \
                      seed 004 §2)",
                 );
                 r.covers = vec![covers(family, "d", "default")];

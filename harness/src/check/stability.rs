@@ -17,7 +17,7 @@ use serde_json::{json, Value};
 use std::f64::consts::FRAC_PI_2;
 use std::sync::Arc;
 
-const SOURCE: &str = "DESIGN.md model boundary: D, Λ, G1 finite and in range for θ ∈ [0, π/2]; \
+const SOURCE: &str = "ARCHITECTURE.md model boundary: D, Λ, G1 finite and in range for θ ∈ [0, π/2]; \
                       sample_wm(u) a unit vector with m_z ≥ 0 for every u ∈ [0, 1)²";
 
 /// The largest double below 1.
@@ -208,7 +208,7 @@ pub fn plan(spec: &ModelSpec, why: &str) -> Vec<Planned> {
                             "stability.extremes",
                             variant_run.clone(),
                             case_run.clone(),
-                            "issue 2 / DESIGN.md: finite and accurate for γ ∈ (1.5, 1e8], \
+                            "issue 2 / ARCHITECTURE.md: finite and accurate for γ ∈ (1.5, 1e8], \
                              α ∈ [1e-4, 10], θ ∈ [0, π/2]",
                         );
                         r.covers = covered_run.clone();

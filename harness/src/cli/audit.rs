@@ -10,7 +10,7 @@ use std::path::PathBuf;
 /// The options of `mfh audit`.
 #[derive(Debug, Args)]
 pub struct AuditArgs {
-    /// The scene file (JSON, DESIGN.md "Scenes"); default: the embedded default scene.
+    /// The scene file (JSON, ARCHITECTURE.md "Scenes"); default: the embedded default scene.
     #[arg(long)]
     pub scene: Option<PathBuf>,
     /// How hard to look.

@@ -1,5 +1,5 @@
 //! Chi-square goodness-of-fit test of a normal sampler against its pdf over the (φ, cos θ)
-//! grid of the upper hemisphere (DESIGN.md, "Checks and records").
+//! grid of the upper hemisphere (ARCHITECTURE.md, "Checks and records").
 //!
 //! Procedure:
 //!

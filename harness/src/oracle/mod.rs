@@ -1,4 +1,4 @@
-//! Oracles: independent sources of truth the checks compare models with (DESIGN.md, "Checks and
+//! Oracles: independent sources of truth the checks compare models with (ARCHITECTURE.md, "Checks and
 //! records"). An oracle owes nothing to the code it checks.
 
 pub mod chi2;

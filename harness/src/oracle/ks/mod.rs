@@ -1,5 +1,5 @@
 //! Kolmogorov–Smirnov test of the 1-D marginals of a normal sampler — of cos θ_m and of φ_m —
-//! against the marginal CDFs of its pdf, tabulated by adaptive quadrature (DESIGN.md, "Checks
+//! against the marginal CDFs of its pdf, tabulated by adaptive quadrature (ARCHITECTURE.md, "Checks
 //! and records").
 //!
 //! Procedure:
