@@ -17,7 +17,8 @@ use serde_json::{json, Value};
 use std::f64::consts::FRAC_PI_2;
 use std::sync::Arc;
 
-const SOURCE: &str = "ARCHITECTURE.md model boundary: D, Λ, G1 finite and in range for θ ∈ [0, π/2]; \
+const SOURCE: &str =
+    "ARCHITECTURE.md model boundary: D, Λ, G1 finite and in range for θ ∈ [0, π/2]; \
                       sample_wm(u) a unit vector with m_z ≥ 0 for every u ∈ [0, 1)²";
 
 /// The largest double below 1.

@@ -87,40 +87,42 @@ fn the_renderers_correct_models_pass() {
     }
 }
 
-/// Each defect fails on the check that sees it (other checks may see it too).
-#[test]
-fn each_wrong_model_fails_on_its_check() {
-    let cases = [
-        (
-            Defect::NormalizationOnePercent,
-            "normalization.projected_area",
-        ),
-        (Defect::LambdaWrongAboveOnePointThree, "smith.lambda_route"),
-        (Defect::SamplerExponent, "sampling.chi2"),
-        (Defect::HalfCirclePhi, "sampling.chi2"),
-        (Defect::PdfMismatch, "sampling.pdf_jacobian"),
-        (Defect::BelowHorizonAtUZero, "stability.incidence"),
-        (Defect::NanAtNormalIncidence, "stability.incidence"),
-        (Defect::G2Uncorrelated, "smith.g1_g2"),
-        (Defect::AxesSwappedInD, "smith.lambda_route"),
-    ];
-    let mut missed = Vec::new();
-    for (defect, check) in cases {
-        let base = if defect == Defect::AxesSwappedInD {
-            Microfacet::anisotropic(Family::Ggx, 0.1, 0.4)
-        } else {
-            Microfacet::new(Family::Ggx, 0.3)
-        };
-        let report = audit(base.with(defect));
-        let failed = report.failed_checks();
-        eprintln!("{defect:?}: failed {failed:?}");
-        if !failed.contains(&check) {
-            missed.push(format!(
-                "{defect:?} did not fail {check} (failed: {failed:?})"
-            ));
+/// Audits the variant of `base` with `defect` and asserts that `check` is among the checks
+/// that failed (other checks may see the defect too).
+fn fails_on(base: Microfacet, defect: Defect, check: &str) {
+    let report = audit(base.with(defect));
+    let failed = report.failed_checks();
+    assert!(
+        failed.contains(&check),
+        "{defect:?} did not fail {check} (failed: {failed:?})"
+    );
+}
+
+/// One test per wrong model, each named for its defect.
+macro_rules! wrong_model {
+    ($($name:ident: $defect:ident => $check:literal,)*) => {$(
+        #[test]
+        fn $name() {
+            let base = if Defect::$defect == Defect::AxesSwappedInD {
+                Microfacet::anisotropic(Family::Ggx, 0.1, 0.4)
+            } else {
+                Microfacet::new(Family::Ggx, 0.3)
+            };
+            fails_on(base, Defect::$defect, $check);
         }
-    }
-    assert!(missed.is_empty(), "{missed:#?}");
+    )*};
+}
+
+wrong_model! {
+    normalization_off_by_one_percent: NormalizationOnePercent => "normalization.projected_area",
+    lambda_wrong_above_1_3_only: LambdaWrongAboveOnePointThree => "smith.lambda_route",
+    sampler_exponent_off: SamplerExponent => "sampling.chi2",
+    phi_over_half_the_circle: HalfCirclePhi => "sampling.chi2",
+    pdf_off_its_sampler_by_half_a_percent: PdfMismatch => "sampling.pdf_jacobian",
+    normal_below_the_horizon_at_u_zero: BelowHorizonAtUZero => "stability.incidence",
+    nan_at_exactly_normal_incidence: NanAtNormalIncidence => "stability.incidence",
+    height_correlated_g2_replaced_by_uncorrelated: G2Uncorrelated => "smith.g1_g2",
+    axes_swapped_in_d_only: AxesSwappedInD => "smith.lambda_route",
 }
 
 /// A model that panics or answers NaN inside its methods gives failing records; the audit
