@@ -22,6 +22,7 @@ pub mod plan_table;
 pub mod random;
 pub mod readback;
 pub mod record;
+pub mod record_serde;
 pub mod report;
 pub mod scene;
 pub mod shard;

@@ -1,7 +1,7 @@
 //! CheckRecord: what one check of one property of one model at one case found, and the schema
 //! version of the records (ARCHITECTURE.md, "Checks and records").
 
-use crate::readback::{interned, nullable_f64};
+use crate::record_serde::{interned, nullable_f64};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
@@ -76,7 +76,7 @@ pub struct OracleValue {
     pub uncertainty: f64,
     /// What the uncertainty is: `error_bound` or `standard_error`.
     #[serde(deserialize_with = "interned")]
-    pub kind: crate::readback::StaticStr,
+    pub kind: crate::record_serde::StaticStr,
 }
 
 /// The measured discrepancy.
@@ -136,13 +136,13 @@ impl Measured {
 pub struct AppliedTolerance {
     /// The tolerance's name in the table.
     #[serde(deserialize_with = "interned")]
-    pub name: crate::readback::StaticStr,
+    pub name: crate::record_serde::StaticStr,
     /// The allowed error (relative or absolute as `measured` says; for p-values, α).
     #[serde(deserialize_with = "nullable_f64")]
     pub value: f64,
     /// Why this tolerance.
     #[serde(deserialize_with = "interned")]
-    pub reason: crate::readback::StaticStr,
+    pub reason: crate::record_serde::StaticStr,
 }
 
 /// What a check cost.

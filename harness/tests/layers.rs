@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 /// The layer of each top-level module of the harness (lower imports nothing higher).
 fn layer(module: &str) -> Option<u32> {
     Some(match module {
-        "record" | "tolerance" | "random" | "messages" => 0,
+        "record" | "record_serde" | "tolerance" | "random" | "messages" => 0,
         "oracle" => 1,
-        "check" | "subject" => 2,
-        "scene" | "mitsuba" | "plan" | "plan_table" | "shard" => 3,
+        "check" | "subject" | "scene" | "mitsuba" => 2,
+        "plan" | "plan_table" => 3,
         "audit" | "gate" | "external" | "merge" | "baseline" | "cost" | "chi2_run" | "readback" => {
             4
         }
@@ -59,6 +59,11 @@ fn no_module_imports_a_layer_above_its_own() {
     rust_files(&src, &mut files);
     let mut violations = Vec::new();
     for file in &files {
+        // Test modules kept in their own files may reach anywhere, like `#[cfg(test)]` ones.
+        let name = file.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name == "tests.rs" || name.ends_with("_tests.rs") {
+            continue;
+        }
         let module = module_of(&src, file);
         let Some(own) = layer(&module) else {
             violations.push(format!(

@@ -35,6 +35,7 @@ fn not_audited(scene: &Scene) -> Vec<String> {
 }
 
 const MASKING_CHECKS: &[&str] = &[
+    "smith.g1_g2",
     "smith.identities",
     "smith.lambda_route",
     "smith.white_furnace",
@@ -44,12 +45,17 @@ const NORMAL_SAMPLING: &[&str] = &[
     "sampling.ks_marginals",
     "sampling.lambda_monte_carlo",
     "sampling.pdf_consistency",
+    "sampling.pdf_jacobian",
 ];
 const VISIBLE_SAMPLING: &[&str] = &[
     "sampling.chi2_visible",
     "sampling.pdf_visible_normalization",
 ];
-const EVERY_MATERIAL: &[&str] = &["normalization.projected_area", "stability.extremes"];
+const EVERY_MATERIAL: &[&str] = &[
+    "normalization.projected_area",
+    "stability.extremes",
+    "stability.incidence",
+];
 /// Certified double-double values of D and Λ: isotropic models only.
 const ISOTROPIC: &[&str] = &["precise.closed_form"];
 

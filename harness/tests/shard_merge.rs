@@ -68,7 +68,8 @@ fn normalized(mut v: Value) -> Value {
         if let Some(a) = r["artefacts"].as_array_mut() {
             for p in a.iter_mut() {
                 let s = p.as_str().unwrap_or("");
-                *p = Value::from(s.find("chi2/").map_or(s, |i| &s[i..]));
+                let at = s.find("chi2/").or_else(|| s.find("ks/"));
+                *p = Value::from(at.map_or(s, |i| &s[i..]));
             }
         }
     }

@@ -169,8 +169,9 @@ fn the_audit_writes_a_report_html_that_chromium_renders() {
     }
     let images = html.matches("<img ").count();
     // Per material Λ and G1 (2 + 2); GGX: 3 chi-square maps and 2 KS plots; 2 limits (D and
-    // Λ); 1 Pareto plot.
-    let expected = 2 + 2 + 3 + 2 + 2 + 1;
+    // Λ); 1 Pareto plot; and Λ and G1 of each of the six stressed shapes the STD material's
+    // route stress cases audit (γ ∈ {20, 50, 90, 171.8, 1e3, 1e6}: 6 × 2).
+    let expected = 2 + 2 + 3 + 2 + 2 + 1 + 6 * 2;
     assert_eq!(images, expected, "images in report.html");
     // report.json lists the chi-square artefacts (and holds no tables); they exist.
     let report: Value =
