@@ -169,7 +169,7 @@ fn gtr_g1(gamma: f64, alpha: f64, theta: f64) -> Estimate {
             ..Estimate::default()
         };
     };
-    let lam = lambda_oracle(m.as_ref(), &spec, from_spherical(theta, 0.0));
+    let lam = lambda_oracle(m.as_ref(), from_spherical(theta, 0.0));
     Estimate {
         value: 1.0 / (1.0 + lam.value),
         error_bound: lam.error_bound / (1.0 + lam.value).powi(2),
@@ -258,7 +258,7 @@ fn trapezoid_error() -> Result<Measurement, String> {
         let lam = smith
             .lambda_route(w, "domain_split")
             .map_err(|e| e.to_string())?;
-        let o = lambda_oracle(m.as_ref(), &spec, w).value;
+        let o = lambda_oracle(m.as_ref(), w).value;
         let e = ((1.0 + o) / (1.0 + lam) - 1.0).abs();
         max = max.max(e);
     }

@@ -127,7 +127,7 @@ fn run_case(
         .unwrap_or(f64::NAN);
     match smith.lambda_route(w, route) {
         Ok(v) => {
-            let oracle = *oracle.get_or_init(|| lambda_oracle(m, spec, w));
+            let oracle = *oracle.get_or_init(|| lambda_oracle(m, w));
             compare(&mut r, v, oracle, &CLOSED_FORM);
             apply_expected(&mut r, family, route);
         }
@@ -160,7 +160,7 @@ fn run_case(
                 let value = student_lambda::route(route, c)
                     .map(|f| f(c, x, sigma))
                     .unwrap_or(f64::NAN);
-                let oracle = *oracle.get_or_init(|| lambda_oracle(m, spec, w));
+                let oracle = *oracle.get_or_init(|| lambda_oracle(m, w));
                 r.check = "smith.lambda_route_loss".into();
                 compare(&mut r, value, oracle, &CLOSED_FORM);
                 apply_expected(&mut r, family, route);

@@ -88,8 +88,7 @@ const STUDENT_TAIL_LIMIT: f64 = 1.6;
 /// The oracle of Λ(w): (1/μ)∫_μ^∞ (q − μ) P2(q) dq along the azimuth of w for slope-space
 /// models; otherwise ∫⟨−w·m⟩⁺ D(m) dm / cos θ (the back-facing projected area, which equals
 /// Λ cos θ without the cancellation of ∫⟨w·m⟩⁺D dm − cos θ).
-/// (`_spec` is the model's spec as JSON, read from the model itself now.)
-pub fn lambda_oracle(model: &dyn Model, _spec: &serde_json::Value, w: Vec3) -> Estimate {
+pub fn lambda_oracle(model: &dyn Model, w: Vec3) -> Estimate {
     lambda_oracle_for(&Subject::borrowed(model), w)
 }
 

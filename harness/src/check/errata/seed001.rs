@@ -51,7 +51,7 @@ fn std_route(route: &'static str, gamma: f64) -> Result<Shown, String> {
     Ok(Shown::new(
         printed,
         corrected,
-        lambda_oracle(m.as_ref(), &spec, w),
+        lambda_oracle(m.as_ref(), w),
         &ERRATUM,
     ))
 }
