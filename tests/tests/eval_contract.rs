@@ -5,99 +5,16 @@
 //! answers keep the order of the queries, a bad line does not stop the others, and the exit
 //! status is 2 exactly when some line failed.
 
-use mfh_harness::cli::run;
 use mfh_reference::geometry::{from_spherical, Vec3};
 use mfh_reference::ndf::gtr_lambda::ROUTES as GTR_ROUTES;
 use mfh_reference::ndf::student_lambda::ROUTES;
-use mfh_reference::sg::{Asg, Sg};
 use mfh_reference::{Masking, Model, ModelSpec, QueryError};
 use serde_json::{json, Value};
 use std::f64::consts::FRAC_PI_2;
 
-/// One in-process run of `mfh`.
-struct Run {
-    status: i32,
-    stdout: String,
-    stderr: String,
-}
+mod eval_support;
 
-/// Runs `mfh <args>` with `stdin` as standard input.
-fn mfh(args: &[&str], stdin: &str) -> Run {
-    let argv: Vec<&str> = std::iter::once("mfh").chain(args.iter().copied()).collect();
-    let (mut out, mut err) = (Vec::new(), Vec::new());
-    let status = run(argv, &mut stdin.as_bytes(), &mut out, &mut err);
-    Run {
-        status,
-        stdout: String::from_utf8(out).expect("stdout is UTF-8"),
-        stderr: String::from_utf8(err).expect("stderr is UTF-8"),
-    }
-}
-
-/// The answer lines, each parsed (each must be one JSON object).
-fn answers(r: &Run) -> Vec<Value> {
-    r.stdout
-        .lines()
-        .map(|l| {
-            let v: Value = serde_json::from_str(l).unwrap_or_else(|e| panic!("{l:?}: {e}"));
-            assert!(v.is_object(), "answer {l} is not an object");
-            v
-        })
-        .collect()
-}
-
-/// Query lines, one per line.
-fn lines(queries: &[Value]) -> String {
-    queries.iter().map(|q| format!("{q}\n")).collect()
-}
-
-/// What the library answers: a JSON value, or the kind of error the CLI must report.
-type Expect = Result<Value, &'static str>;
-
-/// A number as the contract writes it: finite numbers as JSON numbers, the rest as strings.
-fn num(x: f64) -> Value {
-    if x.is_nan() {
-        json!("nan")
-    } else if x == f64::INFINITY {
-        json!("inf")
-    } else if x == f64::NEG_INFINITY {
-        json!("-inf")
-    } else {
-        json!(x)
-    }
-}
-
-/// Equality of answers with numbers compared bit for bit (a JSON number written from an f64
-/// parses back to the same f64).
-fn same(a: &Value, b: &Value) -> bool {
-    match (a, b) {
-        (Value::Number(x), Value::Number(y)) => {
-            x.as_f64().map(f64::to_bits) == y.as_f64().map(f64::to_bits)
-        }
-        (Value::Array(x), Value::Array(y)) => {
-            x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same(x, y))
-        }
-        (Value::Object(x), Value::Object(y)) => {
-            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| same(v, w)))
-        }
-        _ => a == b,
-    }
-}
-
-/// Asserts that `answer` is what `expect` says, for the query `query`.
-fn assert_answer(query: &Value, answer: &Value, expect: &Expect) {
-    match expect {
-        Ok(v) => assert!(
-            same(answer, &json!({ "value": v })),
-            "{query}\n  answered {answer}\n  library  {v}"
-        ),
-        Err(kind) => {
-            assert_eq!(answer["error"]["kind"], *kind, "{query} answered {answer}");
-            let message = answer["error"]["message"].as_str().unwrap_or("");
-            assert!(!message.is_empty(), "{query}: error without message");
-            assert_eq!(answer.as_object().map(|o| o.len()), Some(1), "{answer}");
-        }
-    }
-}
+use eval_support::{answers, assert_answer, lines, mfh, num, Expect};
 
 fn build(spec: &Value) -> Box<dyn Model> {
     serde_json::from_value::<ModelSpec>(spec.clone())
@@ -740,119 +657,6 @@ fn command_line_errors_and_help() {
     let r = mfh(&["eval", "--help"], "");
     assert_eq!(r.status, 0);
     assert!(r.stdout.contains("--input"), "{}", r.stdout);
-}
-
-/// An SG as the contract writes it.
-fn sg_json(axis: Vec3, sharpness: f64, amplitude: f64) -> Value {
-    json!({"axis": axis, "sharpness": sharpness, "amplitude": amplitude})
-}
-
-#[test]
-fn spherical_gaussian_quantities_answer_as_the_library_does() {
-    let (a_axis, b_axis, v) = (
-        from_spherical(0.3, 0.2),
-        from_spherical(0.5, 1.9),
-        from_spherical(0.4, 0.6),
-    );
-    let a = Sg::new(a_axis, 8.0, 1.5).unwrap();
-    let b = Sg::new(b_axis, 20.0, 0.7).unwrap();
-    let (ax, ay, az) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
-    let g = Asg::new(ax, ay, az, [6.0, 15.0], 2.0).unwrap();
-    let asg_json = json!({"x": ax, "y": ay, "z": az, "bandwidths": [6.0, 15.0], "amplitude": 2.0});
-    let (aj, bj) = (sg_json(a_axis, 8.0, 1.5), sg_json(b_axis, 20.0, 0.7));
-    let p = a.product(&b);
-    let warped = a.warp(v).unwrap();
-    let cases: Vec<(Value, Expect)> = vec![
-        (
-            json!({"quantity": "sg_eval", "a": aj, "v": v}),
-            Ok(num(a.eval(v))),
-        ),
-        (
-            json!({"quantity": "sg_inner", "a": aj, "b": bj}),
-            Ok(num(a.inner(&b))),
-        ),
-        (
-            json!({"quantity": "sg_inner", "a": aj, "b": bj, "route": "printed"}),
-            Ok(num(a.inner_printed(&b))),
-        ),
-        (
-            json!({"quantity": "sg_inner", "a": aj, "b": bj, "route": "exact"}),
-            Ok(num(a.inner_exact(&b))),
-        ),
-        (
-            json!({"quantity": "sg_product", "a": aj, "b": bj}),
-            Ok(
-                json!({"axis": p.axis().map(num), "sharpness": num(p.sharpness()),
-                      "amplitude": num(p.amplitude())}),
-            ),
-        ),
-        (
-            json!({"quantity": "sg_integral", "a": aj}),
-            Ok(num(a.integral())),
-        ),
-        (
-            json!({"quantity": "sg_integral", "a": aj, "route": "exact"}),
-            Ok(num(a.integral_exact())),
-        ),
-        (
-            json!({"quantity": "sg_integral", "a": aj, "cap": 0.7}),
-            Ok(num(a.cap_integral(0.7).unwrap())),
-        ),
-        (
-            json!({"quantity": "sg_integral", "a": aj, "cap": 0.7, "route": "cap_product"}),
-            Ok(num(a.cap_product(0.7).unwrap().integral())),
-        ),
-        (
-            json!({"quantity": "sg_warp", "a": aj, "o": v}),
-            Ok(
-                json!({"axis": warped.axis().map(num), "sharpness": num(warped.sharpness()),
-                      "amplitude": num(warped.amplitude())}),
-            ),
-        ),
-        (
-            json!({"quantity": "asg_eval", "asg": asg_json, "v": v}),
-            Ok(num(g.eval(v))),
-        ),
-        (
-            json!({"quantity": "asg_integral", "asg": asg_json}),
-            Ok(num(g.integral().unwrap())),
-        ),
-        (
-            json!({"quantity": "asg_integral", "asg": asg_json, "route": "large_bandwidth"}),
-            Ok(num(g.integral_large_bandwidth().unwrap())),
-        ),
-        (
-            json!({"quantity": "asg_sg_convolution", "asg": asg_json, "sg": bj}),
-            Ok(num(g.convolve_sg(&b).unwrap())),
-        ),
-        (
-            json!({"quantity": "asg_sg_convolution", "asg": asg_json,
-                   "sg": {"sharpness": 20.0, "amplitude": 0.7}, "v": b_axis}),
-            Ok(num(g.convolve_sg(&b).unwrap())),
-        ),
-        // Errors: an unknown route, a missing argument, a bad lobe, a bad direction.
-        (
-            json!({"quantity": "sg_eval", "a": aj, "v": v, "route": "exact"}),
-            Err("route"),
-        ),
-        (json!({"quantity": "sg_inner", "a": aj}), Err("argument")),
-        (
-            json!({"quantity": "sg_eval", "a": {"axis": a_axis}, "v": v}),
-            Err("model"),
-        ),
-        (
-            json!({"quantity": "sg_eval", "a": aj, "v": [0, 0, 2]}),
-            Err("argument"),
-        ),
-    ];
-    let queries: Vec<Value> = cases.iter().map(|c| c.0.clone()).collect();
-    let r = mfh(&["eval"], &lines(&queries));
-    let got = answers(&r);
-    assert_eq!(got.len(), cases.len());
-    for ((q, e), a) in cases.iter().zip(&got) {
-        assert_answer(q, a, e);
-    }
-    assert_eq!(r.status, 2);
 }
 
 /// The contract's model list covers every family of the registry: a new family must be added

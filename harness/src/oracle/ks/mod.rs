@@ -367,6 +367,34 @@ where
     S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
+    ks_test_lobe_kept(sample, pdf, marginal, lobe, theta_kinks, config).result
+}
+
+/// A KS test's result with what it judged: the sorted marginal values it drew and the model's
+/// CDF table, so that a plot of the two shows the test without drawing the samples again.
+#[derive(Debug, Clone)]
+pub struct KsKept {
+    /// The result.
+    pub result: KsResult,
+    /// The drawn marginal values, sorted (samples outside the domain are not among them).
+    pub sorted: Vec<f64>,
+    /// The model's CDF table of the marginal.
+    pub table: CdfTable,
+}
+
+/// [`ks_test_lobe`], keeping the sorted samples and the CDF table ([`KsKept`]).
+pub fn ks_test_lobe_kept<S, P>(
+    sample: &S,
+    pdf: &P,
+    marginal: Marginal,
+    lobe: &Lobe,
+    theta_kinks: &[f64],
+    config: &KsConfig,
+) -> KsKept
+where
+    S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
+    P: Fn(Vec3) -> f64 + Sync + ?Sized,
+{
     let t = Instant::now();
     let mut drawn = draw(sample, marginal, config.samples, config.seed);
     drawn.values.par_sort_unstable_by(f64::total_cmp);
@@ -392,10 +420,19 @@ where
         table_seconds: t.elapsed().as_secs_f64(),
     };
     result.reason = sanity(&drawn, &table, config.samples);
-    if result.reason.is_some() {
-        return result;
+    if result.reason.is_none() {
+        judge(&mut result, &drawn.values, &table, config);
     }
-    let (d, at) = ks_statistic(&drawn.values, &|x| table.cdf(x));
+    KsKept {
+        result,
+        sorted: drawn.values,
+        table,
+    }
+}
+
+/// D_N of the sorted `values` against `table`, λ, the p-value and the verdict.
+fn judge(result: &mut KsResult, values: &[f64], table: &CdfTable, config: &KsConfig) {
+    let (d, at) = ks_statistic(values, &|x| table.cdf(x));
     result.statistic = d;
     result.at = at;
     result.lambda = stephens_lambda(d, config.samples);
@@ -408,7 +445,6 @@ where
             alpha: config.alpha,
         });
     }
-    result
 }
 
 /// The failures that leave no statistic: samples outside the domain, no samples, an invalid

@@ -1,0 +1,154 @@
+//! Kolmogorov–Smirnov tests of the cos θ and φ marginals of a normal sampler, one record per
+//! marginal, with the model's and the samples' CDF curves in the record's data.
+
+use super::SOURCE;
+use crate::check::{applied, covers, timed, PlannedCheck};
+use crate::oracle::ks::{self, KsConfig, Marginal};
+use crate::record::{CheckRecord, Measured, Verdict};
+use crate::subject::Subject;
+use crate::tolerance::STATISTICAL_ALPHA;
+use serde_json::{json, Value};
+use std::sync::Arc;
+
+/// Plans the KS test of one marginal of a model's sampler: `sampling.ks_marginals`, case
+/// `{"marginal": "cos_theta" | "phi", "samples": N}`. The record's value is D_N; its case gains
+/// the table's knots and error bound, Stephens' λ and where D_N is attained. Sanity failures
+/// fail without a p-value; a CDF table too coarse for N is an error (no verdict).
+pub(super) fn plan_ks<'a>(
+    subject: &Arc<Subject<'a>>,
+    marginal: Marginal,
+    samples: u64,
+    why: &str,
+) -> PlannedCheck<'a> {
+    let family = subject.family();
+    let spec = &subject.label;
+    let model = subject.clone();
+    let case = json!({"marginal": marginal.name(), "samples": samples});
+    let (spec_run, case_run) = (spec.clone(), case.clone());
+    let kinks = subject.theta_kinks();
+    PlannedCheck {
+        check: "sampling.ks_marginals".into(),
+        model: spec.clone(),
+        case,
+        why: format!(
+            "{why}: the {} marginal of the sampled normals must follow the pdf's",
+            marginal.name()
+        ),
+        covers: vec![covers(family, "sample_wm", "default")],
+        statistical: true,
+        run: Box::new(move |ctx| {
+            timed(|| {
+                let mut r = CheckRecord::new(
+                    "sampling.ks_marginals",
+                    spec_run.clone(),
+                    case_run.clone(),
+                    SOURCE,
+                );
+                r.covers = vec![covers(family, "sample_wm", "default")];
+                r.seed = Some(ctx.seed);
+                let Some(sampler) = model.model.as_sampler() else {
+                    r.verdict = Verdict::Error {
+                        message: "the model has no sampler".into(),
+                    };
+                    return r;
+                };
+                let config = KsConfig {
+                    samples,
+                    seed: ctx.seed,
+                    alpha: STATISTICAL_ALPHA.value,
+                };
+                let kept = ks::ks_test_lobe_kept(
+                    &|u| sampler.sample_wm(u),
+                    &|m| sampler.pdf_wm(m),
+                    marginal,
+                    model.lobe(),
+                    &kinks,
+                    &config,
+                );
+                fill_ks(&mut r, &kept.result);
+                r.data = ks_marginal_data(&kept);
+                r
+            })
+        }),
+    }
+}
+
+/// Points of the KS marginal curves in a record's data.
+pub(super) const KS_CURVE_POINTS: usize = 256;
+
+/// The KS marginal's curves for the report: the model's CDF (the test's own table) and the
+/// empirical CDF of the very samples the test drew and judged (kept by the test, not drawn
+/// again), at [`KS_CURVE_POINTS`] points of the marginal's range. `None` after a sanity failure
+/// (no statistic to show).
+pub(super) fn ks_marginal_data(kept: &ks::KsKept) -> Option<crate::record::RecordData> {
+    let result = &kept.result;
+    if matches!(&result.reason, Some(reason) if !matches!(reason, ks::Failure::Rejected { .. })) {
+        return None;
+    }
+    let values = &kept.sorted;
+    let [lo, hi] = result.marginal.range();
+    let n = values.len().max(1) as f64;
+    let x: Vec<f64> = (0..KS_CURVE_POINTS)
+        .map(|i| lo + (hi - lo) * i as f64 / (KS_CURVE_POINTS - 1) as f64)
+        .collect();
+    let empirical_cdf = x
+        .iter()
+        .map(|&t| values.partition_point(|&v| v <= t) as f64 / n)
+        .collect();
+    let model_cdf = x.iter().map(|&t| kept.table.cdf(t)).collect();
+    Some(crate::record::RecordData::KsMarginal {
+        marginal: result.marginal.name().to_string(),
+        x,
+        model_cdf,
+        empirical_cdf,
+        samples: result.samples,
+        seed: result.seed,
+    })
+}
+
+/// Fills a `sampling.ks_marginals` record from a KS result.
+fn fill_ks(r: &mut CheckRecord, result: &ks::KsResult) {
+    r.cost.samples = result.samples;
+    r.cost.evaluations = result.evaluations;
+    r.tolerance = Some(applied(&STATISTICAL_ALPHA));
+    if let Value::Object(case) = &mut r.case {
+        case.insert("knots".into(), json!(result.knots));
+        case.insert("table_error_bound".into(), json!(result.table_error_bound));
+    }
+    match &result.reason {
+        Some(ks::Failure::TableInaccurate { .. }) => {
+            r.verdict = Verdict::Error {
+                message: result
+                    .reason
+                    .as_ref()
+                    .map(ToString::to_string)
+                    .unwrap_or_default(),
+            };
+        }
+        Some(reason) if !matches!(reason, ks::Failure::Rejected { .. }) => {
+            r.verdict = Verdict::Fail;
+            if let Value::Object(case) = &mut r.case {
+                case.insert("sanity_failure".into(), json!(reason.to_string()));
+            }
+        }
+        _ => {
+            r.value = Some(result.statistic);
+            if let Value::Object(case) = &mut r.case {
+                case.insert("lambda".into(), json!(result.lambda));
+                case.insert("at".into(), json!(result.at));
+            }
+            r.measured = Some(Measured::PValue {
+                p: result.p_value,
+                statistic: result.statistic,
+                dof: 0,
+                alpha: STATISTICAL_ALPHA.value,
+            });
+            // Provisional: the audit re-decides with the Šidák level.
+            r.verdict = if result.p_value >= STATISTICAL_ALPHA.value {
+                Verdict::Pass
+            } else {
+                Verdict::Fail
+            };
+        }
+    }
+}

@@ -1,0 +1,160 @@
+//! Visible-normal sampling: the chi-square of `sample_wm_visible` against `pdf_wm_visible` at
+//! fixed incidences and the normalization of `pdf_wm_visible` (Heitz & d'Eon 2014, Heitz 2018).
+
+use super::{fill_chi2, skipped};
+use crate::check::{compare, covers, timed, PlannedCheck, Profile};
+use crate::oracle::chi2::{chi2_test_to, Chi2Config, KINKED_CELL_RELATIVE_TOLERANCE};
+use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
+use crate::record::CheckRecord;
+use crate::subject::Subject;
+use crate::tolerance::{NORMALIZATION, STATISTICAL_ALPHA};
+use mfh_reference::geometry::{from_spherical, Vec3};
+use serde_json::json;
+use std::sync::Arc;
+
+/// The incidences (θ, φ) at which visible-normal sampling is checked: a moderate and a
+/// near-grazing one, off the x axis so that anisotropic stretching is exercised.
+pub const VISIBLE_INCIDENCES: [(f64, f64); 2] = [(0.5, 0.3), (1.3, 0.3)];
+
+const VISIBLE_SOURCE: &str = "Heitz & d'Eon 2014 (CGF 33(4)) eq 2 and §4 (Beckmann, with Jakob      2014's inversion); Heitz 2018 (JCGT 7(4)) (GGX); cited by seed 001 §7 as [9]";
+
+/// The polar angles (inside (0, π/2)) of the kinks of ⟨wi·m⟩⁺ (the terminator) and of the
+/// reflected direction's horizon (2(wi·m)m_z = wi_z) along azimuth φ of m, for wi_z > 0.
+pub fn visible_kinks(wi: Vec3, phi: f64) -> Vec<f64> {
+    let k = wi[0] * phi.cos() + wi[1] * phi.sin();
+    let psi = k.atan2(wi[2]);
+    let mut out = vec![std::f64::consts::FRAC_PI_4 + 0.5 * psi];
+    if k < 0.0 {
+        out.push(std::f64::consts::FRAC_PI_2 + psi);
+    }
+    out
+}
+
+/// The azimuths of m in [0, 2π) where the terminator of ⟨wi·m⟩⁺ meets the normal, for wi at
+/// azimuth `phi_i`: φi ± π/2 (the polar kinks of [`visible_kinks`] start there).
+pub fn terminator_azimuths(phi_i: f64) -> [f64; 2] {
+    let tau = std::f64::consts::TAU;
+    let q = std::f64::consts::FRAC_PI_2;
+    [(phi_i + q).rem_euclid(tau), (phi_i - q).rem_euclid(tau)]
+}
+
+/// Plans the visible-normal sampling checks of one model (scene `sampling: visible_normals`):
+/// `sampling.chi2_visible` at each of [`VISIBLE_INCIDENCES`] and
+/// `sampling.pdf_visible_normalization` (∫ pdf_wm_visible dm = 1 by quadrature). A model without
+/// a visible-normal sampler gets one skipped `sampling.chi2_visible` record that says so: the
+/// scene is valid (the renderer may sample visible normals its own way), but there is no
+/// reference sampler to check it against.
+pub fn plan_visible<'a>(
+    subject: &Arc<Subject<'a>>,
+    profile: Profile,
+    why: &str,
+) -> Vec<PlannedCheck<'a>> {
+    let spec = subject.label.clone();
+    let family = subject.family();
+    if subject.model.as_visible_sampler().is_none() {
+        return vec![skipped(
+            "sampling.chi2_visible",
+            &spec,
+            json!({}),
+            why,
+            format!(
+                "{family} has no visible-normal sampler in the reference crate (only GGX and \
+                 Beckmann do; STD has none in closed form, seed 001 §7.1): nothing to check \
+                 the renderer's against"
+            ),
+        )];
+    }
+    let samples = profile.chi2_samples();
+    let resolution = 16;
+    let mut out = Vec::new();
+    for &(theta, phi) in &VISIBLE_INCIDENCES {
+        let (m, spec_run) = (subject.clone(), spec.clone());
+        let case = json!({"theta_i": theta, "phi_i": phi, "samples": samples,
+                          "resolution": resolution});
+        let case_run = case.clone();
+        let ids = vec![
+            covers(family, "sample_wm_visible", "default"),
+            covers(family, "pdf_wm_visible", "default"),
+        ];
+        let ids_run = ids.clone();
+        out.push(PlannedCheck {
+            check: "sampling.chi2_visible".into(),
+            model: spec.clone(),
+            case,
+            why: format!("{why}: importance sampling of visible normals"),
+            covers: ids,
+            statistical: true,
+            run: Box::new(move |ctx| {
+                timed(|| {
+                    let mut r = CheckRecord::new(
+                        "sampling.chi2_visible",
+                        spec_run.clone(),
+                        case_run.clone(),
+                        VISIBLE_SOURCE,
+                    );
+                    r.covers = ids_run.clone();
+                    r.seed = Some(ctx.seed);
+                    let v = m
+                        .model
+                        .as_visible_sampler()
+                        .expect("planned for visible samplers");
+                    let wi = from_spherical(theta, phi);
+                    let config = Chi2Config {
+                        resolution,
+                        samples,
+                        seed: ctx.seed,
+                        alpha: STATISTICAL_ALPHA.value,
+                    };
+                    let result = chi2_test_to(
+                        &|u| v.sample_wm_visible(wi, u),
+                        &|mm| v.pdf_wm_visible(wi, mm),
+                        &config,
+                        KINKED_CELL_RELATIVE_TOLERANCE,
+                    );
+                    fill_chi2(&mut r, &result, ctx, samples);
+                    r
+                })
+            }),
+        });
+        let (m, spec_run) = (subject.clone(), spec.clone());
+        let case = json!({"theta_i": theta, "phi_i": phi});
+        let case_run = case.clone();
+        out.push(PlannedCheck {
+            check: "sampling.pdf_visible_normalization".into(),
+            model: spec.clone(),
+            case,
+            why: format!("{why}: the visible-normal density must integrate to 1"),
+            covers: vec![covers(family, "pdf_wm_visible", "default")],
+            statistical: false,
+            run: Box::new(move |_| {
+                timed(|| {
+                    let mut r = CheckRecord::new(
+                        "sampling.pdf_visible_normalization",
+                        spec_run.clone(),
+                        case_run.clone(),
+                        VISIBLE_SOURCE,
+                    );
+                    r.covers = vec![covers(family, "pdf_wm_visible", "default")];
+                    let v = m
+                        .model
+                        .as_visible_sampler()
+                        .expect("planned for visible samplers");
+                    let wi = from_spherical(theta, phi);
+                    let kinks = |p: f64| visible_kinks(wi, p);
+                    let e = integrate_hemisphere(
+                        &|mm| v.pdf_wm_visible(wi, mm),
+                        m.lobe().width(),
+                        Some(Cuts {
+                            theta: &kinks,
+                            phi: &terminator_azimuths(phi),
+                        }),
+                        Accuracy::relative(1e-11),
+                    );
+                    compare(&mut r, 1.0, e, &NORMALIZATION);
+                    r
+                })
+            }),
+        });
+    }
+    out
+}
