@@ -380,7 +380,11 @@ impl Scene {
         let mut scene = Scene::parse(DEFAULT_SCENE, "<default scene>")
             .expect("the embedded default scene is valid");
         for family in mfh_reference::registry::FAMILIES {
-            if scene.materials.iter().any(|m| m.model.family() == family.name) {
+            if scene
+                .materials
+                .iter()
+                .any(|m| m.model.family() == family.name)
+            {
                 continue;
             }
             let model: ModelSpec = serde_json::from_str(family.examples[0])
