@@ -599,12 +599,12 @@ mod tests {
         let v = value(
             r#"{"model":{"family":"std","gamma":2.5,"alpha":0.3},"quantity":"lambda","theta":1.2}"#,
         );
-        let m = ModelSpec::Std {
+        let m = ModelSpec::Std(mfh_reference::ndf::student::StdSpec {
             gamma: 2.5,
             alpha: Some(0.3),
             alpha_x: None,
             alpha_y: None,
-        }
+        })
         .build()
         .unwrap();
         let expected = m.as_smith().unwrap().lambda(from_spherical(1.2, 0.0));

@@ -461,7 +461,10 @@ impl<'input> Reader<'_, 'input> {
                         let cc = format!("{name}/clearcoat");
                         self.materials.push(Material {
                             name: cc.clone(),
-                            model: ModelSpec::Gtr { gamma: 1.0, alpha },
+                            model: ModelSpec::Gtr(mfh_reference::ndf::gtr::GtrSpec {
+                                gamma: 1.0,
+                                alpha,
+                            }),
                             masking: None,
                             sampling: Some(Sampling::Normals),
                         });
@@ -497,17 +500,17 @@ fn microfacet_spec(distribution: &str, alpha_u: f64, alpha_v: f64) -> ModelSpec 
         (None, Some(u), Some(v))
     };
     if distribution == "ggx" {
-        ModelSpec::Ggx {
+        ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
             alpha,
             alpha_x,
             alpha_y,
-        }
+        })
     } else {
-        ModelSpec::Beckmann {
+        ModelSpec::Beckmann(mfh_reference::ndf::beckmann::BeckmannSpec {
             alpha,
             alpha_x,
             alpha_y,
-        }
+        })
     }
 }
 
@@ -530,11 +533,11 @@ mod tests {
         assert_eq!(m.name, "metal");
         assert_eq!(
             m.model,
-            ModelSpec::Beckmann {
+            ModelSpec::Beckmann(mfh_reference::ndf::beckmann::BeckmannSpec {
                 alpha: Some(0.1),
                 alpha_x: None,
                 alpha_y: None
-            }
+            })
         );
         assert_eq!(m.masking, Some(Masking::Uncorrelated));
         assert_eq!(m.sampling, Some(Sampling::VisibleNormals));
@@ -550,21 +553,21 @@ mod tests {
         .unwrap();
         let aspect = (1.0f64 - 0.45).sqrt();
         match &s.materials[0].model {
-            ModelSpec::Ggx {
+            ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
                 alpha_x: Some(x),
                 alpha_y: Some(y),
                 ..
-            } => {
+            }) => {
                 assert!((x - 0.36 / aspect).abs() < 1e-15 && (y - 0.36 * aspect).abs() < 1e-15);
             }
             other => panic!("{other:?}"),
         }
         assert_eq!(
             s.materials[1].model,
-            ModelSpec::Gtr {
+            ModelSpec::Gtr(mfh_reference::ndf::gtr::GtrSpec {
                 gamma: 1.0,
                 alpha: 0.1 - 0.099 * 0.5
-            }
+            })
         );
         assert_eq!(s.not_audited.len(), 1);
     }
@@ -580,10 +583,10 @@ mod tests {
         assert_eq!(s.materials[0].name, "roughconductor@3:16");
         assert!(matches!(
             s.materials[0].model,
-            ModelSpec::Ggx {
+            ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
                 alpha: Some(a),
                 ..
-            } if a == 0.25
+            }) if a == 0.25
         ));
         let e = scene(r#"<bsdf type="roughconductor"><float name="alpha" value="$b"/></bsdf>"#)
             .unwrap_err()

@@ -371,9 +371,34 @@ impl Scene {
         Ok(())
     }
 
-    /// The embedded default scene.
+    /// The embedded default scene: `scenes/default.json`, plus one material for every family of
+    /// the registry that the file does not name (its first registry example, with every effect
+    /// the model supports: masking height-correlated where it has Λ, normal sampling where it
+    /// has a sampler), so that a family added to the registry is audited by the main job
+    /// without editing the scene.
     pub fn default_scene() -> Scene {
-        Scene::parse(DEFAULT_SCENE, "<default scene>").expect("the embedded default scene is valid")
+        let mut scene = Scene::parse(DEFAULT_SCENE, "<default scene>")
+            .expect("the embedded default scene is valid");
+        for family in mfh_reference::registry::FAMILIES {
+            if scene
+                .materials
+                .iter()
+                .any(|m| m.model.family() == family.name)
+            {
+                continue;
+            }
+            let model: ModelSpec = serde_json::from_str(family.examples[0])
+                .expect("registry examples parse (the registry test)");
+            let built = model.build().expect("registry examples build");
+            let has_smith = built.as_smith().is_some() && model.smith_limit().is_none();
+            scene.materials.push(Material {
+                name: format!("{} (registry example)", family.name),
+                masking: has_smith.then_some(Masking::HeightCorrelated),
+                sampling: built.as_sampler().map(|_| Sampling::Normals),
+                model,
+            });
+        }
+        scene
     }
 }
 

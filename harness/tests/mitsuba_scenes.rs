@@ -74,11 +74,11 @@ fn conductor_plans_ggx_with_separable_masking_and_visible_normals() {
     assert_eq!(m.name, "gold");
     assert_eq!(
         m.model,
-        ModelSpec::Ggx {
+        ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
             alpha: Some(0.2),
             alpha_x: None,
             alpha_y: None
-        }
+        })
     );
     assert_eq!(m.masking, Some(Masking::Uncorrelated));
     assert_eq!(m.sampling, Some(Sampling::VisibleNormals));
@@ -122,20 +122,20 @@ fn mixed_scene_walks_wrappers_params_and_refs_and_lists_the_rest() {
     // $dist = ggx, α_u = 0.05, α_v = $floor_alpha = 0.3; referenced twice, planned once.
     assert_eq!(
         s.materials[0].model,
-        ModelSpec::Ggx {
+        ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
             alpha: None,
             alpha_x: Some(0.05),
             alpha_y: Some(0.3)
-        }
+        })
     );
     // roughplastic's default distribution is Beckmann.
     assert_eq!(
         s.materials[1].model,
-        ModelSpec::Beckmann {
+        ModelSpec::Beckmann(mfh_reference::ndf::beckmann::BeckmannSpec {
             alpha: Some(0.3),
             alpha_x: None,
             alpha_y: None
-        }
+        })
     );
     assert_eq!(s.materials[2].sampling, Some(Sampling::Normals));
     assert!(s
@@ -185,11 +185,11 @@ fn anisotropic_principled_plans_its_ggx_lobe_and_gtr1_clear_coat() {
     let s = load("principled.xml");
     let aspect = (1.0f64 - 0.9 * 0.75).sqrt();
     match &s.materials[0].model {
-        ModelSpec::Ggx {
+        ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
             alpha: None,
             alpha_x: Some(x),
             alpha_y: Some(y),
-        } => {
+        }) => {
             assert!((x - 0.25 / aspect).abs() < 1e-15 && (y - 0.25 * aspect).abs() < 1e-15)
         }
         other => panic!("{other:?}"),
@@ -197,7 +197,7 @@ fn anisotropic_principled_plans_its_ggx_lobe_and_gtr1_clear_coat() {
     let cc = &s.materials[1];
     assert_eq!(cc.name, "car_paint/clearcoat");
     match cc.model {
-        ModelSpec::Gtr { gamma, alpha } => {
+        ModelSpec::Gtr(mfh_reference::ndf::gtr::GtrSpec { gamma, alpha }) => {
             assert_eq!(gamma, 1.0);
             assert!((alpha - 0.0604).abs() < 1e-15, "{alpha}");
         }

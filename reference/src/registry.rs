@@ -1,11 +1,13 @@
 //! The family registry: everything the harness knows about a family of reference models, in one
-//! place. Each family's own file declares its [`FamilyInfo`]; [`FAMILIES`] lists them, and
-//! [`info`] maps a spec to its entry (an exhaustive match: a new `ModelSpec` variant without a
-//! registry entry does not compile). Planners, tests, the default scene's coverage test, the
+//! place. Each family's own file declares its spec type (parameters, validation, construction:
+//! [`FamilySpec`]) and its [`FamilyInfo`]; one line per family in the `registry!` list below
+//! makes the [`ModelSpec`] enum, [`FAMILIES`] and [`info`] from them. Planners, tests, the default scene's coverage test, the
 //! eval contract and the value-stability vectors iterate this registry, so no list of family
 //! names is written anywhere else.
 
-use crate::spec::ModelSpec;
+use serde::{Deserialize, Serialize};
+
+use crate::spec::FamilySpec;
 
 /// What the harness knows about one family of reference models.
 #[derive(Debug, Clone, Copy)]
@@ -67,34 +69,72 @@ pub fn zero_mean(_: &ModelSpec) -> [f64; 2] {
     [0.0, 0.0]
 }
 
-/// Every family, in the order reports list them.
-pub const FAMILIES: [&FamilyInfo; 10] = [
-    &crate::ndf::beckmann::INFO,
-    &crate::ndf::ggx::INFO,
-    &crate::ndf::student::STD_INFO,
-    &crate::ndf::student::HYPER_CAUCHY_INFO,
-    &crate::ndf::student::FIXED_VARIANCE_INFO,
-    &crate::ndf::student::GENERAL_INFO,
-    &crate::ndf::piecewise::INFO,
-    &crate::ndf::blend::INFO,
-    &crate::ndf::gtr::INFO,
-    &crate::slopes::gaussian::INFO,
-];
+/// Declares the families: one line per family, `Variant(SpecType) => INFO`, where the spec type
+/// and the [`FamilyInfo`] live in the family's own file. From this list the macro writes the
+/// [`ModelSpec`] enum (serde-tagged by `family`, the variant name in snake_case), [`FAMILIES`],
+/// [`info`], `ModelSpec::family_spec` and `From<SpecType> for ModelSpec`. Adding a family is its
+/// file (its model, its spec type implementing [`FamilySpec`], its `INFO`) and one line here.
+macro_rules! registry {
+    ($($(#[$doc:meta])* $variant:ident($spec:ty) => $info:path),+ $(,)?) => {
+        /// A model described as data, e.g. `{"family": "std", "gamma": 2.5, "alpha": 0.3}`
+        /// (ARCHITECTURE.md, "Evaluating closed forms"). Unknown keys are errors. Each variant
+        /// holds its family's spec type, declared in the family's file; the variants are the
+        /// lines of the registry below.
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[serde(tag = "family", rename_all = "snake_case")]
+        pub enum ModelSpec {
+            $($(#[$doc])* $variant($spec),)+
+        }
 
-/// The registry entry of a spec's family.
-pub fn info(spec: &ModelSpec) -> &'static FamilyInfo {
-    match spec {
-        ModelSpec::Beckmann { .. } => &crate::ndf::beckmann::INFO,
-        ModelSpec::Ggx { .. } => &crate::ndf::ggx::INFO,
-        ModelSpec::Std { .. } => &crate::ndf::student::STD_INFO,
-        ModelSpec::HyperCauchy { .. } => &crate::ndf::student::HYPER_CAUCHY_INFO,
-        ModelSpec::StudentFixedVariance { .. } => &crate::ndf::student::FIXED_VARIANCE_INFO,
-        ModelSpec::StudentGeneral { .. } => &crate::ndf::student::GENERAL_INFO,
-        ModelSpec::Gtr { .. } => &crate::ndf::gtr::INFO,
-        ModelSpec::PiecewiseLinear { .. } => &crate::ndf::piecewise::INFO,
-        ModelSpec::Blend { .. } => &crate::ndf::blend::INFO,
-        ModelSpec::GaussianSlopes { .. } => &crate::slopes::gaussian::INFO,
-    }
+        impl ModelSpec {
+            /// The family's own spec: its parameters, validation and construction.
+            pub fn family_spec(&self) -> &dyn FamilySpec {
+                match self {
+                    $(ModelSpec::$variant(s) => s,)+
+                }
+            }
+        }
+
+        $(impl From<$spec> for ModelSpec {
+            fn from(s: $spec) -> ModelSpec {
+                ModelSpec::$variant(s)
+            }
+        })+
+
+        /// Every family, in the order reports list them.
+        pub const FAMILIES: [&FamilyInfo; [$(stringify!($variant)),+].len()] = [$(&$info),+];
+
+        /// The registry entry of a spec's family.
+        pub fn info(spec: &ModelSpec) -> &'static FamilyInfo {
+            match spec {
+                $(ModelSpec::$variant(_) => &$info,)+
+            }
+        }
+    };
+}
+
+registry! {
+    /// Beckmann (seed 001, Table 1, γ → ∞).
+    Beckmann(crate::ndf::beckmann::BeckmannSpec) => crate::ndf::beckmann::INFO,
+    /// GGX / Trowbridge–Reitz (seed 001, Table 1, γ = 2).
+    Ggx(crate::ndf::ggx::GgxSpec) => crate::ndf::ggx::INFO,
+    /// Student's t NDF, STD (seed 001, f = 1/(γ−1)); `gamma: "inf"` is Beckmann.
+    Std(crate::ndf::student::StdSpec) => crate::ndf::student::STD_INFO,
+    /// Hyper-Cauchy (seed 001, eq 8, f = 1).
+    HyperCauchy(crate::ndf::student::HyperCauchySpec) => crate::ndf::student::HYPER_CAUCHY_INFO,
+    /// The fixed-variance Student member (seed 001, eq 9, f = 1/(γ−2)); `gamma: "inf"` is
+    /// Beckmann.
+    StudentFixedVariance(crate::ndf::student::FixedVarianceSpec) => crate::ndf::student::FIXED_VARIANCE_INFO,
+    /// The general isotropic family D^G(B, C) (seed 001, eq 1–2).
+    StudentGeneral(crate::ndf::student::GeneralSpec) => crate::ndf::student::GENERAL_INFO,
+    /// The piecewise-linear NDF (seed 000, eq 1–5).
+    PiecewiseLinear(crate::ndf::piecewise::PiecewiseSpec) => crate::ndf::piecewise::INFO,
+    /// Two isotropic models combined by eq 1 of seed 000.
+    Blend(crate::ndf::blend::BlendSpec) => crate::ndf::blend::INFO,
+    /// Generalized-Trowbridge-Reitz (Burley 2012; Smith G1 of seed 004), isotropic.
+    Gtr(crate::ndf::gtr::GtrSpec) => crate::ndf::gtr::INFO,
+    /// A Gaussian distribution of slopes N(s̄, Σ) (seed 002, eq 1; slope sign of eq 11).
+    GaussianSlopes(crate::slopes::gaussian::GaussianSlopesSpec) => crate::slopes::gaussian::INFO,
 }
 
 /// The registry entry of a family name.

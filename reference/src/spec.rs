@@ -1,123 +1,12 @@
-//! Models described as data (`ModelSpec`, serde) and built into validated models.
+//! Models described as data (`ModelSpec`, serde) and built into validated models. The
+//! `ModelSpec` enum is written by the registry (`crate::registry`) from one line per family;
+//! each family's spec type lives in its own file and implements [`FamilySpec`].
 
-use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use serde::{Deserializer, Serializer};
 
 use crate::error::ParamError;
 use crate::model::Model;
-use crate::ndf::{Beckmann, Blend, Ggx, PiecewiseLinear, Profile, Student};
-
-/// A model described as data, e.g. `{"family": "std", "gamma": 2.5, "alpha": 0.3}`
-/// (ARCHITECTURE.md, "Evaluating closed forms"). Unknown keys are errors.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "family", rename_all = "snake_case", deny_unknown_fields)]
-pub enum ModelSpec {
-    /// Beckmann (seed 001, Table 1, γ → ∞).
-    Beckmann {
-        /// Isotropic roughness.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha: Option<f64>,
-        /// Roughness along x.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_x: Option<f64>,
-        /// Roughness along y.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_y: Option<f64>,
-    },
-    /// GGX / Trowbridge–Reitz (seed 001, Table 1, γ = 2).
-    Ggx {
-        /// Isotropic roughness.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha: Option<f64>,
-        /// Roughness along x.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_x: Option<f64>,
-        /// Roughness along y.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_y: Option<f64>,
-    },
-    /// Student's t NDF, STD (seed 001, f = 1/(γ−1)); `gamma: "inf"` is Beckmann.
-    Std {
-        /// Shape γ > 1, or +∞.
-        #[serde(with = "gamma_serde")]
-        gamma: f64,
-        /// Isotropic roughness.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha: Option<f64>,
-        /// Roughness along x.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_x: Option<f64>,
-        /// Roughness along y.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_y: Option<f64>,
-    },
-    /// Hyper-Cauchy (seed 001, eq 8, f = 1).
-    HyperCauchy {
-        /// Shape γ > 1.
-        #[serde(with = "gamma_serde")]
-        gamma: f64,
-        /// Isotropic roughness.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha: Option<f64>,
-        /// Roughness along x.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_x: Option<f64>,
-        /// Roughness along y.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_y: Option<f64>,
-    },
-    /// The fixed-variance Student member (seed 001, eq 9, f = 1/(γ−2)); `gamma: "inf"` is
-    /// Beckmann.
-    StudentFixedVariance {
-        /// Shape γ > 2, or +∞.
-        #[serde(with = "gamma_serde")]
-        gamma: f64,
-        /// Isotropic roughness.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha: Option<f64>,
-        /// Roughness along x.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_x: Option<f64>,
-        /// Roughness along y.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_y: Option<f64>,
-    },
-    /// The general isotropic family D^G(B, C) (seed 001, eq 1–2).
-    StudentGeneral {
-        /// B > 0.
-        b: f64,
-        /// C > 1.
-        c: f64,
-    },
-    /// The piecewise-linear NDF (seed 000, eq 1–5).
-    PiecewiseLinear {
-        /// The profile D_x (alone: the isotropic D_iso).
-        x: Profile,
-        /// The profile D_y of the anisotropic blend (eq 1).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        y: Option<Profile>,
-    },
-    /// Two isotropic models combined by eq 1 of seed 000.
-    Blend {
-        /// The model along x.
-        x: Box<ModelSpec>,
-        /// The model along y.
-        y: Box<ModelSpec>,
-    },
-    /// A Gaussian distribution of slopes N(s̄, Σ) (seed 002, eq 1; slope sign of eq 11).
-    GaussianSlopes {
-        /// The mean slope s̄ = `[s̄x, s̄y]`.
-        mean: [f64; 2],
-        /// The covariance Σ = `[[σx², cxy], [cxy, σy²]]`, symmetric positive definite.
-        cov: [[f64; 2]; 2],
-    },
-    /// Generalized-Trowbridge-Reitz (Burley 2012; Smith G1 of seed 004), isotropic.
-    Gtr {
-        /// Shape 0 ≤ γ ≤ 10.
-        gamma: f64,
-        /// Roughness 1e-4 ≤ α ≤ 1.
-        alpha: f64,
-    },
-}
+pub use crate::registry::ModelSpec;
 
 /// Resolves `alpha` or (`alpha_x`, `alpha_y`) into validated per-axis roughness.
 pub fn resolve_roughness(
@@ -140,116 +29,63 @@ pub fn resolve_roughness(
     }
 }
 
+/// What every family's spec type does (each family's file implements it for its spec type; the
+/// registry's line for the family makes it a [`ModelSpec`] variant).
+pub trait FamilySpec {
+    /// Validates the parameters and builds the model.
+    fn build(&self) -> Result<Box<dyn Model>, ParamError>;
+
+    /// The parameter (name, value) that puts the model outside the domain of its Smith Λ, if
+    /// any: for the Student-t members with γ ≤ 3/2 (and D^G(B, C) with C ≤ 3/2) the mean slope
+    /// diverges and Λ = ∞ at every incidence (seed 001 eq 18).
+    fn smith_limit(&self) -> Option<(&'static str, f64)> {
+        None
+    }
+}
+
+/// Per-axis roughness written back as a spec's fields: `alpha` when isotropic, otherwise
+/// `alpha_x` and `alpha_y` (the inverse of [`resolve_roughness`]).
+pub fn roughness_fields(alpha_x: f64, alpha_y: f64) -> (Option<f64>, Option<f64>, Option<f64>) {
+    if alpha_x == alpha_y {
+        (Some(alpha_x), None, None)
+    } else {
+        (None, Some(alpha_x), Some(alpha_y))
+    }
+}
+
+/// The Smith limit of a Student-t shape parameter: Λ exists for `value` > 3/2 only.
+pub fn student_smith_limit(field: &'static str, value: f64) -> Option<(&'static str, f64)> {
+    (value <= 1.5).then_some((field, value))
+}
+
 impl ModelSpec {
     /// The family name, as written in the spec's `family` key.
     pub fn family(&self) -> &'static str {
-        match self {
-            ModelSpec::Beckmann { .. } => "beckmann",
-            ModelSpec::Ggx { .. } => "ggx",
-            ModelSpec::Std { .. } => "std",
-            ModelSpec::HyperCauchy { .. } => "hyper_cauchy",
-            ModelSpec::StudentFixedVariance { .. } => "student_fixed_variance",
-            ModelSpec::StudentGeneral { .. } => "student_general",
-            ModelSpec::PiecewiseLinear { .. } => "piecewise_linear",
-            ModelSpec::Blend { .. } => "blend",
-            ModelSpec::GaussianSlopes { .. } => "gaussian_slopes",
-            ModelSpec::Gtr { .. } => "gtr",
-        }
+        crate::registry::info(self).name
     }
 
-    /// Why the model has no Smith Λ (and so no G1 or G2), if that follows from its parameters:
-    /// for the Student-t members with γ ≤ 3/2 (and D^G(B, C) with C ≤ 3/2) the mean slope
-    /// diverges and Λ = ∞ at every incidence (seed 001 eq 18: the slope integral behind Λ,
-    /// ((γ−1)σ² + μ²)^{3/2−γ}/(3−2γ), diverges for γ ≤ 3/2).
-    /// The message names the field and the limit.
+    /// Why the model has no Smith Λ (and so no G1 or G2), if that follows from its parameters
+    /// ([`FamilySpec::smith_limit`]). The message names the field and the limit.
     pub fn smith_limit(&self) -> Option<String> {
-        let (field, value) = match *self {
-            ModelSpec::Std { gamma, .. } | ModelSpec::HyperCauchy { gamma, .. } => ("gamma", gamma),
-            ModelSpec::StudentGeneral { c, .. } => ("c", c),
-            _ => return None,
-        };
-        (value <= 1.5).then(|| {
-            format!(
-                "{} {field} = {value} has no Smith Λ: Λ diverges for {field} ≤ 3/2 (the mean \
-                 slope is infinite); masking needs {field} > 3/2",
-                self.family()
-            )
-        })
+        let (field, value) = self.family_spec().smith_limit()?;
+        Some(format!(
+            "{} {field} = {value} has no Smith Λ: Λ diverges for {field} ≤ 3/2 (the mean \
+             slope is infinite); masking needs {field} > 3/2",
+            self.family()
+        ))
     }
 
     /// Validates the parameters and builds the model.
     pub fn build(&self) -> Result<Box<dyn Model>, ParamError> {
-        use crate::ndf::student::Member;
-        Ok(match *self {
-            ModelSpec::Beckmann {
-                alpha,
-                alpha_x,
-                alpha_y,
-            } => {
-                let (ax, ay) = resolve_roughness(alpha, alpha_x, alpha_y)?;
-                Box::new(Beckmann::new(ax, ay)?)
-            }
-            ModelSpec::Ggx {
-                alpha,
-                alpha_x,
-                alpha_y,
-            } => {
-                let (ax, ay) = resolve_roughness(alpha, alpha_x, alpha_y)?;
-                Box::new(Ggx::new(ax, ay)?)
-            }
-            ModelSpec::Std {
-                gamma,
-                alpha,
-                alpha_x,
-                alpha_y,
-            } => {
-                let (ax, ay) = resolve_roughness(alpha, alpha_x, alpha_y)?;
-                if gamma == f64::INFINITY {
-                    Box::new(Beckmann::new(ax, ay)?.described_as(self.clone()))
-                } else {
-                    Box::new(Student::new(Member::Std, gamma, ax, ay)?)
-                }
-            }
-            ModelSpec::HyperCauchy {
-                gamma,
-                alpha,
-                alpha_x,
-                alpha_y,
-            } => {
-                let (ax, ay) = resolve_roughness(alpha, alpha_x, alpha_y)?;
-                Box::new(Student::new(Member::HyperCauchy, gamma, ax, ay)?)
-            }
-            ModelSpec::StudentFixedVariance {
-                gamma,
-                alpha,
-                alpha_x,
-                alpha_y,
-            } => {
-                let (ax, ay) = resolve_roughness(alpha, alpha_x, alpha_y)?;
-                if gamma == f64::INFINITY {
-                    Box::new(Beckmann::new(ax, ay)?.described_as(self.clone()))
-                } else {
-                    Box::new(Student::new(Member::FixedVariance, gamma, ax, ay)?)
-                }
-            }
-            ModelSpec::StudentGeneral { b, c } => Box::new(Student::general(b, c)?),
-            ModelSpec::PiecewiseLinear { ref x, ref y } => {
-                Box::new(PiecewiseLinear::new(x.clone(), y.clone())?)
-            }
-            ModelSpec::Blend { ref x, ref y } => Box::new(Blend::new(x.build()?, y.build()?)?),
-            ModelSpec::GaussianSlopes { mean, cov } => {
-                Box::new(crate::slopes::GaussianSlopes::new(mean, cov)?)
-            }
-            ModelSpec::Gtr { gamma, alpha } => Box::new(crate::ndf::Gtr::new(gamma, alpha)?),
-        })
+        self.family_spec().build()
     }
 }
 
 /// γ as a JSON number, or the string `"inf"` for +∞.
-mod gamma_serde {
+pub(crate) mod gamma_serde {
     use super::*;
 
-    pub fn serialize<S: Serializer>(gamma: &f64, s: S) -> Result<S::Ok, S::Error> {
+    pub(crate) fn serialize<S: Serializer>(gamma: &f64, s: S) -> Result<S::Ok, S::Error> {
         if *gamma == f64::INFINITY {
             s.serialize_str("inf")
         } else {
@@ -291,7 +127,7 @@ mod gamma_serde {
         }
     }
 
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    pub(crate) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
         d.deserialize_any(GammaVisitor)
     }
 }
@@ -307,7 +143,7 @@ mod tests {
     #[test]
     fn parse_build_and_round_trip() {
         let s = parse(r#"{"family":"std","gamma":"inf","alpha":0.3}"#).expect("parses");
-        assert!(matches!(s, ModelSpec::Std { gamma, .. } if gamma == f64::INFINITY));
+        assert!(matches!(&s, ModelSpec::Std(std) if std.gamma == f64::INFINITY));
         let m = s.build().expect("builds");
         assert_eq!(m.family(), "std");
         assert_eq!(m.spec(), s);
@@ -359,10 +195,10 @@ mod tests {
         let s = parse(r#"{"family":"gtr","gamma":1.5,"alpha":0.3}"#).unwrap();
         assert_eq!(
             s,
-            ModelSpec::Gtr {
+            ModelSpec::Gtr(crate::ndf::gtr::GtrSpec {
                 gamma: 1.5,
                 alpha: 0.3
-            }
+            })
         );
         assert_eq!(s.family(), "gtr");
         let m = s.build().unwrap();

@@ -44,25 +44,27 @@ pub fn models() -> Vec<ModelSpec> {
     let mut specs = Vec::new();
     for alpha in ALPHAS {
         let alpha = Some(alpha);
-        specs.push(ModelSpec::Beckmann {
+        specs.push(ModelSpec::Beckmann(
+            mfh_reference::ndf::beckmann::BeckmannSpec {
+                alpha,
+                alpha_x: None,
+                alpha_y: None,
+            },
+        ));
+        specs.push(ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
             alpha,
             alpha_x: None,
             alpha_y: None,
-        });
-        specs.push(ModelSpec::Ggx {
-            alpha,
-            alpha_x: None,
-            alpha_y: None,
-        });
+        }));
     }
     for gamma in GAMMAS {
         for alpha in ALPHAS {
-            specs.push(ModelSpec::Std {
+            specs.push(ModelSpec::Std(mfh_reference::ndf::student::StdSpec {
                 gamma,
                 alpha: Some(alpha),
                 alpha_x: None,
                 alpha_y: None,
-            });
+            }));
         }
     }
     specs

@@ -426,10 +426,10 @@ mod tests {
     use super::*;
 
     fn model() -> Arc<dyn Model> {
-        let spec = ModelSpec::GaussianSlopes {
+        let spec = ModelSpec::GaussianSlopes(mfh_reference::slopes::gaussian::GaussianSlopesSpec {
             mean: [0.1, -0.2],
             cov: [[0.04, 0.01], [0.01, 0.09]],
-        };
+        });
         Arc::from(spec.build().unwrap())
     }
 
@@ -493,10 +493,10 @@ mod dump {
     #[test]
     #[ignore]
     fn standard() {
-        let spec = ModelSpec::GaussianSlopes {
+        let spec = ModelSpec::GaussianSlopes(mfh_reference::slopes::gaussian::GaussianSlopesSpec {
             mean: [0.1, -0.2],
             cov: [[0.04, 0.01], [0.01, 0.09]],
-        };
+        });
         let ctx = crate::check::RunContext { seed: 1, out: None };
         for p in plan(
             Arc::from(spec.build().unwrap()),

@@ -65,18 +65,22 @@ pub fn plan(alpha: f64, why: &str) -> Vec<Planned> {
                                 m.as_smith()?.lambda(w)
                             })
                         };
-                        let std = |g: f64| ModelSpec::Std {
-                            gamma: g,
-                            alpha: Some(alpha),
-                            alpha_x: None,
-                            alpha_y: None,
-                        };
-                        let (Some(limit), Some(at_inf)) = (
-                            eval(ModelSpec::Beckmann {
+                        let std = |g: f64| {
+                            ModelSpec::Std(mfh_reference::ndf::student::StdSpec {
+                                gamma: g,
                                 alpha: Some(alpha),
                                 alpha_x: None,
                                 alpha_y: None,
-                            }),
+                            })
+                        };
+                        let (Some(limit), Some(at_inf)) = (
+                            eval(ModelSpec::Beckmann(
+                                mfh_reference::ndf::beckmann::BeckmannSpec {
+                                    alpha: Some(alpha),
+                                    alpha_x: None,
+                                    alpha_y: None,
+                                },
+                            )),
                             eval(std(f64::INFINITY)),
                         ) else {
                             r.verdict = Verdict::Error {

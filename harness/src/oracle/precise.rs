@@ -262,22 +262,22 @@ impl PreciseModel {
             )),
         };
         match *spec {
-            ModelSpec::Beckmann {
+            ModelSpec::Beckmann(mfh_reference::ndf::beckmann::BeckmannSpec {
                 alpha,
                 alpha_x,
                 alpha_y,
-            } => Self::new(Family::Beckmann, isotropic(alpha, alpha_x, alpha_y)?),
-            ModelSpec::Ggx {
+            }) => Self::new(Family::Beckmann, isotropic(alpha, alpha_x, alpha_y)?),
+            ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
                 alpha,
                 alpha_x,
                 alpha_y,
-            } => Self::new(Family::Ggx, isotropic(alpha, alpha_x, alpha_y)?),
-            ModelSpec::Std {
+            }) => Self::new(Family::Ggx, isotropic(alpha, alpha_x, alpha_y)?),
+            ModelSpec::Std(mfh_reference::ndf::student::StdSpec {
                 gamma,
                 alpha,
                 alpha_x,
                 alpha_y,
-            } => {
+            }) => {
                 let family = if gamma == f64::INFINITY {
                     Family::Beckmann
                 } else {
@@ -306,22 +306,22 @@ impl PreciseModel {
     pub fn spec(&self) -> ModelSpec {
         let alpha = Some(self.alpha);
         match self.family {
-            Family::Beckmann => ModelSpec::Beckmann {
+            Family::Beckmann => ModelSpec::Beckmann(mfh_reference::ndf::beckmann::BeckmannSpec {
                 alpha,
                 alpha_x: None,
                 alpha_y: None,
-            },
-            Family::Ggx => ModelSpec::Ggx {
+            }),
+            Family::Ggx => ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
                 alpha,
                 alpha_x: None,
                 alpha_y: None,
-            },
-            Family::Std { gamma } => ModelSpec::Std {
+            }),
+            Family::Std { gamma } => ModelSpec::Std(mfh_reference::ndf::student::StdSpec {
                 gamma,
                 alpha,
                 alpha_x: None,
                 alpha_y: None,
-            },
+            }),
         }
     }
 

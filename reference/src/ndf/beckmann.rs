@@ -244,23 +244,40 @@ impl SlopeDistribution for Beckmann {
     }
 }
 
+/// The spec of a Beckmann model: `{"family": "beckmann", "alpha": 0.3}`, or `alpha_x` and
+/// `alpha_y`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeckmannSpec {
+    /// Isotropic roughness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha: Option<f64>,
+    /// Roughness along x.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha_x: Option<f64>,
+    /// Roughness along y.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha_y: Option<f64>,
+}
+
+impl crate::spec::FamilySpec for BeckmannSpec {
+    fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
+        let (ax, ay) = crate::spec::resolve_roughness(self.alpha, self.alpha_x, self.alpha_y)?;
+        Ok(Box::new(Beckmann::new(ax, ay)?))
+    }
+}
+
 impl Model for Beckmann {
     fn spec(&self) -> ModelSpec {
-        self.described_as
-            .clone()
-            .unwrap_or(if self.alpha_x == self.alpha_y {
-                ModelSpec::Beckmann {
-                    alpha: Some(self.alpha_x),
-                    alpha_x: None,
-                    alpha_y: None,
-                }
-            } else {
-                ModelSpec::Beckmann {
-                    alpha: None,
-                    alpha_x: Some(self.alpha_x),
-                    alpha_y: Some(self.alpha_y),
-                }
+        self.described_as.clone().unwrap_or_else(|| {
+            let (alpha, alpha_x, alpha_y) =
+                crate::spec::roughness_fields(self.alpha_x, self.alpha_y);
+            ModelSpec::Beckmann(BeckmannSpec {
+                alpha,
+                alpha_x,
+                alpha_y,
             })
+        })
     }
 
     fn family(&self) -> &'static str {

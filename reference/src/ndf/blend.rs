@@ -151,12 +151,28 @@ impl Smith for Blend {
     }
 }
 
+/// The spec of a blend: `{"family": "blend", "x": {…}, "y": {…}}`, two isotropic model specs.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlendSpec {
+    /// The model along x.
+    pub x: Box<ModelSpec>,
+    /// The model along y.
+    pub y: Box<ModelSpec>,
+}
+
+impl crate::spec::FamilySpec for BlendSpec {
+    fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
+        Ok(Box::new(Blend::new(self.x.build()?, self.y.build()?)?))
+    }
+}
+
 impl Model for Blend {
     fn spec(&self) -> ModelSpec {
-        ModelSpec::Blend {
+        ModelSpec::Blend(BlendSpec {
             x: Box::new(self.x.spec()),
             y: Box::new(self.y.spec()),
-        }
+        })
     }
 
     fn family(&self) -> &'static str {
@@ -187,7 +203,7 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
 
 /// The kinks of a blend: those of its two models.
 pub fn blend_kinks(spec: &crate::ModelSpec) -> Vec<f64> {
-    let crate::ModelSpec::Blend { x, y } = spec else {
+    let crate::ModelSpec::Blend(BlendSpec { x, y }) = spec else {
         return Vec::new();
     };
     let mut out = (crate::registry::info(x).theta_kinks)(x);

@@ -197,21 +197,36 @@ impl SlopeDistribution for Ggx {
     }
 }
 
+/// The spec of a GGX model: `{"family": "ggx", "alpha": 0.3}`, or `alpha_x` and `alpha_y`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GgxSpec {
+    /// Isotropic roughness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha: Option<f64>,
+    /// Roughness along x.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha_x: Option<f64>,
+    /// Roughness along y.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha_y: Option<f64>,
+}
+
+impl crate::spec::FamilySpec for GgxSpec {
+    fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
+        let (ax, ay) = crate::spec::resolve_roughness(self.alpha, self.alpha_x, self.alpha_y)?;
+        Ok(Box::new(Ggx::new(ax, ay)?))
+    }
+}
+
 impl Model for Ggx {
     fn spec(&self) -> ModelSpec {
-        if self.alpha_x == self.alpha_y {
-            ModelSpec::Ggx {
-                alpha: Some(self.alpha_x),
-                alpha_x: None,
-                alpha_y: None,
-            }
-        } else {
-            ModelSpec::Ggx {
-                alpha: None,
-                alpha_x: Some(self.alpha_x),
-                alpha_y: Some(self.alpha_y),
-            }
-        }
+        let (alpha, alpha_x, alpha_y) = crate::spec::roughness_fields(self.alpha_x, self.alpha_y);
+        ModelSpec::Ggx(GgxSpec {
+            alpha,
+            alpha_x,
+            alpha_y,
+        })
     }
 
     fn family(&self) -> &'static str {

@@ -312,12 +312,28 @@ impl SlopeDistribution for Gtr {
     }
 }
 
+/// The spec of a GTR model: `{"family": "gtr", "gamma": 1.5, "alpha": 0.3}`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GtrSpec {
+    /// Shape 0 ≤ γ ≤ 10.
+    pub gamma: f64,
+    /// Roughness 1e-4 ≤ α ≤ 1.
+    pub alpha: f64,
+}
+
+impl crate::spec::FamilySpec for GtrSpec {
+    fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
+        Ok(Box::new(Gtr::new(self.gamma, self.alpha)?))
+    }
+}
+
 impl Model for Gtr {
     fn spec(&self) -> ModelSpec {
-        ModelSpec::Gtr {
+        ModelSpec::Gtr(GtrSpec {
             gamma: self.gamma,
             alpha: self.alpha,
-        }
+        })
     }
 
     fn family(&self) -> &'static str {

@@ -647,12 +647,33 @@ impl Smith for PiecewiseLinear {
     }
 }
 
+/// The spec of a piecewise-linear NDF: `{"family": "piecewise_linear", "x": {"theta": […],
+/// "value": […]}}`, with an optional profile `y` for the anisotropic blend.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PiecewiseSpec {
+    /// The profile D_x (alone: the isotropic D_iso).
+    pub x: Profile,
+    /// The profile D_y of the anisotropic blend (eq 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y: Option<Profile>,
+}
+
+impl crate::spec::FamilySpec for PiecewiseSpec {
+    fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
+        Ok(Box::new(PiecewiseLinear::new(
+            self.x.clone(),
+            self.y.clone(),
+        )?))
+    }
+}
+
 impl Model for PiecewiseLinear {
     fn spec(&self) -> ModelSpec {
-        ModelSpec::PiecewiseLinear {
+        ModelSpec::PiecewiseLinear(PiecewiseSpec {
             x: self.x.clone(),
             y: self.y.clone(),
-        }
+        })
     }
 
     fn family(&self) -> &'static str {
@@ -685,7 +706,7 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
 /// The interior breakpoints of a piecewise-linear spec's profiles (both of the anisotropic
 /// blend, whose weights depend on φ only): D has kinks there for every azimuth.
 pub fn profile_kinks(spec: &crate::ModelSpec) -> Vec<f64> {
-    let crate::ModelSpec::PiecewiseLinear { x, y } = spec else {
+    let crate::ModelSpec::PiecewiseLinear(PiecewiseSpec { x, y }) = spec else {
         return Vec::new();
     };
     let mut out: Vec<f64> = x

@@ -336,37 +336,111 @@ impl SlopeDistribution for Student {
     }
 }
 
+/// Declares the spec type of a Student member parameterized by γ and roughness (STD,
+/// Hyper-Cauchy, fixed variance: the same fields, a different member; `beckmann_at_inf` says
+/// whether `gamma: "inf"` builds the Beckmann limit, seed 001 §4).
+macro_rules! student_spec {
+    ($(#[$doc:meta])* $name:ident, $member:expr, $variant:ident, beckmann_at_inf: $inf:expr) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct $name {
+            /// Shape γ (a number, or the string `"inf"`).
+            #[serde(with = "crate::spec::gamma_serde")]
+            pub gamma: f64,
+            /// Isotropic roughness.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub alpha: Option<f64>,
+            /// Roughness along x.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub alpha_x: Option<f64>,
+            /// Roughness along y.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub alpha_y: Option<f64>,
+        }
+
+        impl crate::spec::FamilySpec for $name {
+            fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
+                let (ax, ay) =
+                    crate::spec::resolve_roughness(self.alpha, self.alpha_x, self.alpha_y)?;
+                if $inf && self.gamma == f64::INFINITY {
+                    let limit = crate::ndf::Beckmann::new(ax, ay)?;
+                    Ok(Box::new(limit.described_as(ModelSpec::$variant(self.clone()))))
+                } else {
+                    Ok(Box::new(Student::new($member, self.gamma, ax, ay)?))
+                }
+            }
+
+            fn smith_limit(&self) -> Option<(&'static str, f64)> {
+                crate::spec::student_smith_limit("gamma", self.gamma)
+            }
+        }
+    };
+}
+
+student_spec!(
+    /// The spec of an STD model (seed 001, f = 1/(γ−1)): `{"family": "std", "gamma": 2.5,
+    /// "alpha": 0.3}`; `gamma: "inf"` is Beckmann.
+    StdSpec, Member::Std, Std, beckmann_at_inf: true
+);
+student_spec!(
+    /// The spec of a Hyper-Cauchy model (seed 001 eq 8, f = 1), γ > 1.
+    HyperCauchySpec, Member::HyperCauchy, HyperCauchy, beckmann_at_inf: false
+);
+student_spec!(
+    /// The spec of the fixed-variance Student member (seed 001 eq 9, f = 1/(γ−2)), γ > 2;
+    /// `gamma: "inf"` is Beckmann.
+    FixedVarianceSpec, Member::FixedVariance, StudentFixedVariance, beckmann_at_inf: true
+);
+
+/// The spec of the general isotropic family D^G(B, C) (seed 001 eq 1–2):
+/// `{"family": "student_general", "b": 4, "c": 2.5}`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeneralSpec {
+    /// B > 0.
+    pub b: f64,
+    /// C > 1.
+    pub c: f64,
+}
+
+impl crate::spec::FamilySpec for GeneralSpec {
+    fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
+        Ok(Box::new(Student::general(self.b, self.c)?))
+    }
+
+    fn smith_limit(&self) -> Option<(&'static str, f64)> {
+        crate::spec::student_smith_limit("c", self.c)
+    }
+}
+
 impl Model for Student {
     fn spec(&self) -> ModelSpec {
-        let (alpha, alpha_x, alpha_y) = if self.alpha_x == self.alpha_y {
-            (Some(self.alpha_x), None, None)
-        } else {
-            (None, Some(self.alpha_x), Some(self.alpha_y))
-        };
+        let (alpha, alpha_x, alpha_y) = crate::spec::roughness_fields(self.alpha_x, self.alpha_y);
         let gamma = self.c;
         match self.member {
-            Member::Std => ModelSpec::Std {
+            Member::Std => ModelSpec::Std(StdSpec {
                 gamma,
                 alpha,
                 alpha_x,
                 alpha_y,
-            },
-            Member::HyperCauchy => ModelSpec::HyperCauchy {
+            }),
+            Member::HyperCauchy => ModelSpec::HyperCauchy(HyperCauchySpec {
                 gamma,
                 alpha,
                 alpha_x,
                 alpha_y,
-            },
-            Member::FixedVariance => ModelSpec::StudentFixedVariance {
+            }),
+            Member::FixedVariance => ModelSpec::StudentFixedVariance(FixedVarianceSpec {
                 gamma,
                 alpha,
                 alpha_x,
                 alpha_y,
-            },
-            Member::General => ModelSpec::StudentGeneral {
+            }),
+            Member::General => ModelSpec::StudentGeneral(GeneralSpec {
                 b: 1.0 / (self.sx * self.sx),
                 c: self.c,
-            },
+            }),
         }
     }
 
@@ -458,11 +532,13 @@ pub const GENERAL_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInf
 /// and the fixed-variance member (seed 001 eq 7–9), `c` for the general member (eq 2).
 pub fn student_tail_exponent(spec: &crate::ModelSpec) -> Option<f64> {
     use crate::ModelSpec as S;
-    match *spec {
-        S::Std { gamma, .. }
-        | S::HyperCauchy { gamma, .. }
-        | S::StudentFixedVariance { gamma, .. } => Some(gamma).filter(|g| g.is_finite()),
-        S::StudentGeneral { c, .. } => Some(c),
+    match spec {
+        S::Std(StdSpec { gamma, .. })
+        | S::HyperCauchy(HyperCauchySpec { gamma, .. })
+        | S::StudentFixedVariance(FixedVarianceSpec { gamma, .. }) => {
+            Some(*gamma).filter(|g| g.is_finite())
+        }
+        S::StudentGeneral(s) => Some(s.c),
         _ => None,
     }
 }

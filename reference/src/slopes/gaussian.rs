@@ -343,12 +343,29 @@ impl VisibleSlopeMoments for GaussianSlopes {
     }
 }
 
+/// The spec of a Gaussian distribution of slopes:
+/// `{"family": "gaussian_slopes", "mean": [0, 0], "cov": [[0.1, 0], [0, 0.2]]}`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GaussianSlopesSpec {
+    /// The mean slope s̄ = `[s̄x, s̄y]`.
+    pub mean: [f64; 2],
+    /// The covariance Σ = `[[σx², cxy], [cxy, σy²]]`, symmetric positive definite.
+    pub cov: [[f64; 2]; 2],
+}
+
+impl crate::spec::FamilySpec for GaussianSlopesSpec {
+    fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
+        Ok(Box::new(GaussianSlopes::new(self.mean, self.cov)?))
+    }
+}
+
 impl Model for GaussianSlopes {
     fn spec(&self) -> ModelSpec {
-        ModelSpec::GaussianSlopes {
+        ModelSpec::GaussianSlopes(GaussianSlopesSpec {
             mean: self.mean,
             cov: self.cov,
-        }
+        })
     }
 
     fn family(&self) -> &'static str {
@@ -627,7 +644,7 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
 /// The mean slope of a Gaussian-slopes spec.
 pub fn spec_mean(spec: &crate::ModelSpec) -> [f64; 2] {
     match spec {
-        crate::ModelSpec::GaussianSlopes { mean, .. } => *mean,
+        crate::ModelSpec::GaussianSlopes(s) => s.mean,
         _ => [0.0, 0.0],
     }
 }

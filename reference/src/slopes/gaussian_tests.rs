@@ -621,10 +621,10 @@ fn spec_round_trip() {
     let spec: ModelSpec = serde_json::from_str(text).unwrap();
     assert_eq!(
         spec,
-        ModelSpec::GaussianSlopes {
+        ModelSpec::GaussianSlopes(super::GaussianSlopesSpec {
             mean: [0.1, -0.2],
             cov: [[0.04, 0.01], [0.01, 0.09]]
-        }
+        })
     );
     assert_eq!(spec.family(), "gaussian_slopes");
     let model = spec.build().unwrap();

@@ -19,19 +19,21 @@ use std::sync::Arc;
 /// The pseudo-VNIS parameters (γ, αx, αy) of an STD spec with finite γ, or why there are none.
 fn std_parameters(spec: &ModelSpec) -> Result<(f64, f64, f64), String> {
     match *spec {
-        ModelSpec::Std {
+        ModelSpec::Std(mfh_reference::ndf::student::StdSpec {
             gamma,
             alpha,
             alpha_x,
             alpha_y,
-        } if gamma.is_finite() => {
+        }) if gamma.is_finite() => {
             let ax = alpha.or(alpha_x).unwrap_or(f64::NAN);
             let ay = alpha.or(alpha_y).unwrap_or(f64::NAN);
             Ok((gamma, ax, ay))
         }
-        ModelSpec::Std { .. } => Err("STD with γ = ∞ is Beckmann, whose visible-normal \
+        ModelSpec::Std(mfh_reference::ndf::student::StdSpec { .. }) => {
+            Err("STD with γ = ∞ is Beckmann, whose visible-normal \
              sampling is exact (Algorithm 1 line 3 picks it): use `visible_normals`"
-            .into()),
+                .into())
+        }
         _ => Err(format!(
             "the pseudo-VNIS of seed 001 §7.2 is defined for STD only (got {})",
             spec.family()
