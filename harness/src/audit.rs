@@ -286,7 +286,6 @@ pub fn run_plan(
             }
             let ctx = RunContext {
                 seed: check_seed(options.seed, p),
-                out: options.out.clone(),
             };
             let mut r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| (p.run)(&ctx)))
                 .unwrap_or_else(|e| {

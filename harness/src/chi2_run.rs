@@ -4,7 +4,7 @@
 //! CLI (`cli/chi2.rs`) maps errors to exit codes and writes tables and heat maps.
 
 use crate::oracle::chi2::{
-    chi2_test_to, Chi2Config, Chi2Result, CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE,
+    chi2_test_in, Chi2Config, Chi2Result, CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE,
     MIN_EXPECTED,
 };
 use mfh_reference::{Model, ModelSpec};
@@ -277,7 +277,7 @@ pub fn run(plan: &Chi2Plan, progress: Option<Arc<AtomicU64>>) -> Chi2Result {
             let wi = mfh_reference::geometry::from_spherical(theta, phi);
             // The visible density has a kink along the terminator of wi: cells that straddle
             // it converge slowly, so they are integrated to 1e-6 (still ≪ √count).
-            chi2_test_to(
+            chi2_test_in(
                 &|u| {
                     count(&progress);
                     v.sample_wm_visible(wi, u)
@@ -285,6 +285,7 @@ pub fn run(plan: &Chi2Plan, progress: Option<Arc<AtomicU64>>) -> Chi2Result {
                 &|m| v.pdf_wm_visible(wi, m),
                 &plan.config,
                 KINKED_CELL_RELATIVE_TOLERANCE,
+                None,
             )
         }
         _ => {
@@ -292,7 +293,7 @@ pub fn run(plan: &Chi2Plan, progress: Option<Arc<AtomicU64>>) -> Chi2Result {
                 .model
                 .as_sampler()
                 .expect("validate checked the normal sampler");
-            chi2_test_to(
+            chi2_test_in(
                 &|u| {
                     count(&progress);
                     s.sample_wm(u)
@@ -300,6 +301,7 @@ pub fn run(plan: &Chi2Plan, progress: Option<Arc<AtomicU64>>) -> Chi2Result {
                 &|m| s.pdf_wm(m),
                 &plan.config,
                 CELL_RELATIVE_TOLERANCE,
+                None,
             )
         }
     }

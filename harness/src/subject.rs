@@ -159,21 +159,15 @@ impl<'a> Subject<'a> {
     }
 }
 
-/// The lobe width a reference spec implies.
-fn spec_width(spec: &ModelSpec) -> f64 {
+/// The lobe width a reference spec implies (a hint for lobe measurement and quadrature): atan
+/// of the smallest roughness (or of the square root of the smallest slope variance), 0.3 where
+/// the spec has no scale.
+pub fn spec_width(spec: &ModelSpec) -> f64 {
     lobe_width(&serde_json::to_value(spec).unwrap_or(Value::Null))
 }
 
-/// The polar kinks of a spec given as JSON (registry), none if it does not parse.
-pub fn theta_kinks(spec: &Value) -> Vec<f64> {
-    serde_json::from_value::<ModelSpec>(spec.clone())
-        .map(|s| (registry::info(&s).theta_kinks)(&s))
-        .unwrap_or_default()
-}
-
-/// The lobe width a spec (JSON) implies: atan of the smallest roughness (or of the square root
-/// of the smallest slope variance), 0.3 where the spec has no scale.
-pub fn lobe_width(spec: &Value) -> f64 {
+/// [`spec_width`] of the spec's JSON form.
+fn lobe_width(spec: &Value) -> f64 {
     let get = |k: &str| spec.get(k).and_then(Value::as_f64);
     let mut w = f64::INFINITY;
     for k in ["alpha", "alpha_x", "alpha_y"] {

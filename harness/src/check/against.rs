@@ -3,8 +3,9 @@
 //! directions that includes exactly normal and near-grazing incidence and several azimuths; one
 //! record per quantity, with the worst relative error and where it is attained.
 
-use super::{compare_exact, covers, timed, PlannedCheck};
-use crate::record::{relative_error, CheckRecord, Verdict};
+use super::{compare_exact, covers, PlannedCheck};
+use crate::check::Check;
+use crate::record::{relative_error, Verdict};
 use crate::subject::Subject;
 use crate::tolerance::AGAINST_REFERENCE;
 use mfh_reference::geometry::from_spherical;
@@ -105,51 +106,45 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, spec: &ModelSpec, why: &str) -> Vec<
         .map(|&quantity| {
             let case = json!({"quantity": quantity, "reference": spec_value,
                               "grid": format!("θ ∈ {THETAS:?} × φ ∈ {PHIS:?}")});
-            let (s, r_model, case_run) = (subject.clone(), reference.clone(), case.clone());
+            let (s, r_model) = (subject.clone(), reference.clone());
             let family = subject.family();
-            PlannedCheck {
-                check: "against.reference".into(),
-                model: subject.label.clone(),
+            Check::new(
+                "against.reference",
+                subject.label.clone(),
                 case,
-                why: format!("{why}: {quantity} value by value against the reference"),
-                covers: vec![covers(family, quantity, "default")],
-                statistical: false,
-                run: Box::new(move |_| {
-                    timed(|| {
-                        let mut r = CheckRecord::new(
-                            "against.reference",
-                            s.label.clone(),
-                            case_run.clone(),
-                            "the reference closed forms of mfh-reference (each cites its source)",
-                        );
-                        let mut worst = (0.0f64, 0.0, 0.0, 0.0, 0.0);
-                        let points = grid();
-                        for (i, &(t, p, w)) in points.iter().enumerate() {
-                            let wi = points[(i * 7 + 3) % points.len()].2;
-                            let Some((u, v)) = values(quantity, &s, r_model.as_ref(), w, wi) else {
-                                continue;
-                            };
-                            let e = if u == v {
-                                0.0
-                            } else if u.is_finite() && v.is_finite() {
-                                relative_error(u, v)
-                            } else {
-                                f64::INFINITY
-                            };
-                            if !(e <= worst.0) {
-                                worst = (e, u, v, t, p);
-                            }
-                        }
-                        let (e, u, v, t, p) = worst;
-                        compare_exact(&mut r, u, v, &AGAINST_REFERENCE);
-                        if e == f64::INFINITY {
-                            r.verdict = Verdict::Fail;
-                        }
-                        r.case["worst_at"] = json!({"theta": t, "phi": p});
-                        r
-                    })
-                }),
-            }
+                "the reference closed forms of mfh-reference (each cites its source)",
+            )
+            .why(format!(
+                "{why}: {quantity} value by value against the reference"
+            ))
+            .covers(vec![covers(family, quantity, "default")])
+            .run(move |r, _| {
+                let mut worst = (0.0f64, 0.0, 0.0, 0.0, 0.0);
+                let points = grid();
+                for (i, &(t, p, w)) in points.iter().enumerate() {
+                    let wi = points[(i * 7 + 3) % points.len()].2;
+                    let Some((u, v)) = values(quantity, &s, r_model.as_ref(), w, wi) else {
+                        continue;
+                    };
+                    let e = if u == v {
+                        0.0
+                    } else if u.is_finite() && v.is_finite() {
+                        relative_error(u, v)
+                    } else {
+                        f64::INFINITY
+                    };
+                    if !(e <= worst.0) {
+                        worst = (e, u, v, t, p);
+                    }
+                }
+                let (e, u, v, t, p) = worst;
+                compare_exact(r, u, v, &AGAINST_REFERENCE);
+                if e == f64::INFINITY {
+                    r.verdict = Verdict::Fail;
+                }
+                r.case["worst_at"] = json!({"theta": t, "phi": p});
+                Ok(())
+            })
         })
         .collect()
 }

@@ -8,13 +8,14 @@
 
 use super::errata::{Concern, Effect, Scope, STUDENT};
 use super::smith::lambda_oracle;
-use super::{applied, covers, timed, Planned};
+use super::{applied, covers, Planned};
+use crate::check::Check;
 use crate::oracle::gtr::g1_gamma0;
 use crate::oracle::quadrature::{
     integrate, integrate_hemisphere, integrate_line, integrate_pieces, integrate_upper, Accuracy,
 };
 use crate::oracle::Estimate;
-use crate::record::{CheckRecord, Measured, Verdict};
+use crate::record::{Measured, Verdict};
 use crate::tolerance::{
     Tolerance, CLOSED_FORM, GTR_CLAMP, GTR_LIMIT, GTR_SPLINE, IDENTITY, PIECEWISE_TRAPEZOID,
     SLOPE_MOMENT_CLAIM,
@@ -108,19 +109,11 @@ pub fn plan(scope: &Scope, why: &str) -> Vec<Planned> {
             run,
             ..
         } = claim;
-        let (model_run, case_run, covers_run) = (model.clone(), case.clone(), covers.clone());
-        out.push(Planned {
-            check: check.into(),
-            model,
-            case,
-            why: format!("{why}: claim of {source}; {used}"),
-            covers,
-            statistical: false,
-            run: Box::new(move |_| {
-                timed(|| {
-                    let mut r =
-                        CheckRecord::new(check, model_run.clone(), case_run.clone(), source);
-                    r.covers = covers_run.clone();
+        out.push(
+            Check::new(check, model, case, source)
+                .why(format!("{why}: claim of {source}; {used}"))
+                .covers(covers)
+                .run(move |r, _| {
                     match run() {
                         Ok(m) => {
                             r.value = Some(m.error);
@@ -150,10 +143,9 @@ pub fn plan(scope: &Scope, why: &str) -> Vec<Planned> {
                         }
                         Err(message) => r.verdict = Verdict::Error { message },
                     }
-                    r
-                })
-            }),
-        });
+                    Ok(())
+                }),
+        );
     }
     out
 }
@@ -556,7 +548,7 @@ mod tests {
     #[test]
     fn claims_reach_the_verdicts_errata_md_records() {
         let plan = plan(&Scope::everything(), "test");
-        let ctx = super::super::RunContext { seed: 1, out: None };
+        let ctx = super::super::RunContext { seed: 1 };
         for p in &plan {
             let r = (p.run)(&ctx);
             println!("{} {:?} {:?}", r.check, r.value, r.verdict);

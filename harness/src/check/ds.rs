@@ -3,7 +3,8 @@
 //! cubature of their defining integrals (eq 16, 19–23), for regular, near-singular and
 //! back-facing (mean facet facing away at grazing incidence) cases.
 
-use super::{applied, apply_expected, covers, timed, Planned, Profile};
+use super::{applied, apply_expected, covers, Planned, Profile};
+use crate::check::Check;
 use crate::oracle::cubature::{integrate_rectangle, Tolerance as CubatureTolerance};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
 use crate::tolerance::VISIBLE_MOMENTS;
@@ -356,38 +357,26 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                                       "phi": phi, "z0": z0_of(&variant, w)});
                     let covered = vec![covers(family, "visible_moments", route)];
                     let (built, shared) = (built.clone(), shared.clone());
-                    let (variant_run, case_run, covered_run) =
-                        (variant.clone(), case.clone(), covered.clone());
-                    out.push(Planned {
-                        check: check.into(),
-                        model: variant.clone(),
-                        case,
-                        why: format!("{why}: D_s moments by route `{route}` ({label})"),
-                        covers: covered,
-                        statistical: false,
-                        run: Box::new(move |_| {
-                            timed(|| {
-                                let mut r = CheckRecord::new(
-                                    check,
-                                    variant_run.clone(),
-                                    case_run.clone(),
-                                    SOURCE,
-                                );
-                                r.covers = covered_run.clone();
+                    let variant_run = variant.clone();
+                    out.push(
+                        Check::new(check, variant.clone(), case, SOURCE)
+                            .why(format!("{why}: D_s moments by route `{route}` ({label})"))
+                            .covers(covered)
+                            .run(move |r, _| {
                                 let m = match &built {
                                     Ok(m) => m,
                                     Err(e) => {
                                         r.verdict = Verdict::Error {
                                             message: format!("variant rejected: {e}"),
                                         };
-                                        return r;
+                                        return Ok(());
                                     }
                                 };
                                 let Some(vis) = m.as_visible_moments() else {
                                     r.verdict = Verdict::Error {
                                         message: "the model lost its visible moments".into(),
                                     };
-                                    return r;
+                                    return Ok(());
                                 };
                                 let value = match vis.visible_moments_route(w, route) {
                                     Ok(v) => v,
@@ -395,14 +384,14 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                                         r.verdict = Verdict::Error {
                                             message: format!("route `{route}` refused: {e}"),
                                         };
-                                        return r;
+                                        return Ok(());
                                     }
                                 };
                                 let o = shared.get_or_init(|| oracle(&variant_run, w));
                                 match o {
                                     Ok(o) => {
-                                        judge(&mut r, &value, o);
-                                        apply_expected(&mut r, family, route);
+                                        judge(r, &value, o);
+                                        apply_expected(r, family, route);
                                     }
                                     Err(e) => {
                                         r.verdict = Verdict::Error {
@@ -410,10 +399,9 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                                         };
                                     }
                                 }
-                                r
-                            })
-                        }),
-                    });
+                                Ok(())
+                            }),
+                    );
                 }
             }
         }
@@ -437,7 +425,7 @@ mod tests {
     fn quick_plan_passes_or_fails_as_expected() {
         let plan = plan(model(), Profile::Quick, 1.5, "test");
         assert!(!plan.is_empty());
-        let ctx = super::super::RunContext { seed: 1, out: None };
+        let ctx = super::super::RunContext { seed: 1 };
         let mut expected = 0;
         let mut seen = std::collections::BTreeSet::new();
         for p in &plan {
@@ -497,7 +485,7 @@ mod dump {
             mean: [0.1, -0.2],
             cov: [[0.04, 0.01], [0.01, 0.09]],
         });
-        let ctx = crate::check::RunContext { seed: 1, out: None };
+        let ctx = crate::check::RunContext { seed: 1 };
         for p in plan(
             Arc::from(spec.build().unwrap()),
             Profile::Standard,

@@ -3,8 +3,9 @@
 //! at quasi-random interior points. Unlike comparing `pdf_wm` with D(m)(m·n), this fails a pdf
 //! that disagrees with its sampler whatever D says.
 
-use super::{applied, covers, timed, PlannedCheck};
-use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
+use super::{applied, covers, PlannedCheck};
+use crate::check::{need, Check};
+use crate::record::{Measured, OracleValue, Verdict};
 use crate::subject::Subject;
 use crate::tolerance::PDF_JACOBIAN;
 use mfh_reference::geometry::Vec3;
@@ -112,50 +113,43 @@ pub fn measure(sampler: &dyn NormalSampler) -> JacobianResult {
 pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> PlannedCheck<'a> {
     let family = subject.family();
     let case = json!({"points": POINTS, "step": STEP});
-    let (s, case_run) = (subject.clone(), case.clone());
-    PlannedCheck {
-        check: "sampling.pdf_jacobian".into(),
-        model: subject.label.clone(),
+    let s = subject.clone();
+    Check::new(
+        "sampling.pdf_jacobian",
+        subject.label.clone(),
         case,
-        why: format!("{why}: pdf_wm must be the density of the sampling map itself"),
-        covers: vec![covers(family, "pdf_wm", "default")],
-        statistical: false,
-        run: Box::new(move |_| {
-            timed(|| {
-                let mut r = CheckRecord::new(
-                    "sampling.pdf_jacobian",
-                    s.label.clone(),
-                    case_run.clone(),
-                    "change of variables: pdf(m) = 1/|∂m/∂u₁ × ∂m/∂u₂| for u uniform on [0,1)²",
-                );
-                r.covers = vec![covers(family, "pdf_wm", "default")];
-                let sampler = s.model.as_sampler().expect("planned for samplers");
-                let j = measure(sampler);
-                r.value = Some(j.pdf_and_density.0);
-                r.oracle = Some(OracleValue {
-                    value: j.pdf_and_density.1,
-                    uncertainty: 0.0,
-                    kind: "error_bound",
-                });
-                r.measured = Some(Measured::Relative { error: j.worst });
-                r.tolerance = Some(applied(&PDF_JACOBIAN));
-                r.case = json!({"points": POINTS, "step": STEP, "resolved": j.resolved,
+        "change of variables: pdf(m) = 1/|∂m/∂u₁ × ∂m/∂u₂| for u uniform on [0,1)²",
+    )
+    .why(format!(
+        "{why}: pdf_wm must be the density of the sampling map itself"
+    ))
+    .covers(vec![covers(family, "pdf_wm", "default")])
+    .run(move |r, _| {
+        let sampler = need(s.model.as_sampler(), "normal sampler")?;
+        let j = measure(sampler);
+        r.value = Some(j.pdf_and_density.0);
+        r.oracle = Some(OracleValue {
+            value: j.pdf_and_density.1,
+            uncertainty: 0.0,
+            kind: "error_bound",
+        });
+        r.measured = Some(Measured::Relative { error: j.worst });
+        r.tolerance = Some(applied(&PDF_JACOBIAN));
+        r.case = json!({"points": POINTS, "step": STEP, "resolved": j.resolved,
                                 "worst_at_u": j.at});
-                r.verdict = if f64::from(j.resolved) < MIN_RESOLVED * f64::from(POINTS) {
-                    Verdict::Error {
-                        message: format!(
-                            "only {} of {POINTS} points had a smooth sampling map within the \
+        r.verdict = if f64::from(j.resolved) < MIN_RESOLVED * f64::from(POINTS) {
+            Verdict::Error {
+                message: format!(
+                    "only {} of {POINTS} points had a smooth sampling map within the \
                              finite-difference stencil (need {MIN_RESOLVED})",
-                            j.resolved
-                        ),
-                    }
-                } else if j.worst <= PDF_JACOBIAN.value {
-                    Verdict::Pass
-                } else {
-                    Verdict::Fail
-                };
-                r
-            })
-        }),
-    }
+                    j.resolved
+                ),
+            }
+        } else if j.worst <= PDF_JACOBIAN.value {
+            Verdict::Pass
+        } else {
+            Verdict::Fail
+        };
+        Ok(())
+    })
 }

@@ -2,8 +2,9 @@
 //! O(1/γ), for D and Λ. Each record carries the fitted exponent (the verdict) and the constant
 //! of the rate: max over γ of γ × (relative D error) or γ × (absolute Λ error).
 
-use super::{applied, covers, timed, Planned};
-use crate::record::{relative_error, CheckRecord, Measured, Verdict};
+use super::{applied, covers, Planned};
+use crate::check::Check;
+use crate::record::{relative_error, Measured, Verdict};
 use crate::tolerance::LIMIT_RATE;
 use mfh_reference::geometry::from_spherical;
 use mfh_reference::ModelSpec;
@@ -39,83 +40,76 @@ pub fn plan(alpha: f64, why: &str) -> Vec<Planned> {
             };
             let case =
                 json!({"quantity": quantity, "alpha": alpha, "theta": theta, "gammas": GAMMAS});
-            let case_run = case.clone();
-            Planned {
-                check: "limits.std_to_beckmann".into(),
-                model: json!({"family": "std", "gamma": "→∞", "alpha": alpha}),
+            Check::new(
+                "limits.std_to_beckmann",
+                json!({"family": "std", "gamma": "→∞", "alpha": alpha}),
                 case,
-                why: format!("{why}: STD must reach Beckmann as γ → ∞ at rate 1/γ"),
-                covers: vec![covers("std", quantity, "default")],
-                statistical: false,
-                run: Box::new(move |_| {
-                    timed(|| {
-                        let mut r = CheckRecord::new(
-                            "limits.std_to_beckmann",
-                            json!({"family": "std", "gamma": "→∞", "alpha": alpha}),
-                            case_run.clone(),
-                            "seed 001 §4 (γ → ∞: STD → Beckmann), Table 1 (γ = ∞ row)",
-                        );
-                        r.covers = vec![covers("std", quantity, "default")];
-                        let w = from_spherical(theta, 0.0);
-                        let eval = |spec: ModelSpec| -> Option<f64> {
-                            let m = spec.build().ok()?;
-                            Some(if quantity == "d" {
-                                m.d(w)
-                            } else {
-                                m.as_smith()?.lambda(w)
-                            })
-                        };
-                        let std = |g: f64| {
-                            ModelSpec::Std(mfh_reference::ndf::student::StdSpec {
-                                gamma: g,
-                                alpha: Some(alpha),
-                                alpha_x: None,
-                                alpha_y: None,
-                            })
-                        };
-                        let (Some(limit), Some(at_inf)) = (
-                            eval(ModelSpec::Beckmann(
-                                mfh_reference::ndf::beckmann::BeckmannSpec {
-                                    alpha: Some(alpha),
-                                    alpha_x: None,
-                                    alpha_y: None,
-                                },
-                            )),
-                            eval(std(f64::INFINITY)),
-                        ) else {
-                            r.verdict = Verdict::Error {
-                                message: "cannot build the models".into(),
-                            };
-                            return r;
-                        };
-                        let values: Vec<f64> = GAMMAS
-                            .iter()
-                            .map(|&g| eval(std(g)).unwrap_or(f64::NAN))
-                            .collect();
-                        let errors: Vec<f64> =
-                            values.iter().map(|&v| relative_error(v, limit)).collect();
-                        // The constant of the O(1/γ) rate: relative for D, absolute for Λ (Λ → 0
-                        // at grazing-free incidences is not the concern; its size is O(1)).
-                        let scaled: Vec<f64> = GAMMAS
-                            .iter()
-                            .zip(&values)
-                            .map(|(&g, &v)| {
-                                g * if quantity == "d" {
-                                    relative_error(v, limit)
-                                } else {
-                                    (v - limit).abs()
-                                }
-                            })
-                            .collect();
-                        let constant = scaled.iter().copied().fold(f64::NAN, f64::max);
-                        let exponent = fitted_exponent(&GAMMAS, &errors);
-                        r.value = Some(exponent);
-                        r.measured = Some(Measured::Rate {
-                            exponent,
-                            expected: -1.0,
-                        });
-                        r.tolerance = Some(applied(&LIMIT_RATE));
-                        r.case = json!({"quantity": quantity, "alpha": alpha, "theta": theta,
+                "seed 001 §4 (γ → ∞: STD → Beckmann), Table 1 (γ = ∞ row)",
+            )
+            .why(format!(
+                "{why}: STD must reach Beckmann as γ → ∞ at rate 1/γ"
+            ))
+            .covers(vec![covers("std", quantity, "default")])
+            .run(move |r, _| {
+                let w = from_spherical(theta, 0.0);
+                let eval = |spec: ModelSpec| -> Option<f64> {
+                    let m = spec.build().ok()?;
+                    Some(if quantity == "d" {
+                        m.d(w)
+                    } else {
+                        m.as_smith()?.lambda(w)
+                    })
+                };
+                let std = |g: f64| {
+                    ModelSpec::Std(mfh_reference::ndf::student::StdSpec {
+                        gamma: g,
+                        alpha: Some(alpha),
+                        alpha_x: None,
+                        alpha_y: None,
+                    })
+                };
+                let (Some(limit), Some(at_inf)) = (
+                    eval(ModelSpec::Beckmann(
+                        mfh_reference::ndf::beckmann::BeckmannSpec {
+                            alpha: Some(alpha),
+                            alpha_x: None,
+                            alpha_y: None,
+                        },
+                    )),
+                    eval(std(f64::INFINITY)),
+                ) else {
+                    r.verdict = Verdict::Error {
+                        message: "cannot build the models".into(),
+                    };
+                    return Ok(());
+                };
+                let values: Vec<f64> = GAMMAS
+                    .iter()
+                    .map(|&g| eval(std(g)).unwrap_or(f64::NAN))
+                    .collect();
+                let errors: Vec<f64> = values.iter().map(|&v| relative_error(v, limit)).collect();
+                // The constant of the O(1/γ) rate: relative for D, absolute for Λ (Λ → 0
+                // at grazing-free incidences is not the concern; its size is O(1)).
+                let scaled: Vec<f64> = GAMMAS
+                    .iter()
+                    .zip(&values)
+                    .map(|(&g, &v)| {
+                        g * if quantity == "d" {
+                            relative_error(v, limit)
+                        } else {
+                            (v - limit).abs()
+                        }
+                    })
+                    .collect();
+                let constant = scaled.iter().copied().fold(f64::NAN, f64::max);
+                let exponent = fitted_exponent(&GAMMAS, &errors);
+                r.value = Some(exponent);
+                r.measured = Some(Measured::Rate {
+                    exponent,
+                    expected: -1.0,
+                });
+                r.tolerance = Some(applied(&LIMIT_RATE));
+                r.case = json!({"quantity": quantity, "alpha": alpha, "theta": theta,
                                         "gammas": GAMMAS, "relative_errors": errors,
                                         "rate_constant": constant,
                                         "rate_constant_kind": if quantity == "d" {
@@ -125,16 +119,13 @@ pub fn plan(alpha: f64, why: &str) -> Vec<Planned> {
                                         },
                                         "gamma_times_error": scaled,
                                         "gamma_inf_equals_beckmann": at_inf == limit});
-                        r.verdict = if (exponent + 1.0).abs() <= LIMIT_RATE.value && at_inf == limit
-                        {
-                            Verdict::Pass
-                        } else {
-                            Verdict::Fail
-                        };
-                        r
-                    })
-                }),
-            }
+                r.verdict = if (exponent + 1.0).abs() <= LIMIT_RATE.value && at_inf == limit {
+                    Verdict::Pass
+                } else {
+                    Verdict::Fail
+                };
+                Ok(())
+            })
         })
         .collect()
 }
@@ -145,7 +136,7 @@ mod tests {
 
     #[test]
     fn the_rate_and_its_constants_are_recorded() {
-        let ctx = super::super::RunContext { seed: 1, out: None };
+        let ctx = super::super::RunContext { seed: 1 };
         for alpha in [0.2, 0.4] {
             for p in plan(alpha, "test") {
                 let r = (p.run)(&ctx);

@@ -12,6 +12,7 @@ pub mod moments;
 pub mod normalization;
 pub mod precise;
 pub mod route_stress;
+pub mod run;
 pub mod sampling;
 pub mod sg;
 pub mod smith;
@@ -24,9 +25,8 @@ use crate::record::{
 use crate::tolerance::Tolerance;
 use serde::Serialize;
 use serde_json::Value;
-use std::path::PathBuf;
 
-pub use crate::subject::{lobe_width, theta_kinks};
+pub use run::{need, Check, Missing, Outcome};
 
 /// How hard an audit looks: the size of the case grids and of the statistical samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -126,14 +126,13 @@ impl Profile {
     }
 }
 
-/// What a running check may use: its seed and where to write artefacts.
+/// What a running check may use: its seed (checks do no I/O: what they produce goes into their
+/// record, and the sinks write it).
 #[derive(Debug, Clone)]
 pub struct RunContext {
     /// The seed of this check's random stream (derived from the audit seed and the check's id
     /// and case, so that order and thread count do not matter).
     pub seed: u64,
-    /// The folder for artefacts (heat maps, tables), if any.
-    pub out: Option<PathBuf>,
 }
 
 /// The function that runs a planned check; it may borrow the model under audit for `'a`.
@@ -308,14 +307,6 @@ fn case_parameter(record: &CheckRecord, family: &str, name: &str) -> Option<f64>
     }
 }
 
-/// Times `f` into `record.cost.wall_seconds` and returns the record.
-pub fn timed(f: impl FnOnce() -> CheckRecord) -> CheckRecord {
-    let t = std::time::Instant::now();
-    let mut r = f();
-    r.cost.wall_seconds += t.elapsed().as_secs_f64();
-    r
-}
-
 /// The closed-form id `family/quantity/route` used by coverage.
 pub fn covers(family: &str, quantity: &str, route: &str) -> String {
     format!("{family}/{quantity}/{route}")
@@ -375,7 +366,7 @@ mod tests {
         }
     }
     fn run(plan: Vec<PlannedCheck<'_>>) -> Vec<crate::record::CheckRecord> {
-        let ctx = RunContext { seed: 7, out: None };
+        let ctx = RunContext { seed: 7 };
         plan.iter().map(|p| (p.run)(&ctx)).collect()
     }
 
@@ -565,7 +556,7 @@ mod tests {
             lambda_scale: 1.0,
             flip: true,
         });
-        let ctx = RunContext { seed: 7, out: None };
+        let ctx = RunContext { seed: 7 };
         let f: Vec<_> = sampling::plan(&flipped, Profile::Quick, "test")
             .iter()
             .map(|p| (p.run)(&ctx))

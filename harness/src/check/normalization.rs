@@ -1,9 +1,9 @@
 //! Normalization: ∫ D(m)(m·n) dm = 1 over the hemisphere, by nested adaptive quadrature.
 
-use super::{compare, covers, timed, PlannedCheck};
+use super::{compare, covers, PlannedCheck};
+use crate::check::Check;
 use crate::oracle::quadrature::{integrate_hemisphere_lobe, Accuracy, Cuts};
 use crate::oracle::Estimate;
-use crate::record::CheckRecord;
 use crate::subject::Subject;
 use crate::tolerance::NORMALIZATION;
 use serde_json::json;
@@ -13,44 +13,30 @@ use std::sync::Arc;
 pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> {
     let family = subject.family();
     let s = subject.clone();
-    vec![PlannedCheck {
-        check: "normalization.projected_area".to_string(),
-        model: subject.label.clone(),
-        case: json!({}),
-        why: why.to_string(),
-        covers: vec![covers(family, "d", "default")],
-        statistical: false,
-        run: Box::new(move |_| {
-            timed(|| {
-                let mut r = CheckRecord::new(
-                    "normalization.projected_area",
-                    s.label.clone(),
-                    json!({}),
-                    "ARCHITECTURE.md model boundary: ∫ D(m)(m·n) dm = 1 (seed 001 eq 3; seed 000 eq 2; \
+    vec![Check::new(
+        "normalization.projected_area",
+        subject.label.clone(),
+        json!({}),
+        "ARCHITECTURE.md model boundary: ∫ D(m)(m·n) dm = 1 (seed 001 eq 3; seed 000 eq 2; \
                      seed 004 §2)",
-                );
-                r.covers = vec![covers(family, "d", "default")];
-                let kinks = s.theta_kinks();
-                let e = integrate_hemisphere_lobe(
-                    &|w| s.model.d(w) * w[2],
-                    s.lobe(),
-                    Some(Cuts {
-                        theta: &|_| kinks.clone(),
-                        phi: &[],
-                    }),
-                    Accuracy::relative(1e-11),
-                );
-                // The value under test is the quadrature of the closed form, so the
-                // quadrature's error bound is the slack `compare` grants (reported as the
-                // oracle's uncertainty).
-                compare(
-                    &mut r,
-                    e.value,
-                    Estimate { value: 1.0, ..e },
-                    &NORMALIZATION,
-                );
-                r
-            })
-        }),
-    }]
+    )
+    .why(why.to_string())
+    .covers(vec![covers(family, "d", "default")])
+    .run(move |r, _| {
+        let kinks = s.theta_kinks();
+        let e = integrate_hemisphere_lobe(
+            &|w| s.model.d(w) * w[2],
+            s.lobe(),
+            Some(Cuts {
+                theta: &|_| kinks.clone(),
+                phi: &[],
+            }),
+            Accuracy::relative(1e-11),
+        );
+        // The value under test is the quadrature of the closed form, so the
+        // quadrature's error bound is the slack `compare` grants (reported as the
+        // oracle's uncertainty).
+        compare(r, e.value, Estimate { value: 1.0, ..e }, &NORMALIZATION);
+        Ok(())
+    })]
 }

@@ -3,10 +3,11 @@
 //! (`oracle::precise`, certified to ~1e-24), at the 1e-14 the closed forms are built for —
 //! a hundred times tighter than the quadrature checks of `smith` and `normalization` can see.
 
-use super::{compare, covers, timed, Planned, Profile};
+use super::{compare, covers, Planned, Profile};
+use crate::check::{need, Check};
 use crate::oracle::precise::{Certified, PreciseError, PreciseModel};
 use crate::oracle::Estimate;
-use crate::record::{CheckRecord, Verdict};
+use crate::record::Verdict;
 use crate::tolerance::PRECISE;
 use mfh_reference::geometry::from_spherical;
 use mfh_reference::Model;
@@ -50,28 +51,18 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
         }
         for theta in thetas(profile, theta_max) {
             let case = json!({"quantity": quantity, "theta": theta, "phi": 0.7});
-            let (m, spec_run, case_run) = (model.clone(), spec.clone(), case.clone());
+            let m = model.clone();
             let covered = vec![covers(family, quantity, "default")];
-            let covered_run = covered.clone();
-            out.push(Planned {
-                check: "precise.closed_form".into(),
-                model: spec.clone(),
-                case,
-                why: format!("{why}: {quantity} against the double-double reference"),
-                covers: covered,
-                statistical: false,
-                run: Box::new(move |_| {
-                    timed(|| {
-                        let mut r = CheckRecord::new(
-                            "precise.closed_form",
-                            spec_run.clone(),
-                            case_run.clone(),
-                            SOURCE,
-                        );
-                        r.covers = covered_run.clone();
+            out.push(
+                Check::new("precise.closed_form", spec.clone(), case, SOURCE)
+                    .why(format!(
+                        "{why}: {quantity} against the double-double reference"
+                    ))
+                    .covers(covered)
+                    .run(move |r, _| {
                         let w = from_spherical(theta, 0.7);
                         let (value, reference) = if quantity == "lambda" {
-                            let smith = m.as_smith().expect("planned for Smith models");
+                            let smith = need(m.as_smith(), "Smith masking")?;
                             let c = precise
                                 .lambda(w)
                                 .and_then(|c| Ok((c, precise.lambda_condition(w)?)));
@@ -81,7 +72,7 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                         };
                         match reference {
                             Ok((c, condition)) => {
-                                compare(&mut r, value, widened(&c, condition), &PRECISE);
+                                compare(r, value, widened(&c, condition), &PRECISE);
                                 r.cost.evaluations += c.evaluations;
                             }
                             Err(PreciseError::Underflow { value: v }) => {
@@ -97,10 +88,9 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                                 };
                             }
                         }
-                        r
-                    })
-                }),
-            });
+                        Ok(())
+                    }),
+            );
         }
     }
     out
@@ -109,6 +99,7 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::record::CheckRecord;
     use mfh_reference::ModelSpec;
 
     fn model(json: &str) -> Arc<dyn Model> {
@@ -118,7 +109,7 @@ mod tests {
 
     #[test]
     fn closed_forms_pass_and_a_defect_of_1e_12_fails() {
-        let ctx = crate::check::RunContext { seed: 1, out: None };
+        let ctx = crate::check::RunContext { seed: 1 };
         for json in [
             r#"{"family":"ggx","alpha":0.3}"#,
             r#"{"family":"beckmann","alpha":0.3}"#,

@@ -10,7 +10,7 @@
 //! demonstrates the loss as an expected failure bounded by that prediction; or it is an
 //! expected failure of the table (`tolerance::EXPECTED_FAILURES`) within its bound and domain.
 
-use super::{apply_expected, compare, covers, timed, Planned};
+use super::{apply_expected, compare, covers, need, Check, Outcome, Planned};
 use crate::check::smith::lambda_oracle;
 use crate::oracle::Estimate;
 use crate::record::{CheckRecord, Verdict};
@@ -79,20 +79,15 @@ pub fn plan(model: &dyn Model, why: &str) -> Vec<Planned> {
             let route: &'static str = route;
             for (theta, memo) in STRESS_THETAS.into_iter().zip(oracles.iter().cloned()) {
                 let case = json!({"route": route, "theta": theta, "phi": 0.0, "stress": true});
-                let (m, spec_run, case_run) = (m.clone(), stress.clone(), case.clone());
-                out.push(Planned {
-                    check: "smith.lambda_route".into(),
-                    model: stress.clone(),
-                    case,
-                    why: format!("{why}: Λ by route `{route}` stressed at γ = {gamma}"),
-                    covers: vec![covers(family, "lambda", route)],
-                    statistical: false,
-                    run: Box::new(move |_| {
-                        timed(|| {
-                            run_case(m.as_ref(), &spec_run, case_run.clone(), route, theta, &memo)
-                        })
-                    }),
-                });
+                let (m, spec_run) = (m.clone(), stress.clone());
+                out.push(
+                    Check::new("smith.lambda_route", stress.clone(), case, SOURCE)
+                        .why(format!(
+                            "{why}: Λ by route `{route}` stressed at γ = {gamma}"
+                        ))
+                        .covers(vec![covers(family, "lambda", route)])
+                        .run(move |r, _| run_case(r, m.as_ref(), &spec_run, route, theta, &memo)),
+                );
             }
         }
     }
@@ -103,23 +98,16 @@ pub fn plan(model: &dyn Model, why: &str) -> Vec<Planned> {
 /// ≥ `LOSS_DEMONSTRATED_FROM`, the record becomes `smith.lambda_route_loss`, its formula
 /// evaluated outside the domain against the oracle.
 fn run_case(
+    r: &mut CheckRecord,
     m: &dyn Model,
     spec: &Value,
-    case: Value,
     route: &'static str,
     theta: f64,
     oracle: &OnceLock<Estimate>,
-) -> CheckRecord {
+) -> Outcome {
     let family = m.family();
-    let mut r = CheckRecord::new("smith.lambda_route", spec.clone(), case, SOURCE);
-    r.covers = vec![covers(family, "lambda", route)];
     let w = from_spherical(theta, 0.0);
-    let Some(smith) = m.as_smith() else {
-        r.verdict = Verdict::Error {
-            message: "the stressed model has no Smith masking".into(),
-        };
-        return r;
-    };
+    let smith = need(m.as_smith(), "Smith masking")?;
     let c = spec
         .get("gamma")
         .or_else(|| spec.get("c"))
@@ -128,19 +116,14 @@ fn run_case(
     match smith.lambda_route(w, route) {
         Ok(v) => {
             let oracle = *oracle.get_or_init(|| lambda_oracle(m, w));
-            compare(&mut r, v, oracle, &CLOSED_FORM);
-            apply_expected(&mut r, family, route);
+            compare(r, v, oracle, &CLOSED_FORM);
+            apply_expected(r, family, route);
         }
         Err(QueryError::Route { reason, .. })
             if !matches!(route, "default" | "stable")
                 && student_lambda::route(route, c).is_ok() =>
         {
-            let Some((x, sigma)) = standardized(m, c, theta, 0.0) else {
-                r.verdict = Verdict::Error {
-                    message: "no slope distribution".into(),
-                };
-                return r;
-            };
+            let (x, sigma) = need(standardized(m, c, theta, 0.0), "slope distribution")?;
             let lambda = student_lambda::lambda_stable(c, x);
             let predicted = term_magnitude(route, c, x)
                 .map(|mag| 32.0 * f64::EPSILON / 2.0 * mag / lambda)
@@ -162,8 +145,8 @@ fn run_case(
                     .unwrap_or(f64::NAN);
                 let oracle = *oracle.get_or_init(|| lambda_oracle(m, w));
                 r.check = "smith.lambda_route_loss".into();
-                compare(&mut r, value, oracle, &CLOSED_FORM);
-                apply_expected(&mut r, family, route);
+                compare(r, value, oracle, &CLOSED_FORM);
+                apply_expected(r, family, route);
                 if let Verdict::ExpectedFailure { reason: why } = &r.verdict {
                     r.verdict = Verdict::ExpectedFailure {
                         reason: format!("{why}; route refused in the audit: {reason}"),
@@ -188,7 +171,7 @@ fn run_case(
             }
         }
     }
-    r
+    Ok(())
 }
 
 #[cfg(test)]
@@ -201,7 +184,7 @@ mod tests {
             .unwrap()
             .build()
             .unwrap();
-        let ctx = RunContext { seed: 1, out: None };
+        let ctx = RunContext { seed: 1 };
         plan(m.as_ref(), "test")
             .iter()
             .map(|p| (p.run)(&ctx))

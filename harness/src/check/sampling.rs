@@ -17,8 +17,12 @@ mod visible;
 pub use pseudo_vnis::plan_pseudo_vnis;
 pub use visible::{plan_visible, terminator_azimuths, visible_kinks, VISIBLE_INCIDENCES};
 
-use super::{applied, compare_exact, covers, timed, Planned, PlannedCheck, Profile};
-use crate::oracle::chi2::{chi2_test_batch_in, Chi2Config, CELL_RELATIVE_TOLERANCE};
+use super::{applied, compare_exact, covers, Planned, PlannedCheck, Profile};
+use crate::check::{need, Check};
+use crate::oracle::chi2::{
+    chi2_test_batch_in, chi2_test_in, Chi2Config, CELL_RELATIVE_TOLERANCE,
+    KINKED_CELL_RELATIVE_TOLERANCE,
+};
 use crate::oracle::ks::Marginal;
 use crate::oracle::monte_carlo::{estimate, two_sided_p};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
@@ -43,27 +47,15 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
     let samples = profile.chi2_samples();
     let resolution = 16;
     {
-        let (m, spec_run) = (subject.clone(), spec.clone());
+        let m = subject.clone();
         let case = json!({"samples": samples, "resolution": resolution});
-        let case_run = case.clone();
-        out.push(PlannedCheck {
-            check: "sampling.chi2".into(),
-            model: spec.clone(),
-            case,
-            why: format!("{why}: importance sampling of normals"),
-            covers: vec![covers(family, "sample_wm", "default")],
-            statistical: true,
-            run: Box::new(move |ctx| {
-                timed(|| {
-                    let mut r = CheckRecord::new(
-                        "sampling.chi2",
-                        spec_run.clone(),
-                        case_run.clone(),
-                        SOURCE,
-                    );
-                    r.covers = vec![covers(family, "sample_wm", "default")];
-                    r.seed = Some(ctx.seed);
-                    let sampler = m.model.as_sampler().expect("planned for samplers");
+        out.push(
+            Check::new("sampling.chi2", spec.clone(), case, SOURCE)
+                .why(format!("{why}: importance sampling of normals"))
+                .covers(vec![covers(family, "sample_wm", "default")])
+                .statistical()
+                .run(move |r, ctx| {
+                    let sampler = need(m.model.as_sampler(), "normal sampler")?;
                     let config = Chi2Config {
                         resolution,
                         samples,
@@ -77,11 +69,10 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                         CELL_RELATIVE_TOLERANCE,
                         Some(m.lobe()),
                     );
-                    fill_chi2(&mut r, &result, ctx, samples);
-                    r
-                })
-            }),
-        });
+                    fill_chi2(r, &result, ctx, samples);
+                    Ok(())
+                }),
+        );
     }
     for marginal in [Marginal::CosTheta, Marginal::Phi] {
         out.push(ks::plan_ks(
@@ -92,119 +83,108 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
         ));
     }
     {
-        let (m, spec_run) = (subject.clone(), spec.clone());
-        out.push(PlannedCheck {
-            check: "sampling.pdf_consistency".into(),
-            model: spec.clone(),
-            case: json!({"points": 4096}),
-            why: format!("{why}: the sampler's pdf must be D(m)(m·n) at what it samples"),
-            covers: vec![covers(family, "pdf_wm", "default")],
-            statistical: false,
-            run: Box::new(move |_| {
-                timed(|| {
-                    let mut r = CheckRecord::new(
-                        "sampling.pdf_consistency",
-                        spec_run.clone(),
-                        json!({"points": 4096}),
-                        SOURCE,
-                    );
-                    r.covers = vec![covers(family, "pdf_wm", "default")];
-                    let sampler = m.model.as_sampler().expect("planned for samplers");
-                    let mut worst = 0.0f64;
-                    let g = 0.618_033_988_749_894_9;
-                    for i in 0..4096u32 {
-                        let u = [(f64::from(i) + 0.5) / 4096.0, (f64::from(i) * g).fract()];
-                        let mm = sampler.sample_wm(u);
-                        let len = dot(mm, mm).sqrt();
-                        let pdf = sampler.pdf_wm(mm);
-                        let want = m.model.d(mm) * mm[2];
-                        let e = if !(mm[2] >= 0.0) || !pdf.is_finite() {
-                            f64::INFINITY
-                        } else {
-                            crate::record::relative_error(pdf, want).max((len - 1.0).abs())
-                        };
-                        worst = worst.max(e);
-                    }
-                    compare_exact(&mut r, worst, 0.0, &PDF_CONSISTENCY);
-                    // `worst` is itself a relative error (against 0, `compare` says absolute).
-                    r.measured = Some(Measured::Relative { error: worst });
-                    r
-                })
+        let m = subject.clone();
+        out.push(
+            Check::new(
+                "sampling.pdf_consistency",
+                spec.clone(),
+                json!({"points": 4096}),
+                SOURCE,
+            )
+            .why(format!(
+                "{why}: the sampler's pdf must be D(m)(m·n) at what it samples"
+            ))
+            .covers(vec![covers(family, "pdf_wm", "default")])
+            .run(move |r, _| {
+                let sampler = need(m.model.as_sampler(), "normal sampler")?;
+                let mut worst = 0.0f64;
+                let g = 0.618_033_988_749_894_9;
+                for i in 0..4096u32 {
+                    let u = [(f64::from(i) + 0.5) / 4096.0, (f64::from(i) * g).fract()];
+                    let mm = sampler.sample_wm(u);
+                    let len = dot(mm, mm).sqrt();
+                    let pdf = sampler.pdf_wm(mm);
+                    let want = m.model.d(mm) * mm[2];
+                    let e = if !(mm[2] >= 0.0) || !pdf.is_finite() {
+                        f64::INFINITY
+                    } else {
+                        crate::record::relative_error(pdf, want).max((len - 1.0).abs())
+                    };
+                    worst = worst.max(e);
+                }
+                compare_exact(r, worst, 0.0, &PDF_CONSISTENCY);
+                // `worst` is itself a relative error (against 0, `compare` says absolute).
+                r.measured = Some(Measured::Relative { error: worst });
+                Ok(())
             }),
-        });
+        );
     }
     out.push(super::jacobian::plan(subject, why));
     if subject.model.as_smith().is_some() {
-        let (m, spec_run) = (subject.clone(), spec.clone());
+        let m = subject.clone();
         let theta = 1.2;
         let mc_samples = samples;
         let case = json!({"theta": theta, "phi": 0.3, "samples": mc_samples});
-        let case_run = case.clone();
-        out.push(PlannedCheck {
-            check: "sampling.lambda_monte_carlo".into(),
-            model: spec.clone(),
-            case,
-            why: format!("{why}: the sampler and Λ must agree on the back-facing projected area"),
-            covers: vec![covers(family, "sample_wm", "default")],
-            statistical: true,
-            run: Box::new(move |ctx| {
-                timed(|| {
-                    let mut r = CheckRecord::new(
-                        "sampling.lambda_monte_carlo",
-                        spec_run.clone(),
-                        case_run.clone(),
-                        "Λ(w) cos θ = ∫⟨−w·m⟩⁺D(m)dm = E_{m∼D(m)(m·n)}[⟨−w·m⟩⁺/(m·n)]",
-                    );
-                    r.covers = vec![covers(family, "sample_wm", "default")];
-                    r.seed = Some(ctx.seed);
-                    let sampler = m.model.as_sampler().expect("planned for samplers");
-                    let smith = m.model.as_smith().expect("planned for Smith models");
-                    let w = from_spherical(theta, 0.3);
-                    let e = estimate(
-                        &|u| {
-                            let mm = sampler.sample_wm(u);
-                            let c = -dot(w, mm);
-                            if c > 0.0 && mm[2] > 0.0 {
-                                c / mm[2]
-                            } else {
-                                0.0
-                            }
-                        },
-                        mc_samples,
-                        ctx.seed,
-                    );
-                    let value = smith.lambda(w) * w[2];
-                    r.value = Some(value);
-                    r.oracle = Some(OracleValue {
-                        value: e.mean,
-                        uncertainty: e.standard_error,
-                        kind: "standard_error",
-                    });
-                    r.cost.samples = mc_samples;
-                    let z = (value - e.mean) / e.standard_error;
-                    let p = if e.standard_error > 0.0 {
-                        two_sided_p(z)
-                    } else if value == e.mean {
-                        1.0
-                    } else {
-                        0.0
-                    };
-                    r.measured = Some(Measured::PValue {
-                        p,
-                        statistic: z,
-                        dof: 0,
-                        alpha: STATISTICAL_ALPHA.value,
-                    });
-                    r.tolerance = Some(applied(&STATISTICAL_ALPHA));
-                    r.verdict = if p >= STATISTICAL_ALPHA.value {
-                        Verdict::Pass
-                    } else {
-                        Verdict::Fail
-                    };
-                    r
-                })
+        out.push(
+            Check::new(
+                "sampling.lambda_monte_carlo",
+                spec.clone(),
+                case,
+                "Λ(w) cos θ = ∫⟨−w·m⟩⁺D(m)dm = E_{m∼D(m)(m·n)}[⟨−w·m⟩⁺/(m·n)]",
+            )
+            .why(format!(
+                "{why}: the sampler and Λ must agree on the back-facing projected area"
+            ))
+            .covers(vec![covers(family, "sample_wm", "default")])
+            .statistical()
+            .run(move |r, ctx| {
+                let sampler = need(m.model.as_sampler(), "normal sampler")?;
+                let smith = need(m.model.as_smith(), "Smith masking")?;
+                let w = from_spherical(theta, 0.3);
+                let e = estimate(
+                    &|u| {
+                        let mm = sampler.sample_wm(u);
+                        let c = -dot(w, mm);
+                        if c > 0.0 && mm[2] > 0.0 {
+                            c / mm[2]
+                        } else {
+                            0.0
+                        }
+                    },
+                    mc_samples,
+                    ctx.seed,
+                );
+                let value = smith.lambda(w) * w[2];
+                r.value = Some(value);
+                r.oracle = Some(OracleValue {
+                    value: e.mean,
+                    uncertainty: e.standard_error,
+                    kind: "standard_error",
+                });
+                r.cost.samples = mc_samples;
+                let z = (value - e.mean) / e.standard_error;
+                let p = if e.standard_error > 0.0 {
+                    two_sided_p(z)
+                } else if value == e.mean {
+                    1.0
+                } else {
+                    0.0
+                };
+                r.measured = Some(Measured::PValue {
+                    p,
+                    statistic: z,
+                    dof: 0,
+                    alpha: STATISTICAL_ALPHA.value,
+                });
+                r.tolerance = Some(applied(&STATISTICAL_ALPHA));
+                r.verdict = if p >= STATISTICAL_ALPHA.value {
+                    Verdict::Pass
+                } else {
+                    Verdict::Fail
+                };
+                Ok(())
             }),
-        });
+        );
     }
     out
 }
@@ -253,29 +233,31 @@ fn fill_chi2(
     }
 }
 
+/// The chi-square of a scalar sampler of a density with kinks (visible normals, the pseudo-VNIS
+/// proxy) on the `resolution` grid with `samples` samples from the record's stream, into `r`.
+fn chi2_kinked(
+    r: &mut CheckRecord,
+    ctx: &super::RunContext,
+    resolution: usize,
+    samples: u64,
+    sample: &(dyn Fn([f64; 2]) -> Vec3 + Sync),
+    pdf: &(dyn Fn(Vec3) -> f64 + Sync),
+) {
+    let config = Chi2Config {
+        resolution,
+        samples,
+        seed: ctx.seed,
+        alpha: STATISTICAL_ALPHA.value,
+    };
+    let result = chi2_test_in(sample, pdf, &config, KINKED_CELL_RELATIVE_TOLERANCE, None);
+    fill_chi2(r, &result, ctx, samples);
+}
+
 /// A skipped record for a check the scene calls for but the model cannot support.
 fn skipped(check: &str, spec: &Value, case: Value, why: &str, reason: String) -> Planned {
-    let (spec_run, case_run, check_run, reason_run) = (
-        spec.clone(),
-        case.clone(),
-        check.to_string(),
-        reason.clone(),
-    );
-    Planned {
-        check: check.into(),
-        model: spec.clone(),
-        case,
-        why: why.to_string(),
-        covers: Vec::new(),
-        statistical: false,
-        run: Box::new(move |_| {
-            let mut r = CheckRecord::new(&check_run, spec_run.clone(), case_run.clone(), "");
-            r.verdict = Verdict::Skipped {
-                reason: reason_run.clone(),
-            };
-            r
-        }),
-    }
+    Check::new(check, spec.clone(), case, "")
+        .why(why)
+        .skipped(reason)
 }
 
 #[cfg(test)]

@@ -11,11 +11,12 @@ mod circular;
 #[allow(clippy::module_inception)]
 mod sg;
 
+use crate::check::Check;
 use asg::plan_asg;
 use circular::plan_circular;
 use sg::plan_sg;
 
-use super::{compare, compare_exact, covers, timed, Planned, Profile};
+use super::{compare, compare_exact, covers, Planned, Profile};
 use crate::oracle::quadrature::{frame_about, integrate_cap, Accuracy, Cuts};
 use crate::oracle::Estimate;
 use crate::record::{CheckRecord, Verdict};
@@ -146,23 +147,13 @@ fn planned(
     source: &'static str,
     body: impl Fn(&mut CheckRecord) + Send + Sync + 'static,
 ) -> Planned {
-    let (case_run, covered_run) = (case.clone(), covered.clone());
-    Planned {
-        check: check.into(),
-        model: Value::Null,
-        case,
-        why: why.to_string(),
-        covers: covered,
-        statistical: false,
-        run: Box::new(move |_| {
-            timed(|| {
-                let mut r = CheckRecord::new(check, Value::Null, case_run.clone(), source);
-                r.covers = covered_run.clone();
-                body(&mut r);
-                r
-            })
-        }),
-    }
+    Check::new(check, Value::Null, case, source)
+        .why(why.to_string())
+        .covers(covered)
+        .run(move |r, _| {
+            body(r);
+            Ok(())
+        })
 }
 
 fn cover(quantity: &str, route: &str) -> String {

@@ -6,8 +6,9 @@
 //! covariance), plus Λ against the oracle at one interior incidence.
 
 use super::smith::lambda_oracle_for;
-use super::{compare, covers, timed, Planned, PlannedCheck};
-use crate::record::{CheckRecord, Verdict};
+use super::{compare, covers, Planned, PlannedCheck};
+use crate::check::Check;
+use crate::record::Verdict;
 use crate::subject::Subject;
 use crate::tolerance::{CLOSED_FORM, IDENTITY, NUMERICAL_ROUTE};
 use mfh_reference::geometry::from_spherical;
@@ -121,36 +122,23 @@ pub fn probe(model: &dyn Ndf) -> Vec<String> {
 pub fn plan_incidence<'a>(subject: &Arc<Subject<'a>>, why: &str) -> PlannedCheck<'a> {
     let family = subject.family();
     let covered = vec![covers(family, "d", "default")];
-    let (s, covered_run) = (subject.clone(), covered.clone());
+    let s = subject.clone();
     let case = json!({"theta": "0 … π/2 exactly", "u": "edges and corners of [0, 1)²"});
-    let case_run = case.clone();
-    PlannedCheck {
-        check: "stability.incidence".into(),
-        model: subject.label.clone(),
-        case,
-        why: format!("{why}: exactly normal and grazing incidence, samplers at the edges of u"),
-        covers: covered,
-        statistical: false,
-        run: Box::new(move |_| {
-            timed(|| {
-                let mut r = CheckRecord::new(
-                    "stability.incidence",
-                    s.label.clone(),
-                    case_run.clone(),
-                    SOURCE,
-                );
-                r.covers = covered_run.clone();
-                let problems = probe(s.model.as_ref());
-                r.verdict = if problems.is_empty() {
-                    Verdict::Pass
-                } else {
-                    r.case["problems"] = json!(problems);
-                    Verdict::Fail
-                };
-                r
-            })
-        }),
-    }
+    Check::new("stability.incidence", subject.label.clone(), case, SOURCE)
+        .why(format!(
+            "{why}: exactly normal and grazing incidence, samplers at the edges of u"
+        ))
+        .covers(covered)
+        .run(move |r, _| {
+            let problems = probe(s.model.as_ref());
+            r.verdict = if problems.is_empty() {
+                Verdict::Pass
+            } else {
+                r.case["problems"] = json!(problems);
+                Verdict::Fail
+            };
+            Ok(())
+        })
 }
 
 /// The stressed variants of a reference spec: each parameter the registry lists pushed to the
@@ -193,67 +181,57 @@ pub fn plan(spec: &ModelSpec, why: &str) -> Vec<Planned> {
                 covers(family, "d", "default"),
                 covers(family, "lambda", "default"),
             ];
-            let covered_run = covered.clone();
             let case = json!({"variant": label});
             let (case_run, variant_run) = (case.clone(), variant.clone());
-            Planned {
-                check: "stability.extremes".into(),
-                model: variant,
+            Check::new(
+                "stability.extremes",
+                variant,
                 case,
-                why: format!("{why}: hard case {label}"),
-                covers: covered,
-                statistical: false,
-                run: Box::new(move |_| {
-                    timed(|| {
-                        let mut r = CheckRecord::new(
-                            "stability.extremes",
-                            variant_run.clone(),
-                            case_run.clone(),
-                            "issue 2 / ARCHITECTURE.md: finite and accurate for γ ∈ (1.5, 1e8], \
+                "issue 2 / ARCHITECTURE.md: finite and accurate for γ ∈ (1.5, 1e8], \
                              α ∈ [1e-4, 10], θ ∈ [0, π/2]",
-                        );
-                        r.covers = covered_run.clone();
-                        let subject = match serde_json::from_value::<ModelSpec>(variant_run.clone())
-                            .map_err(|e| e.to_string())
-                            .and_then(|s| Subject::reference(&s).map_err(|e| e.to_string()))
-                        {
-                            Ok(m) => m,
-                            Err(e) => {
-                                r.verdict = Verdict::Error {
-                                    message: format!("variant rejected: {e}"),
-                                };
-                                return r;
-                            }
+            )
+            .why(format!("{why}: hard case {label}"))
+            .covers(covered)
+            .run(move |r, _| {
+                let subject = match serde_json::from_value::<ModelSpec>(variant_run.clone())
+                    .map_err(|e| e.to_string())
+                    .and_then(|s| Subject::reference(&s).map_err(|e| e.to_string()))
+                {
+                    Ok(m) => m,
+                    Err(e) => {
+                        r.verdict = Verdict::Error {
+                            message: format!("variant rejected: {e}"),
                         };
-                        let mut problems = probe(subject.model.as_ref());
-                        // Accuracy at one interior incidence, against the oracle.
-                        if let Some(s) = subject.model.as_smith() {
-                            let w = from_spherical(1.0, 0.4);
-                            let value = s.lambda(w);
-                            let oracle = lambda_oracle_for(&subject, w);
-                            let tol = if subject.lambda_numerical() {
-                                &NUMERICAL_ROUTE
-                            } else {
-                                &CLOSED_FORM
-                            };
-                            compare(&mut r, value, oracle, tol);
-                            if r.verdict == Verdict::Fail {
-                                problems.push(format!(
-                                    "Λ(θ = 1) = {value} against the oracle {}",
-                                    oracle.value
-                                ));
-                            }
-                        }
-                        r.verdict = if problems.is_empty() {
-                            Verdict::Pass
-                        } else {
-                            r.case = json!({"variant": case_run["variant"], "problems": problems});
-                            Verdict::Fail
-                        };
-                        r
-                    })
-                }),
-            }
+                        return Ok(());
+                    }
+                };
+                let mut problems = probe(subject.model.as_ref());
+                // Accuracy at one interior incidence, against the oracle.
+                if let Some(s) = subject.model.as_smith() {
+                    let w = from_spherical(1.0, 0.4);
+                    let value = s.lambda(w);
+                    let oracle = lambda_oracle_for(&subject, w);
+                    let tol = if subject.lambda_numerical() {
+                        &NUMERICAL_ROUTE
+                    } else {
+                        &CLOSED_FORM
+                    };
+                    compare(r, value, oracle, tol);
+                    if r.verdict == Verdict::Fail {
+                        problems.push(format!(
+                            "Λ(θ = 1) = {value} against the oracle {}",
+                            oracle.value
+                        ));
+                    }
+                }
+                r.verdict = if problems.is_empty() {
+                    Verdict::Pass
+                } else {
+                    r.case = json!({"variant": case_run["variant"], "problems": problems});
+                    Verdict::Fail
+                };
+                Ok(())
+            })
         })
         .collect()
 }

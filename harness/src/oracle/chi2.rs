@@ -422,32 +422,12 @@ where
     S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
-    chi2_test_to(sample, pdf, config, CELL_RELATIVE_TOLERANCE)
+    chi2_test_in(sample, pdf, config, CELL_RELATIVE_TOLERANCE, None)
 }
 
 /// [`chi2_test`] with the expected counts integrated to the per-cell relative tolerance
-/// `cell_relative` (e.g. [`KINKED_CELL_RELATIVE_TOLERANCE`]).
-pub fn chi2_test_to<S, P>(
-    sample: &S,
-    pdf: &P,
-    config: &Chi2Config,
-    cell_relative: f64,
-) -> Chi2Result
-where
-    S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
-    P: Fn(Vec3) -> f64 + Sync + ?Sized,
-{
-    chi2_test_batch_in(
-        &|u: &[[f64; 2]], m: &mut [Vec3]| scalar_batch(sample, u, m),
-        pdf,
-        config,
-        cell_relative,
-        None,
-    )
-}
-
-/// [`chi2_test_to`] with the expected counts integrated about a given lobe (e.g. measured once
-/// from the model's D by [`lobe::measure`]); `None` measures it from `pdf`.
+/// `cell_relative` (e.g. [`KINKED_CELL_RELATIVE_TOLERANCE`]) about a given lobe (e.g. measured
+/// once from the model's D by [`lobe::measure`]); `None` measures it from `pdf`.
 pub fn chi2_test_in<S, P>(
     sample: &S,
     pdf: &P,
@@ -468,23 +448,8 @@ where
     )
 }
 
-/// [`chi2_test_to`] with a batch sampler (`sample(u, m)` sets `m[i]` to the normal of `u[i]`,
+/// [`chi2_test_in`] with a batch sampler (`sample(u, m)` sets `m[i]` to the normal of `u[i]`,
 /// as [`observe_batch`] takes it): the same result as the scalar form of the sampler.
-pub fn chi2_test_batch_to<S, P>(
-    sample: &S,
-    pdf: &P,
-    config: &Chi2Config,
-    cell_relative: f64,
-) -> Chi2Result
-where
-    S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
-    P: Fn(Vec3) -> f64 + Sync + ?Sized,
-{
-    chi2_test_batch_in(sample, pdf, config, cell_relative, None)
-}
-
-/// The chi-square test with a batch sampler and, optionally, the lobe the expected counts are
-/// integrated about.
 pub fn chi2_test_batch_in<S, P>(
     sample: &S,
     pdf: &P,
@@ -555,11 +520,12 @@ where
 /// Draws through [`NormalSampler::sample_wm_batch`] (the scalar method for models that do not
 /// override it): the same counts as through `sample_wm`.
 pub fn chi2_test_sampler(sampler: &dyn NormalSampler, config: &Chi2Config) -> Chi2Result {
-    chi2_test_batch_to(
+    chi2_test_batch_in(
         &|u: &[[f64; 2]], m: &mut [Vec3]| sampler.sample_wm_batch(u, m),
         &|m| sampler.pdf_wm(m),
         config,
         CELL_RELATIVE_TOLERANCE,
+        None,
     )
 }
 

@@ -8,14 +8,14 @@ use mfh_harness::cli::run;
 use serde_json::{json, Value};
 
 /// One in-process run of `mfh`.
-struct Run {
-    status: i32,
-    stdout: String,
-    stderr: String,
+pub struct Run {
+    pub status: i32,
+    pub stdout: String,
+    pub stderr: String,
 }
 
 /// Runs `mfh <args>` with `stdin` as standard input.
-fn mfh(args: &[&str], stdin: &str) -> Run {
+pub fn mfh(args: &[&str], stdin: &str) -> Run {
     let argv: Vec<&str> = std::iter::once("mfh").chain(args.iter().copied()).collect();
     let (mut out, mut err) = (Vec::new(), Vec::new());
     let status = run(argv, &mut stdin.as_bytes(), &mut out, &mut err);
@@ -27,7 +27,7 @@ fn mfh(args: &[&str], stdin: &str) -> Run {
 }
 
 /// The answer lines, each parsed (each must be one JSON object).
-fn answers(r: &Run) -> Vec<Value> {
+pub fn answers(r: &Run) -> Vec<Value> {
     r.stdout
         .lines()
         .map(|l| {
@@ -39,15 +39,15 @@ fn answers(r: &Run) -> Vec<Value> {
 }
 
 /// Query lines, one per line.
-fn lines(queries: &[Value]) -> String {
+pub fn lines(queries: &[Value]) -> String {
     queries.iter().map(|q| format!("{q}\n")).collect()
 }
 
 /// What the library answers: a JSON value, or the kind of error the CLI must report.
-type Expect = Result<Value, &'static str>;
+pub type Expect = Result<Value, &'static str>;
 
 /// A number as the contract writes it: finite numbers as JSON numbers, the rest as strings.
-fn num(x: f64) -> Value {
+pub fn num(x: f64) -> Value {
     if x.is_nan() {
         json!("nan")
     } else if x == f64::INFINITY {
@@ -61,7 +61,7 @@ fn num(x: f64) -> Value {
 
 /// Equality of answers with numbers compared bit for bit (a JSON number written from an f64
 /// parses back to the same f64).
-fn same(a: &Value, b: &Value) -> bool {
+pub fn same(a: &Value, b: &Value) -> bool {
     match (a, b) {
         (Value::Number(x), Value::Number(y)) => {
             x.as_f64().map(f64::to_bits) == y.as_f64().map(f64::to_bits)
@@ -77,7 +77,7 @@ fn same(a: &Value, b: &Value) -> bool {
 }
 
 /// Asserts that `answer` is what `expect` says, for the query `query`.
-fn assert_answer(query: &Value, answer: &Value, expect: &Expect) {
+pub fn assert_answer(query: &Value, answer: &Value, expect: &Expect) {
     match expect {
         Ok(v) => assert!(
             same(answer, &json!({ "value": v })),

@@ -23,7 +23,8 @@ mod seed004;
 pub use scope::{Concern, Effect, Scope, STUDENT};
 
 use super::smith::lambda_oracle;
-use super::{applied, covers, timed, Planned};
+use super::{applied, covers, Planned};
+use crate::check::Check;
 use crate::oracle::quadrature::{
     integrate, integrate_cap, integrate_hemisphere, integrate_line, integrate_pieces,
     integrate_upper, Accuracy,
@@ -360,50 +361,29 @@ pub fn plan(scope: &Scope, why: &str) -> Vec<Planned> {
         if let Value::Object(map) = &mut case {
             map.insert("erratum".into(), json!(id));
         }
-        let (model_run, case_run, covers_run) = (model.clone(), case.clone(), covers.clone());
-        out.push(Planned {
-            check: CHECK.into(),
-            model,
-            case,
-            why: format!("{why}: erratum {id} ({}); {used}", description(id)),
-            covers,
-            statistical: false,
-            run: Box::new(move |_| {
-                timed(|| {
-                    let mut r =
-                        CheckRecord::new(CHECK, model_run.clone(), case_run.clone(), source);
-                    r.covers = covers_run.clone();
+        out.push(
+            Check::new(CHECK, model, case, source)
+                .why(format!("{why}: erratum {id} ({}); {used}", description(id)))
+                .covers(covers)
+                .run(move |r, _| {
                     match run() {
-                        Ok(shown) => decide(&mut r, id, description(id), &shown),
+                        Ok(shown) => decide(r, id, description(id), &shown),
                         Err(message) => r.verdict = Verdict::Error { message },
                     }
-                    r
-                })
-            }),
-        });
+                    Ok(())
+                }),
+        );
     }
     for (id, reason, concern) in NOT_DEMONSTRABLE {
         let Some(used) = scope.uses(concern) else {
             continue;
         };
         let case = json!({"erratum": id});
-        let case_run = case.clone();
-        out.push(Planned {
-            check: CHECK.into(),
-            model: Value::Null,
-            case,
-            why: format!("{why}: erratum {id} ({}); {used}", description(id)),
-            covers: Vec::new(),
-            statistical: false,
-            run: Box::new(move |_| {
-                let mut r =
-                    CheckRecord::new(CHECK, Value::Null, case_run.clone(), "reference/ERRATA.md");
-                r.verdict = Verdict::Skipped {
-                    reason: format!("[{id}] not demonstrable: {reason}"),
-                };
-                r
-            }),
-        });
+        out.push(
+            Check::new(CHECK, Value::Null, case, "reference/ERRATA.md")
+                .why(format!("{why}: erratum {id} ({}); {used}", description(id)))
+                .skipped(format!("[{id}] not demonstrable: {reason}")),
+        );
     }
     out
 }
@@ -481,6 +461,6 @@ mod tests {
     }
 
     fn ctx() -> super::super::RunContext {
-        super::super::RunContext { seed: 1, out: None }
+        super::super::RunContext { seed: 1 }
     }
 }

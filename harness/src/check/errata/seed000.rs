@@ -293,7 +293,8 @@ fn e000_14() -> Result<Shown, String> {
         (c2 * m.d_x(theta) * dy0 + s2 * m.d_y(theta) * dx0) * v[2]
     };
     // Cut at the profiles' breakpoints, where D has kinks (22 s without, in the audit).
-    let kinks = crate::check::theta_kinks(&serde_json::to_value(m.spec()).unwrap_or(Value::Null));
+    let spec = m.spec();
+    let kinks = (mfh_reference::registry::info(&spec).theta_kinks)(&spec);
     let at_kinks = |_: f64| kinks.clone();
     let cuts = || {
         Some(crate::oracle::quadrature::Cuts {

@@ -2,7 +2,8 @@
 //! marginal, with the model's and the samples' CDF curves in the record's data.
 
 use super::SOURCE;
-use crate::check::{applied, covers, timed, PlannedCheck};
+use crate::check::Check;
+use crate::check::{applied, covers, PlannedCheck};
 use crate::oracle::ks::{self, KsConfig, Marginal};
 use crate::record::{CheckRecord, Measured, Verdict};
 use crate::subject::Subject;
@@ -24,53 +25,38 @@ pub(super) fn plan_ks<'a>(
     let spec = &subject.label;
     let model = subject.clone();
     let case = json!({"marginal": marginal.name(), "samples": samples});
-    let (spec_run, case_run) = (spec.clone(), case.clone());
     let kinks = subject.theta_kinks();
-    PlannedCheck {
-        check: "sampling.ks_marginals".into(),
-        model: spec.clone(),
-        case,
-        why: format!(
+    Check::new("sampling.ks_marginals", spec.clone(), case, SOURCE)
+        .why(format!(
             "{why}: the {} marginal of the sampled normals must follow the pdf's",
             marginal.name()
-        ),
-        covers: vec![covers(family, "sample_wm", "default")],
-        statistical: true,
-        run: Box::new(move |ctx| {
-            timed(|| {
-                let mut r = CheckRecord::new(
-                    "sampling.ks_marginals",
-                    spec_run.clone(),
-                    case_run.clone(),
-                    SOURCE,
-                );
-                r.covers = vec![covers(family, "sample_wm", "default")];
-                r.seed = Some(ctx.seed);
-                let Some(sampler) = model.model.as_sampler() else {
-                    r.verdict = Verdict::Error {
-                        message: "the model has no sampler".into(),
-                    };
-                    return r;
+        ))
+        .covers(vec![covers(family, "sample_wm", "default")])
+        .statistical()
+        .run(move |r, ctx| {
+            let Some(sampler) = model.model.as_sampler() else {
+                r.verdict = Verdict::Error {
+                    message: "the model has no sampler".into(),
                 };
-                let config = KsConfig {
-                    samples,
-                    seed: ctx.seed,
-                    alpha: STATISTICAL_ALPHA.value,
-                };
-                let kept = ks::ks_test_lobe_kept(
-                    &|u| sampler.sample_wm(u),
-                    &|m| sampler.pdf_wm(m),
-                    marginal,
-                    model.lobe(),
-                    &kinks,
-                    &config,
-                );
-                fill_ks(&mut r, &kept.result);
-                r.data = ks_marginal_data(&kept);
-                r
-            })
-        }),
-    }
+                return Ok(());
+            };
+            let config = KsConfig {
+                samples,
+                seed: ctx.seed,
+                alpha: STATISTICAL_ALPHA.value,
+            };
+            let kept = ks::ks_test_lobe_kept(
+                &|u| sampler.sample_wm(u),
+                &|m| sampler.pdf_wm(m),
+                marginal,
+                model.lobe(),
+                &kinks,
+                &config,
+            );
+            fill_ks(r, &kept.result);
+            r.data = ks_marginal_data(&kept);
+            Ok(())
+        })
 }
 
 /// Points of the KS marginal curves in a record's data.

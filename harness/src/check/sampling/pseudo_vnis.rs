@@ -3,9 +3,9 @@
 //! one.
 
 use super::visible::{terminator_azimuths, visible_kinks, VISIBLE_INCIDENCES};
-use super::{fill_chi2, skipped};
-use crate::check::{applied, timed, Planned, Profile};
-use crate::oracle::chi2::{chi2_test_to, Chi2Config, KINKED_CELL_RELATIVE_TOLERANCE};
+use super::{chi2_kinked, skipped};
+use crate::check::Check;
+use crate::check::{applied, Planned, Profile};
 use crate::oracle::monte_carlo::{estimate, two_sided_p};
 use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
@@ -81,81 +81,57 @@ pub fn plan_pseudo_vnis(
     // Eq 43 is stated for the uncorrelated GAF; a material that masks otherwise uses its own.
     let masking = masking.unwrap_or(Masking::Uncorrelated);
     let samples = profile.chi2_samples();
-    let width = crate::check::lobe_width(&spec_value);
+    let width = crate::subject::spec_width(spec);
     let mut out = Vec::new();
     for &(theta, phi) in &VISIBLE_INCIDENCES {
         let resolution = 16;
         let case = json!({"theta_i": theta, "phi_i": phi, "proxy": vnis.proxy().name(),
                           "sigma": vnis.sigma(), "samples": samples, "resolution": resolution});
-        let (v, spec_run, case_run) = (vnis.clone(), spec_value.clone(), case.clone());
-        out.push(Planned {
-            check: "sampling.chi2_pseudo_vnis".into(),
-            model: spec_value.clone(),
-            case,
-            why: format!(
+        let v = vnis.clone();
+        out.push(
+            Check::new(
+                "sampling.chi2_pseudo_vnis",
+                spec_value.clone(),
+                case,
+                PSEUDO_VNIS_SOURCE,
+            )
+            .why(format!(
                 "{why}: the pseudo-VNIS sampler ({} proxy) must draw from its density",
                 vnis.proxy().name()
-            ),
-            covers: Vec::new(),
-            statistical: true,
-            run: Box::new(move |ctx| {
-                timed(|| {
-                    let mut r = CheckRecord::new(
-                        "sampling.chi2_pseudo_vnis",
-                        spec_run.clone(),
-                        case_run.clone(),
-                        PSEUDO_VNIS_SOURCE,
-                    );
-                    r.seed = Some(ctx.seed);
-                    let wi = from_spherical(theta, phi);
-                    let config = Chi2Config {
-                        resolution,
-                        samples,
-                        seed: ctx.seed,
-                        alpha: STATISTICAL_ALPHA.value,
-                    };
-                    let result = chi2_test_to(
-                        &|u| v.sample_wm(wi, u),
-                        &|m| v.pdf_wm(wi, m),
-                        &config,
-                        KINKED_CELL_RELATIVE_TOLERANCE,
-                    );
-                    fill_chi2(&mut r, &result, ctx, samples);
-                    r
-                })
+            ))
+            .statistical()
+            .run(move |r, ctx| {
+                let wi = from_spherical(theta, phi);
+                chi2_kinked(r, ctx, resolution, samples, &|u| v.sample_wm(wi, u), &|m| {
+                    v.pdf_wm(wi, m)
+                });
+                Ok(())
             }),
-        });
+        );
         for weight in ["printed", "unbiased"] {
             let case = json!({"theta_i": theta, "phi_i": phi, "weight": weight,
                               "proxy": vnis.proxy().name(), "sigma": vnis.sigma(),
                               "masking": masking, "samples": samples});
-            let (v, spec_run, case_run) = (vnis.clone(), spec_value.clone(), case.clone());
-            out.push(Planned {
-                check: "sampling.pseudo_vnis".into(),
-                model: spec_value.clone(),
-                case,
-                why: format!(
+            let v = vnis.clone();
+            out.push(
+                Check::new(
+                    "sampling.pseudo_vnis",
+                    spec_value.clone(),
+                    case,
+                    PSEUDO_VNIS_SOURCE,
+                )
+                .why(format!(
                     "{why}: the pseudo-VNIS estimator ({} proxy, weight {weight}) must be \
                      unbiased",
                     vnis.proxy().name()
-                ),
-                covers: Vec::new(),
-                statistical: true,
-                run: Box::new(move |ctx| {
-                    timed(|| {
-                        let mut r = CheckRecord::new(
-                            "sampling.pseudo_vnis",
-                            spec_run.clone(),
-                            case_run.clone(),
-                            PSEUDO_VNIS_SOURCE,
-                        );
-                        r.seed = Some(ctx.seed);
-                        pseudo_vnis_record(&mut r, &v, theta, phi, weight, masking, samples, width);
-                        r.seed = Some(ctx.seed);
-                        r
-                    })
+                ))
+                .statistical()
+                .run(move |r, ctx| {
+                    pseudo_vnis_record(r, &v, theta, phi, weight, masking, samples, width);
+                    r.seed = Some(ctx.seed);
+                    Ok(())
                 }),
-            });
+            );
         }
     }
     out

@@ -5,7 +5,7 @@ use crate::oracle::ks::{self as oracle_ks, KsConfig, Marginal};
 use mfh_reference::{Masking, ModelSpec};
 
 fn run(plan: &[PlannedCheck<'_>]) -> Vec<CheckRecord> {
-    let ctx = RunContext { seed: 7, out: None };
+    let ctx = RunContext { seed: 7 };
     plan.iter()
         .map(|p| {
             let r = (p.run)(&ctx);

@@ -1,13 +1,12 @@
 //! Visible-normal sampling: the chi-square of `sample_wm_visible` against `pdf_wm_visible` at
 //! fixed incidences and the normalization of `pdf_wm_visible` (Heitz & d'Eon 2014, Heitz 2018).
 
-use super::{fill_chi2, skipped};
-use crate::check::{compare, covers, timed, PlannedCheck, Profile};
-use crate::oracle::chi2::{chi2_test_to, Chi2Config, KINKED_CELL_RELATIVE_TOLERANCE};
+use super::{chi2_kinked, skipped};
+use crate::check::{compare, covers, PlannedCheck, Profile};
+use crate::check::{need, Check};
 use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
-use crate::record::CheckRecord;
 use crate::subject::Subject;
-use crate::tolerance::{NORMALIZATION, STATISTICAL_ALPHA};
+use crate::tolerance::NORMALIZATION;
 use mfh_reference::geometry::{from_spherical, Vec3};
 use serde_json::json;
 use std::sync::Arc;
@@ -68,93 +67,62 @@ pub fn plan_visible<'a>(
     let resolution = 16;
     let mut out = Vec::new();
     for &(theta, phi) in &VISIBLE_INCIDENCES {
-        let (m, spec_run) = (subject.clone(), spec.clone());
+        let m = subject.clone();
         let case = json!({"theta_i": theta, "phi_i": phi, "samples": samples,
                           "resolution": resolution});
-        let case_run = case.clone();
         let ids = vec![
             covers(family, "sample_wm_visible", "default"),
             covers(family, "pdf_wm_visible", "default"),
         ];
-        let ids_run = ids.clone();
-        out.push(PlannedCheck {
-            check: "sampling.chi2_visible".into(),
-            model: spec.clone(),
-            case,
-            why: format!("{why}: importance sampling of visible normals"),
-            covers: ids,
-            statistical: true,
-            run: Box::new(move |ctx| {
-                timed(|| {
-                    let mut r = CheckRecord::new(
-                        "sampling.chi2_visible",
-                        spec_run.clone(),
-                        case_run.clone(),
-                        VISIBLE_SOURCE,
-                    );
-                    r.covers = ids_run.clone();
-                    r.seed = Some(ctx.seed);
-                    let v = m
-                        .model
-                        .as_visible_sampler()
-                        .expect("planned for visible samplers");
+        out.push(
+            Check::new("sampling.chi2_visible", spec.clone(), case, VISIBLE_SOURCE)
+                .why(format!("{why}: importance sampling of visible normals"))
+                .covers(ids)
+                .statistical()
+                .run(move |r, ctx| {
+                    let v = need(m.model.as_visible_sampler(), "visible-normal sampler")?;
                     let wi = from_spherical(theta, phi);
-                    let config = Chi2Config {
+                    chi2_kinked(
+                        r,
+                        ctx,
                         resolution,
                         samples,
-                        seed: ctx.seed,
-                        alpha: STATISTICAL_ALPHA.value,
-                    };
-                    let result = chi2_test_to(
                         &|u| v.sample_wm_visible(wi, u),
                         &|mm| v.pdf_wm_visible(wi, mm),
-                        &config,
-                        KINKED_CELL_RELATIVE_TOLERANCE,
                     );
-                    fill_chi2(&mut r, &result, ctx, samples);
-                    r
-                })
-            }),
-        });
-        let (m, spec_run) = (subject.clone(), spec.clone());
+                    Ok(())
+                }),
+        );
+        let m = subject.clone();
         let case = json!({"theta_i": theta, "phi_i": phi});
-        let case_run = case.clone();
-        out.push(PlannedCheck {
-            check: "sampling.pdf_visible_normalization".into(),
-            model: spec.clone(),
-            case,
-            why: format!("{why}: the visible-normal density must integrate to 1"),
-            covers: vec![covers(family, "pdf_wm_visible", "default")],
-            statistical: false,
-            run: Box::new(move |_| {
-                timed(|| {
-                    let mut r = CheckRecord::new(
-                        "sampling.pdf_visible_normalization",
-                        spec_run.clone(),
-                        case_run.clone(),
-                        VISIBLE_SOURCE,
-                    );
-                    r.covers = vec![covers(family, "pdf_wm_visible", "default")];
-                    let v = m
-                        .model
-                        .as_visible_sampler()
-                        .expect("planned for visible samplers");
-                    let wi = from_spherical(theta, phi);
-                    let kinks = |p: f64| visible_kinks(wi, p);
-                    let e = integrate_hemisphere(
-                        &|mm| v.pdf_wm_visible(wi, mm),
-                        m.lobe().width(),
-                        Some(Cuts {
-                            theta: &kinks,
-                            phi: &terminator_azimuths(phi),
-                        }),
-                        Accuracy::relative(1e-11),
-                    );
-                    compare(&mut r, 1.0, e, &NORMALIZATION);
-                    r
-                })
+        out.push(
+            Check::new(
+                "sampling.pdf_visible_normalization",
+                spec.clone(),
+                case,
+                VISIBLE_SOURCE,
+            )
+            .why(format!(
+                "{why}: the visible-normal density must integrate to 1"
+            ))
+            .covers(vec![covers(family, "pdf_wm_visible", "default")])
+            .run(move |r, _| {
+                let v = need(m.model.as_visible_sampler(), "visible-normal sampler")?;
+                let wi = from_spherical(theta, phi);
+                let kinks = |p: f64| visible_kinks(wi, p);
+                let e = integrate_hemisphere(
+                    &|mm| v.pdf_wm_visible(wi, mm),
+                    m.lobe().width(),
+                    Some(Cuts {
+                        theta: &kinks,
+                        phi: &terminator_azimuths(phi),
+                    }),
+                    Accuracy::relative(1e-11),
+                );
+                compare(r, 1.0, e, &NORMALIZATION);
+                Ok(())
             }),
-        });
+        );
     }
     out
 }

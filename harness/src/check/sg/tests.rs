@@ -8,7 +8,7 @@ use serde_json::json;
 #[test]
 fn quick_plan_passes_or_fails_as_expected() {
     let plan = plan(Profile::Quick, true, true, "test");
-    let ctx = RunContext { seed: 1, out: None };
+    let ctx = RunContext { seed: 1 };
     use rayon::prelude::*;
     let records: Vec<CheckRecord> = plan.par_iter().map(|p| (p.run)(&ctx)).collect();
     let mut expected = 0;
@@ -82,7 +82,7 @@ mod dump {
     #[test]
     #[ignore]
     fn standard() {
-        let ctx = crate::check::RunContext { seed: 1, out: None };
+        let ctx = crate::check::RunContext { seed: 1 };
         for p in plan(Profile::Standard, true, true, "") {
             let r = (p.run)(&ctx);
             println!(

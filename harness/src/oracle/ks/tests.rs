@@ -129,8 +129,7 @@ fn ks_cdf_tables_match_closed_forms() {
 fn passes(json: &str, samples: u64) {
     let m = model(json);
     let s = m.as_sampler().unwrap();
-    let spec = serde_json::to_value(m.spec()).unwrap();
-    let width = crate::check::lobe_width(&spec);
+    let width = crate::subject::spec_width(&m.spec());
     for marginal in [Marginal::CosTheta, Marginal::Phi] {
         let r = ks_test_sampler(s, marginal, &hints(width), &config(samples, 7));
         report(json, &r);
