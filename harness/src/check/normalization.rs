@@ -1,11 +1,12 @@
 //! Normalization: ∫ D(m)(m·n) dm = 1 over the hemisphere, by nested adaptive quadrature.
 
 use super::{compare, covers, timed, PlannedCheck};
-use crate::oracle::quadrature::{integrate_hemisphere_lobe, Accuracy, Cuts};
+use crate::oracle::quadrature::{integrate_hemisphere_lobe_batch, Accuracy, Cuts};
 use crate::oracle::Estimate;
 use crate::record::CheckRecord;
 use crate::subject::Subject;
 use crate::tolerance::NORMALIZATION;
+use mfh_reference::Vec3;
 use serde_json::json;
 use std::sync::Arc;
 
@@ -31,8 +32,14 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> 
                 );
                 r.covers = vec![covers(family, "d", "default")];
                 let kinks = s.theta_kinks();
-                let e = integrate_hemisphere_lobe(
-                    &|w| s.model.d(w) * w[2],
+                // D in batches (one round trip per step for an external model).
+                let e = integrate_hemisphere_lobe_batch(
+                    &|w: &[Vec3], out: &mut [f64]| {
+                        s.model.d_batch(w, out);
+                        for (o, w) in out.iter_mut().zip(w) {
+                            *o *= w[2];
+                        }
+                    },
                     s.lobe(),
                     Some(Cuts {
                         theta: &|_| kinks.clone(),

@@ -8,12 +8,13 @@
 
 use super::{applied, compare, compare_exact, covers, timed, Planned, PlannedCheck, Profile};
 use crate::oracle::chi2::{
-    chi2_test_batch_in, chi2_test_to, Chi2Config, CELL_RELATIVE_TOLERANCE,
-    KINKED_CELL_RELATIVE_TOLERANCE,
+    chi2_test_batches_in, chi2_test_to, Chi2Config, CELL_ABSOLUTE_TOLERANCE,
+    CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE, REMOTE_CELL_ABSOLUTE_TOLERANCE,
+    REMOTE_KINKED_CELL_RELATIVE_TOLERANCE,
 };
 use crate::oracle::ks::{self, KsConfig, LobeHints, Marginal};
-use crate::oracle::monte_carlo::{estimate, two_sided_p};
-use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
+use crate::oracle::monte_carlo::{estimate, estimate_batch, two_sided_p};
+use crate::oracle::quadrature::{integrate_hemisphere, integrate_hemisphere_batch, Accuracy, Cuts};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
 use crate::subject::Subject;
 use crate::tolerance::{NORMALIZATION, PDF_CONSISTENCY, STATISTICAL_ALPHA};
@@ -64,11 +65,11 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                         seed: ctx.seed,
                         alpha: STATISTICAL_ALPHA.value,
                     };
-                    let result = chi2_test_batch_in(
+                    let result = chi2_test_batches_in(
                         &|u: &[[f64; 2]], out: &mut [Vec3]| sampler.sample_wm_batch(u, out),
-                        &|mm| sampler.pdf_wm(mm),
+                        &|mm: &[Vec3], out: &mut [f64]| sampler.pdf_wm_batch(mm, out),
                         &config,
-                        CELL_RELATIVE_TOLERANCE,
+                        (CELL_RELATIVE_TOLERANCE, CELL_ABSOLUTE_TOLERANCE),
                         Some(m.lobe()),
                     );
                     fill_chi2(&mut r, &result, ctx, samples);
@@ -106,12 +107,19 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                     let sampler = m.model.as_sampler().expect("planned for samplers");
                     let mut worst = 0.0f64;
                     let g = 0.618_033_988_749_894_9;
-                    for i in 0..4096u32 {
-                        let u = [(f64::from(i) + 0.5) / 4096.0, (f64::from(i) * g).fract()];
-                        let mm = sampler.sample_wm(u);
+                    // In batches: three round trips for an external model.
+                    let u: Vec<[f64; 2]> = (0..4096u32)
+                        .map(|i| [(f64::from(i) + 0.5) / 4096.0, (f64::from(i) * g).fract()])
+                        .collect();
+                    let mut normals = vec![[0.0; 3]; u.len()];
+                    sampler.sample_wm_batch(&u, &mut normals);
+                    let (mut pdfs, mut ds) = (vec![0.0; u.len()], vec![0.0; u.len()]);
+                    sampler.pdf_wm_batch(&normals, &mut pdfs);
+                    m.model.d_batch(&normals, &mut ds);
+                    for i in 0..u.len() {
+                        let (mm, pdf) = (normals[i], pdfs[i]);
                         let len = dot(mm, mm).sqrt();
-                        let pdf = sampler.pdf_wm(mm);
-                        let want = m.model.d(mm) * mm[2];
+                        let want = ds[i] * mm[2];
                         let e = if !(mm[2] >= 0.0) || !pdf.is_finite() {
                             f64::INFINITY
                         } else {
@@ -154,14 +162,18 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                     let sampler = m.model.as_sampler().expect("planned for samplers");
                     let smith = m.model.as_smith().expect("planned for Smith models");
                     let w = from_spherical(theta, 0.3);
-                    let e = estimate(
-                        &|u| {
-                            let mm = sampler.sample_wm(u);
-                            let c = -dot(w, mm);
-                            if c > 0.0 && mm[2] > 0.0 {
-                                c / mm[2]
-                            } else {
-                                0.0
+                    // Normals in batches (one round trip per chunk for an external model).
+                    let e = estimate_batch(
+                        &|u: &[[f64; 2]], out: &mut [f64]| {
+                            let mut normals = vec![[0.0; 3]; u.len()];
+                            sampler.sample_wm_batch(u, &mut normals);
+                            for (o, mm) in out.iter_mut().zip(normals) {
+                                let c = -dot(w, mm);
+                                *o = if c > 0.0 && mm[2] > 0.0 {
+                                    c / mm[2]
+                                } else {
+                                    0.0
+                                };
                             }
                         },
                         mc_samples,
@@ -365,11 +377,21 @@ pub fn plan_visible<'a>(
                         seed: ctx.seed,
                         alpha: STATISTICAL_ALPHA.value,
                     };
-                    let result = chi2_test_to(
-                        &|u| v.sample_wm_visible(wi, u),
-                        &|mm| v.pdf_wm_visible(wi, mm),
+                    let result = chi2_test_batches_in(
+                        &|u: &[[f64; 2]], out: &mut [Vec3]| v.sample_wm_visible_batch(wi, u, out),
+                        &|mm: &[Vec3], out: &mut [f64]| v.pdf_wm_visible_batch(wi, mm, out),
                         &config,
-                        KINKED_CELL_RELATIVE_TOLERANCE,
+                        // The looser stated tolerances for a remote model (its evaluations
+                        // are protocol traffic); the reference models keep the tight ones.
+                        if m.model.is_remote() {
+                            (
+                                REMOTE_KINKED_CELL_RELATIVE_TOLERANCE,
+                                REMOTE_CELL_ABSOLUTE_TOLERANCE,
+                            )
+                        } else {
+                            (KINKED_CELL_RELATIVE_TOLERANCE, CELL_ABSOLUTE_TOLERANCE)
+                        },
+                        None,
                     );
                     fill_chi2(&mut r, &result, ctx, samples);
                     r
@@ -401,8 +423,8 @@ pub fn plan_visible<'a>(
                         .expect("planned for visible samplers");
                     let wi = from_spherical(theta, phi);
                     let kinks = |p: f64| visible_kinks(wi, p);
-                    let e = integrate_hemisphere(
-                        &|mm| v.pdf_wm_visible(wi, mm),
+                    let e = integrate_hemisphere_batch(
+                        &|mm: &[Vec3], out: &mut [f64]| v.pdf_wm_visible_batch(wi, mm, out),
                         m.lobe().width(),
                         Some(Cuts {
                             theta: &kinks,
@@ -699,9 +721,9 @@ fn plan_ks<'a>(
                     seed: ctx.seed,
                     alpha: STATISTICAL_ALPHA.value,
                 };
-                let result = ks::ks_test_lobe(
-                    &|u| sampler.sample_wm(u),
-                    &|m| sampler.pdf_wm(m),
+                let result = ks::ks_test_lobe_batch(
+                    &|u: &[[f64; 2]], out: &mut [Vec3]| sampler.sample_wm_batch(u, out),
+                    &|m: &[Vec3], out: &mut [f64]| sampler.pdf_wm_batch(m, out),
                     marginal,
                     model.lobe(),
                     &kinks,
@@ -739,7 +761,11 @@ fn ks_marginal_data(
         return None;
     }
     let values = ks_redraw(sampler, marginal, config);
-    let table = ks::marginal_cdf(&|m| sampler.pdf_wm(m), marginal, hints);
+    let table = ks::marginal_cdf_batch(
+        &|m: &[Vec3], out: &mut [f64]| sampler.pdf_wm_batch(m, out),
+        marginal,
+        hints,
+    );
     let [lo, hi] = marginal.range();
     let n = values.len().max(1) as f64;
     let x: Vec<f64> = (0..KS_CURVE_POINTS)
@@ -775,12 +801,12 @@ fn ks_redraw(
         .map(|chunk| {
             let mut rng = stream(config.seed, chunk);
             let end = ((chunk + 1) * CHUNK).min(config.samples);
-            (chunk * CHUNK..end)
-                .map(|_| {
-                    let u = [uniform(&mut rng), uniform(&mut rng)];
-                    marginal.value(sampler.sample_wm(u))
-                })
-                .collect()
+            let u: Vec<[f64; 2]> = (chunk * CHUNK..end)
+                .map(|_| [uniform(&mut rng), uniform(&mut rng)])
+                .collect();
+            let mut m = vec![[0.0; 3]; u.len()];
+            sampler.sample_wm_batch(&u, &mut m);
+            m.into_iter().map(|m| marginal.value(m)).collect()
         })
         .collect();
     let mut values = chunks.concat();
