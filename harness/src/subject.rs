@@ -5,7 +5,7 @@
 
 use crate::oracle::lobe::{self, Lobe, Options};
 use mfh_reference::registry::{self, FamilyInfo};
-use mfh_reference::{Model, ModelSpec, Ndf, ParamError};
+use mfh_reference::{Model, ModelSpec, Ndf, ParamError, Vec3};
 use serde_json::{json, Value};
 use std::sync::{Arc, OnceLock};
 
@@ -112,8 +112,15 @@ impl<'a> Subject<'a> {
     /// measurement up).
     pub fn lobe(&self) -> &Lobe {
         self.measured.get_or_init(|| {
-            lobe::measure_with(
-                &|m| self.model.d(m) * m[2],
+            // D in batches (the survey grids in one call each: an external model's round
+            // trips).
+            lobe::measure_with_batch(
+                &|m: &[Vec3], out: &mut [f64]| {
+                    self.model.d_batch(m, out);
+                    for (o, m) in out.iter_mut().zip(m) {
+                        *o *= m[2];
+                    }
+                },
                 &Options {
                     hint: self.hints.lobe_width,
                     ..Options::default()

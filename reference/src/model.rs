@@ -58,6 +58,14 @@ pub trait Ndf: Send + Sync {
         None
     }
 
+    /// Whether every evaluation crosses a process boundary (an implementation in another
+    /// language behind a protocol): checks whose oracle accuracy is a cost trade-off may then
+    /// use the looser of two stated tolerances that both keep their margin (each such check
+    /// says which). Default false.
+    fn is_remote(&self) -> bool {
+        false
+    }
+
     /// `out[i] = self.d(m[i])` for every i: a batch capability for throughput (the default
     /// loops over [`Ndf::d`]; models may override it with a vectorized form that agrees with
     /// `d` to the number of ulps they document).
@@ -81,6 +89,9 @@ macro_rules! delegate_ndf {
             }
             fn d_batch(&self, m: &[Vec3], out: &mut [f64]) {
                 (**self).d_batch(m, out)
+            }
+            fn is_remote(&self) -> bool {
+                (**self).is_remote()
             }
             fn as_smith(&self) -> Option<&dyn Smith> {
                 (**self).as_smith()
@@ -255,6 +266,39 @@ pub trait VisibleNormalSampler: Smith {
             return 0.0;
         }
         c * d / (wi[2] * (1.0 + self.lambda(wi)))
+    }
+
+    /// `out[i] = self.sample_wm_visible(wi, u[i])` for every i, at one incidence (the default
+    /// loops over [`VisibleNormalSampler::sample_wm_visible`]; an override must agree with it
+    /// to the number of ulps it documents).
+    ///
+    /// # Panics
+    /// If `u` and `out` differ in length.
+    fn sample_wm_visible_batch(&self, wi: Vec3, u: &[[f64; 2]], out: &mut [Vec3]) {
+        assert_eq!(
+            u.len(),
+            out.len(),
+            "sample_wm_visible_batch: u and out differ in length"
+        );
+        for (o, &u) in out.iter_mut().zip(u) {
+            *o = self.sample_wm_visible(wi, u);
+        }
+    }
+
+    /// `out[i] = self.pdf_wm_visible(wi, m[i])` for every i, at one incidence (the default
+    /// loops over [`VisibleNormalSampler::pdf_wm_visible`]).
+    ///
+    /// # Panics
+    /// If `m` and `out` differ in length.
+    fn pdf_wm_visible_batch(&self, wi: Vec3, m: &[Vec3], out: &mut [f64]) {
+        assert_eq!(
+            m.len(),
+            out.len(),
+            "pdf_wm_visible_batch: m and out differ in length"
+        );
+        for (o, &m) in out.iter_mut().zip(m) {
+            *o = self.pdf_wm_visible(wi, m);
+        }
     }
 }
 

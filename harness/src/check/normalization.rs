@@ -2,10 +2,11 @@
 
 use super::{compare, covers, PlannedCheck};
 use crate::check::Check;
-use crate::oracle::quadrature::{integrate_hemisphere_lobe, Accuracy, Cuts};
+use crate::oracle::quadrature::{integrate_hemisphere_lobe_batch, Accuracy, Cuts};
 use crate::oracle::Estimate;
 use crate::subject::Subject;
 use crate::tolerance::NORMALIZATION;
+use mfh_reference::Vec3;
 use serde_json::json;
 use std::sync::Arc;
 
@@ -24,8 +25,14 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> 
     .covers(vec![covers(family, "d", "default")])
     .run(move |r, _| {
         let kinks = s.theta_kinks();
-        let e = integrate_hemisphere_lobe(
-            &|w| s.model.d(w) * w[2],
+        // D in batches (one round trip per step for an external model).
+        let e = integrate_hemisphere_lobe_batch(
+            &|w: &[Vec3], out: &mut [f64]| {
+                s.model.d_batch(w, out);
+                for (o, w) in out.iter_mut().zip(w) {
+                    *o *= w[2];
+                }
+            },
             s.lobe(),
             Some(Cuts {
                 theta: &|_| kinks.clone(),

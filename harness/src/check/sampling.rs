@@ -20,11 +20,12 @@ pub use visible::{plan_visible, terminator_azimuths, visible_kinks, VISIBLE_INCI
 use super::{applied, compare_exact, covers, Planned, PlannedCheck, Profile};
 use crate::check::{need, Check};
 use crate::oracle::chi2::{
-    chi2_test_batch_in, chi2_test_in, Chi2Config, CELL_RELATIVE_TOLERANCE,
-    KINKED_CELL_RELATIVE_TOLERANCE,
+    chi2_test_batches_in, BatchPdf, BatchSampler, Chi2Config, CELL_ABSOLUTE_TOLERANCE,
+    CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE, REMOTE_CELL_ABSOLUTE_TOLERANCE,
+    REMOTE_KINKED_CELL_RELATIVE_TOLERANCE,
 };
 use crate::oracle::ks::Marginal;
-use crate::oracle::monte_carlo::{estimate, two_sided_p};
+use crate::oracle::monte_carlo::{estimate_batch, two_sided_p};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
 use crate::subject::Subject;
 use crate::tolerance::{PDF_CONSISTENCY, STATISTICAL_ALPHA};
@@ -62,11 +63,11 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                         seed: ctx.seed,
                         alpha: STATISTICAL_ALPHA.value,
                     };
-                    let result = chi2_test_batch_in(
+                    let result = chi2_test_batches_in(
                         &|u: &[[f64; 2]], out: &mut [Vec3]| sampler.sample_wm_batch(u, out),
-                        &|mm| sampler.pdf_wm(mm),
+                        &|mm: &[Vec3], out: &mut [f64]| sampler.pdf_wm_batch(mm, out),
                         &config,
-                        CELL_RELATIVE_TOLERANCE,
+                        (CELL_RELATIVE_TOLERANCE, CELL_ABSOLUTE_TOLERANCE),
                         Some(m.lobe()),
                     );
                     fill_chi2(r, &result, ctx, samples);
@@ -99,12 +100,19 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                 let sampler = need(m.model.as_sampler(), "normal sampler")?;
                 let mut worst = 0.0f64;
                 let g = 0.618_033_988_749_894_9;
-                for i in 0..4096u32 {
-                    let u = [(f64::from(i) + 0.5) / 4096.0, (f64::from(i) * g).fract()];
-                    let mm = sampler.sample_wm(u);
+                // In batches: three round trips for an external model.
+                let u: Vec<[f64; 2]> = (0..4096u32)
+                    .map(|i| [(f64::from(i) + 0.5) / 4096.0, (f64::from(i) * g).fract()])
+                    .collect();
+                let mut normals = vec![[0.0; 3]; u.len()];
+                sampler.sample_wm_batch(&u, &mut normals);
+                let (mut pdfs, mut ds) = (vec![0.0; u.len()], vec![0.0; u.len()]);
+                sampler.pdf_wm_batch(&normals, &mut pdfs);
+                m.model.d_batch(&normals, &mut ds);
+                for i in 0..u.len() {
+                    let (mm, pdf) = (normals[i], pdfs[i]);
                     let len = dot(mm, mm).sqrt();
-                    let pdf = sampler.pdf_wm(mm);
-                    let want = m.model.d(mm) * mm[2];
+                    let want = ds[i] * mm[2];
                     let e = if !(mm[2] >= 0.0) || !pdf.is_finite() {
                         f64::INFINITY
                     } else {
@@ -141,14 +149,18 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                 let sampler = need(m.model.as_sampler(), "normal sampler")?;
                 let smith = need(m.model.as_smith(), "Smith masking")?;
                 let w = from_spherical(theta, 0.3);
-                let e = estimate(
-                    &|u| {
-                        let mm = sampler.sample_wm(u);
-                        let c = -dot(w, mm);
-                        if c > 0.0 && mm[2] > 0.0 {
-                            c / mm[2]
-                        } else {
-                            0.0
+                // Normals in batches (one round trip per chunk for an external model).
+                let e = estimate_batch(
+                    &|u: &[[f64; 2]], out: &mut [f64]| {
+                        let mut normals = vec![[0.0; 3]; u.len()];
+                        sampler.sample_wm_batch(u, &mut normals);
+                        for (o, mm) in out.iter_mut().zip(normals) {
+                            let c = -dot(w, mm);
+                            *o = if c > 0.0 && mm[2] > 0.0 {
+                                c / mm[2]
+                            } else {
+                                0.0
+                            };
                         }
                     },
                     mc_samples,
@@ -233,15 +245,17 @@ fn fill_chi2(
     }
 }
 
-/// The chi-square of a scalar sampler of a density with kinks (visible normals, the pseudo-VNIS
+/// The chi-square of a batch sampler of a density with kinks (visible normals, the pseudo-VNIS
 /// proxy) on the `resolution` grid with `samples` samples from the record's stream, into `r`.
+/// `remote` (an external model, whose evaluations are protocol traffic) takes the looser stated
+/// cell tolerances; reference models keep the tight ones.
 fn chi2_kinked(
     r: &mut CheckRecord,
     ctx: &super::RunContext,
-    resolution: usize,
-    samples: u64,
-    sample: &(dyn Fn([f64; 2]) -> Vec3 + Sync),
-    pdf: &(dyn Fn(Vec3) -> f64 + Sync),
+    (resolution, samples): (usize, u64),
+    sample: &BatchSampler<'_>,
+    pdf: &BatchPdf<'_>,
+    remote: bool,
 ) {
     let config = Chi2Config {
         resolution,
@@ -249,7 +263,15 @@ fn chi2_kinked(
         seed: ctx.seed,
         alpha: STATISTICAL_ALPHA.value,
     };
-    let result = chi2_test_in(sample, pdf, &config, KINKED_CELL_RELATIVE_TOLERANCE, None);
+    let tolerance = if remote {
+        (
+            REMOTE_KINKED_CELL_RELATIVE_TOLERANCE,
+            REMOTE_CELL_ABSOLUTE_TOLERANCE,
+        )
+    } else {
+        (KINKED_CELL_RELATIVE_TOLERANCE, CELL_ABSOLUTE_TOLERANCE)
+    };
+    let result = chi2_test_batches_in(sample, pdf, &config, tolerance, None);
     fill_chi2(r, &result, ctx, samples);
 }
 

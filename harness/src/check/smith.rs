@@ -5,7 +5,8 @@
 use super::{apply_expected, compare, compare_exact, covers, PlannedCheck, Profile};
 use crate::check::{need, Check};
 use crate::oracle::quadrature::{
-    integrate_hemisphere_polar, integrate_pieces, integrate_upper, Accuracy, Cuts,
+    integrate_hemisphere_polar_batch, integrate_pieces_batch, integrate_pieces_many,
+    integrate_upper, Accuracy, Cuts,
 };
 use crate::oracle::{student_t, Estimate};
 use crate::record::Verdict;
@@ -139,29 +140,49 @@ fn lambda_oracle_lune(subject: &Subject, w: Vec3) -> Estimate {
         .collect();
     let evaluations = std::cell::Cell::new(0u64);
     let inner_error = std::cell::Cell::new(0.0f64);
-    let inner = |psi: f64| {
-        let a = -st * (psi - phi_w).cos();
-        if !(a > 0.0) {
-            return 0.0;
+    // The inner integrals of one outer step run in lockstep, D in batches (one round trip per
+    // step for an external model); the arithmetic is that of one integral at a time.
+    let inner = |psis: &[f64], out: &mut [f64]| {
+        let (mut problems, mut geometry, mut index) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, &psi) in psis.iter().enumerate() {
+            out[i] = 0.0;
+            let a = -st * (psi - phi_w).cos();
+            if !(a > 0.0) {
+                continue;
+            }
+            let r = a.hypot(ct);
+            let eps_t = a.atan2(ct);
+            let mut points = vec![0.0];
+            points.extend(kinks.iter().copied().filter(|k| *k > 0.0 && *k < eps_t));
+            points.push(eps_t);
+            points.sort_by(f64::total_cmp);
+            problems.push((points, Accuracy::relative(2e-13)));
+            geometry.push((r, eps_t, psi.sin_cos()));
+            index.push(i);
         }
-        let r = a.hypot(ct);
-        let eps_t = a.atan2(ct);
-        let mut points = vec![0.0];
-        points.extend(kinks.iter().copied().filter(|k| *k > 0.0 && *k < eps_t));
-        points.push(eps_t);
-        points.sort_by(f64::total_cmp);
-        let (sp, cp) = psi.sin_cos();
-        let e = integrate_pieces(
-            &|eps: f64| {
-                let (se, ce) = eps.sin_cos();
-                r * (eps_t - eps).sin() * model.d([ce * cp, ce * sp, se]) * ce
+        let mut dirs = Vec::new();
+        let estimates = integrate_pieces_many(
+            &mut |tx: &[(usize, f64)], values: &mut [f64]| {
+                dirs.clear();
+                dirs.extend(tx.iter().map(|&(k, eps)| {
+                    let (se, ce) = eps.sin_cos();
+                    let (sp, cp) = geometry[k].2;
+                    [ce * cp, ce * sp, se]
+                }));
+                model.d_batch(&dirs, values);
+                for (v, &(k, eps)) in values.iter_mut().zip(tx) {
+                    let ce = eps.cos();
+                    let (r, eps_t, _) = geometry[k];
+                    *v = r * (eps_t - eps).sin() * *v * ce;
+                }
             },
-            &points,
-            Accuracy::relative(2e-13),
+            &problems,
         );
-        evaluations.set(evaluations.get() + e.evaluations);
-        inner_error.set(inner_error.get().max(e.error_bound));
-        e.value
+        for (e, i) in estimates.iter().zip(index) {
+            evaluations.set(evaluations.get() + e.evaluations);
+            inner_error.set(inner_error.get().max(e.error_bound));
+            out[i] = e.value;
+        }
     };
     let (lo, hi) = (phi_w + 0.5 * PI, phi_w + 1.5 * PI);
     // The outer integrand has kinks where ε_t(ψ) crosses a kink elevation ε_k:
@@ -176,7 +197,7 @@ fn lambda_oracle_lune(subject: &Subject, w: Vec3) -> Estimate {
     }
     points.retain(|p| *p >= lo && *p <= hi);
     points.sort_by(f64::total_cmp);
-    let outer = integrate_pieces(&inner, &points, Accuracy::relative(1e-12));
+    let outer = integrate_pieces_batch(&inner, &points, Accuracy::relative(1e-12));
     Estimate {
         value: outer.value / ct,
         error_bound: (outer.error_bound + inner_error.get() * (hi - lo)) / ct,
@@ -288,15 +309,24 @@ pub fn plan<'a>(
                 let phis = terminator_azimuths(w, &kinks);
                 let theta_cut = terminator(w, kinks);
                 let p = projection(w);
-                let e = integrate_hemisphere_polar(
-                    &|theta_m, phi_m| {
-                        let (rr, theta_t) = p(phi_m);
-                        if theta_m < theta_t {
-                            g1 * rr
-                                * (theta_t - theta_m).sin()
-                                * m.model.d(from_spherical(theta_m, phi_m))
-                        } else {
-                            0.0
+                // D in batches (one round trip per step for an external model).
+                let e = integrate_hemisphere_polar_batch(
+                    &|tp: &[[f64; 2]], out: &mut [f64]| {
+                        // D only where the normal faces w (as the scalar form did).
+                        let (mut dirs, mut at) = (Vec::new(), Vec::new());
+                        for (i, &[theta_m, phi_m]) in tp.iter().enumerate() {
+                            out[i] = 0.0;
+                            if theta_m < p(phi_m).1 {
+                                dirs.push(from_spherical(theta_m, phi_m));
+                                at.push(i);
+                            }
+                        }
+                        let mut d = vec![0.0; dirs.len()];
+                        m.model.d_batch(&dirs, &mut d);
+                        for (d, i) in d.into_iter().zip(at) {
+                            let [theta_m, phi_m] = tp[i];
+                            let (rr, theta_t) = p(phi_m);
+                            out[i] = g1 * rr * (theta_t - theta_m).sin() * d;
                         }
                     },
                     m.lobe().width(),

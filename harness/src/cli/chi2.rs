@@ -14,8 +14,16 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Args)]
 pub struct Chi2Args {
     /// The model spec as JSON text, e.g. '{"family":"ggx","alpha":0.3}'.
+    #[arg(long, required_unless_present = "cmd", conflicts_with = "cmd")]
+    pub model: Option<String>,
+    /// Test an implementation in any language instead: the command that starts it (run with
+    /// `sh -c`, speaking the external protocol, see `mfh audit-external`), e.g.
+    /// "python3 examples/external/ggx.py".
     #[arg(long)]
-    pub model: String,
+    pub cmd: Option<String>,
+    /// With --cmd: seconds to wait for each answer before the child is killed.
+    #[arg(long, default_value_t = crate::external::DEFAULT_TIMEOUT_SECONDS)]
+    pub timeout: f64,
     /// Samples to draw: at least 5 per cell of the grid (10·R²), at most 2^32.
     #[arg(long, default_value_t = 1_000_000)]
     pub samples: u64,
@@ -60,8 +68,11 @@ pub fn run(args: Chi2Args, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
         Ok(seed) => seed,
         Err(e) => return bad(stderr, e),
     };
+    if let Some(cmd) = args.cmd.clone() {
+        return run_external(&args, &cmd, seed, stdout, stderr);
+    }
     let request = Chi2Request {
-        model: args.model.clone(),
+        model: args.model.clone().unwrap_or_default(),
         samples: args.samples,
         resolution: args.resolution,
         seed,
@@ -75,10 +86,162 @@ pub fn run(args: Chi2Args, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
         Err(e) => return bad(stderr, e.to_string()),
     };
     let result = run_with_progress(&plan, args.quiet);
+    let name = crate::report::artefacts::model_name(&serde_json::json!(plan.model.spec()));
+    let spec_text = serde_json::to_string(&plan.model.spec()).unwrap_or_default();
+    let record = chi2_run::record(&plan, &result, &[]);
+    let reproduce = chi2_run::reproduce_command(&plan);
+    report(
+        &args,
+        &result,
+        (&name, &spec_text),
+        record,
+        &reproduce,
+        stdout,
+        stderr,
+    )
+}
+
+/// `mfh chi2 --cmd`: the same test of an external implementation's sampler (through the
+/// protocol's batches: one round trip per 65 536 samples, and per step of the expected-count
+/// cubature), the same output and heat maps. The other options are validated as for `--model`
+/// (by validating them with a stand-in GGX spec, whose sampler is never called).
+fn run_external(
+    args: &Chi2Args,
+    cmd: &str,
+    seed: u64,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> i32 {
+    let bad = |stderr: &mut dyn Write, message: String| {
+        let _ = writeln!(stderr, "mfh chi2: {message}");
+        EXIT_BAD_INPUT
+    };
+    if !(args.timeout > 0.0 && args.timeout <= 86_400.0) {
+        return bad(
+            stderr,
+            format!("--timeout {} is outside (0, 86400] seconds", args.timeout),
+        );
+    }
+    let request = Chi2Request {
+        model: r#"{"family":"ggx","alpha":0.5}"#.into(),
+        samples: args.samples,
+        resolution: args.resolution,
+        seed,
+        alpha: args.alpha,
+        sampling: args.sampling.kind(),
+        incidence: args.incidence,
+        azimuth: args.azimuth,
+    };
+    let plan = match chi2_run::validate(&request) {
+        Ok(plan) => plan,
+        Err(e) => return bad(stderr, e.to_string()),
+    };
+    let timeout = std::time::Duration::from_secs_f64(args.timeout);
+    let model = match crate::external::ExternalModel::start(cmd, timeout) {
+        Ok(m) => m,
+        Err(e) => return bad(stderr, format!("--cmd: {e}")),
+    };
+    let description = model.description().clone();
+    let name = description.name.clone().unwrap_or_else(|| cmd.to_string());
+    use mfh_reference::Ndf;
+    let result = match plan.incidence {
+        Some((theta, phi)) => {
+            let Some(v) = model.as_visible_sampler() else {
+                model.shutdown();
+                return bad(
+                    stderr,
+                    format!(
+                        "--sampling visible: `{name}` does not declare sample_wm_visible;                          nothing to test"
+                    ),
+                );
+            };
+            let wi = mfh_reference::geometry::from_spherical(theta, phi);
+            crate::oracle::chi2::chi2_test_batches_in(
+                &|u: &[[f64; 2]], m: &mut [mfh_reference::Vec3]| {
+                    v.sample_wm_visible_batch(wi, u, m)
+                },
+                &|m: &[mfh_reference::Vec3], out: &mut [f64]| v.pdf_wm_visible_batch(wi, m, out),
+                &plan.config,
+                (
+                    crate::oracle::chi2::REMOTE_KINKED_CELL_RELATIVE_TOLERANCE,
+                    crate::oracle::chi2::REMOTE_CELL_ABSOLUTE_TOLERANCE,
+                ),
+                None,
+            )
+        }
+        None => {
+            let Some(s) = model.as_sampler() else {
+                model.shutdown();
+                return bad(
+                    stderr,
+                    format!(
+                        "--sampling normals: `{name}` does not declare sample_wm; nothing to test"
+                    ),
+                );
+            };
+            crate::oracle::chi2::chi2_test_batches_in(
+                &|u: &[[f64; 2]], m: &mut [mfh_reference::Vec3]| s.sample_wm_batch(u, m),
+                &|m: &[mfh_reference::Vec3], out: &mut [f64]| s.pdf_wm_batch(m, out),
+                &plan.config,
+                (
+                    crate::oracle::chi2::CELL_RELATIVE_TOLERANCE,
+                    crate::oracle::chi2::CELL_ABSOLUTE_TOLERANCE,
+                ),
+                None,
+            )
+        }
+    };
+    let protocol_error = model.first_error();
+    model.shutdown();
+    if let Some(e) = protocol_error {
+        // The counts of a broken session mean nothing: say what went wrong instead.
+        let _ = writeln!(stderr, "mfh chi2: --cmd: {e}");
+        return EXIT_FAIL;
+    }
+    let label = serde_json::json!({
+        "name": name,
+        "command": cmd,
+        "parameters": description.parameters,
+    });
+    let mut record = chi2_run::record(&plan, &result, &[]);
+    record["model"] = label.clone();
+    let mut reproduce = chi2_run::reproduce_command(&plan);
+    if let Some(rest) = reproduce
+        .split_once(" --samples ")
+        .map(|(_, r)| r.to_string())
+    {
+        reproduce = format!("mfh chi2 --cmd {cmd:?} --samples {rest}");
+    }
+    let model_name = crate::report::artefacts::model_name(&label);
+    let label_text = serde_json::to_string(&label).unwrap_or_default();
+    report(
+        args,
+        &result,
+        (&model_name, &label_text),
+        record,
+        &reproduce,
+        stdout,
+        stderr,
+    )
+}
+
+/// Writes the artefacts (with `--out`) and prints the result, text or JSON; the exit status.
+fn report(
+    args: &Chi2Args,
+    result: &Chi2Result,
+    (name, spec_text): (&str, &str),
+    mut record: serde_json::Value,
+    reproduce: &str,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> i32 {
+    let bad = |stderr: &mut dyn Write, message: String| {
+        let _ = writeln!(stderr, "mfh chi2: {message}");
+        EXIT_BAD_INPUT
+    };
     let mut artefacts = Vec::new();
     if let Some(dir) = &args.out {
-        let name = crate::report::artefacts::model_name(&serde_json::json!(plan.model.spec()));
-        match write_artefacts(dir, &name, &result) {
+        match write_artefacts(dir, name, result) {
             Ok(paths) => artefacts = paths,
             Err(e) => {
                 return bad(
@@ -93,10 +256,10 @@ pub fn run(args: Chi2Args, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
     }
     let artefacts: Vec<String> = artefacts.iter().map(|p| p.display().to_string()).collect();
     let written = if args.json {
-        writeln!(stdout, "{}", chi2_run::record(&plan, &result, &artefacts))
+        record["artefacts"] = serde_json::json!(artefacts);
+        writeln!(stdout, "{record}")
     } else {
-        let r = &result;
-        let spec_text = serde_json::to_string(&plan.model.spec()).unwrap_or_default();
+        let r = result;
         let reason = r.reason.as_ref().map(|r| r.to_string());
         writeln!(
             stdout,
@@ -131,7 +294,7 @@ pub fn run(args: Chi2Args, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
                 .iter()
                 .map(|a| format!("wrote {a}\n"))
                 .collect::<String>(),
-            chi2_run::reproduce_command(&plan),
+            reproduce,
         )
     };
     if let Err(e) = written.and_then(|_| stdout.flush()) {

@@ -227,9 +227,26 @@ fn show(v: Vec3) -> String {
     format!("[{}, {}, {}]", v[0], v[1], v[2])
 }
 
+/// Copies a batch result into `out`, or NaN everywhere after a protocol error (recorded).
+fn fill(out: &mut [f64], got: Result<Vec<f64>, ExternalError>) {
+    match got {
+        Ok(v) => out.copy_from_slice(&v),
+        Err(_) => out.fill(f64::NAN),
+    }
+}
+
 impl Ndf for ExternalModel {
     fn d(&self, m: Vec3) -> f64 {
         self.one_value(Request::D { m: &[m] }, format!("m = {}", show(m)))
+    }
+    /// A child process: every call is a round trip.
+    fn is_remote(&self) -> bool {
+        true
+    }
+    /// D through the protocol: up to 65 536 directions per request.
+    fn d_batch(&self, m: &[Vec3], out: &mut [f64]) {
+        assert_eq!(m.len(), out.len(), "d_batch: m and out differ in length");
+        fill(out, ExternalModel::d_batch(self, m));
     }
     fn as_smith(&self) -> Option<&dyn Smith> {
         self.description.has("lambda").then_some(self as &dyn Smith)
@@ -249,6 +266,15 @@ impl Ndf for ExternalModel {
 impl Smith for ExternalModel {
     fn lambda(&self, w: Vec3) -> f64 {
         self.one_value(Request::Lambda { w: &[w] }, format!("w = {}", show(w)))
+    }
+    /// Λ through the protocol: up to 65 536 directions per request.
+    fn lambda_batch(&self, w: &[Vec3], out: &mut [f64]) {
+        assert_eq!(
+            w.len(),
+            out.len(),
+            "lambda_batch: w and out differ in length"
+        );
+        fill(out, ExternalModel::lambda_batch(self, w));
     }
     fn g1(&self, w: Vec3, m: Vec3) -> f64 {
         if !self.description.has("g1") {
@@ -314,6 +340,21 @@ impl NormalSampler for ExternalModel {
         }
         self.one_value(Request::PdfWm { m: &[m] }, format!("m = {}", show(m)))
     }
+    /// pdf_wm through the protocol (D(m) m_z from a `d` batch when not declared).
+    fn pdf_wm_batch(&self, m: &[Vec3], out: &mut [f64]) {
+        assert_eq!(
+            m.len(),
+            out.len(),
+            "pdf_wm_batch: m and out differ in length"
+        );
+        if self.description.has("pdf_wm") {
+            return fill(out, ExternalModel::pdf_wm_batch(self, m));
+        }
+        Ndf::d_batch(self, m, out);
+        for (o, m) in out.iter_mut().zip(m) {
+            *o = if m[2] <= 0.0 { 0.0 } else { *o * m[2] };
+        }
+    }
 }
 
 impl VisibleNormalSampler for ExternalModel {
@@ -349,5 +390,73 @@ impl VisibleNormalSampler for ExternalModel {
             Request::PdfWmVisible { wi: &[wi], m: &[m] },
             format!("wi = {}, m = {}", show(wi), show(m)),
         )
+    }
+    /// sample_wm_visible through the protocol: up to 65 536 pairs per request (NaN directions
+    /// outside the domain, and after a protocol error).
+    fn sample_wm_visible_batch(&self, wi: Vec3, u: &[[f64; 2]], out: &mut [Vec3]) {
+        assert_eq!(
+            u.len(),
+            out.len(),
+            "sample_wm_visible_batch: u and out differ in length"
+        );
+        if !visible_domain(wi) {
+            return out.fill(NAN3);
+        }
+        let wis = vec![wi; u.len().min(MAX_BATCH)];
+        for (start, chunk) in (0..u.len())
+            .step_by(MAX_BATCH)
+            .zip(out.chunks_mut(MAX_BATCH))
+        {
+            let r = start..start + chunk.len();
+            let request = Request::SampleWmVisible {
+                wi: &wis[..chunk.len()],
+                u: &u[r.clone()],
+            };
+            match self.directions(&request, &|i| {
+                format!("wi = {}, u = {:?}", show(wi), u[r.start + i])
+            }) {
+                Ok(m) => chunk.copy_from_slice(&m),
+                Err(_) => {
+                    out[start..].fill(NAN3);
+                    return;
+                }
+            }
+        }
+    }
+    /// pdf_wm_visible through the protocol (from `d` and Λ batches when not declared).
+    fn pdf_wm_visible_batch(&self, wi: Vec3, m: &[Vec3], out: &mut [f64]) {
+        assert_eq!(
+            m.len(),
+            out.len(),
+            "pdf_wm_visible_batch: m and out differ in length"
+        );
+        if !visible_domain(wi) {
+            return out.fill(0.0);
+        }
+        if !self.description.has("pdf_wm_visible") {
+            Ndf::d_batch(self, m, out);
+            let lambda = self.lambda(wi);
+            for (o, m) in out.iter_mut().zip(m) {
+                let c = wi[0] * m[0] + wi[1] * m[1] + wi[2] * m[2];
+                *o = if !(m[2] > 0.0) || !(c > 0.0) || *o == 0.0 {
+                    0.0
+                } else {
+                    c * *o / (wi[2] * (1.0 + lambda))
+                };
+            }
+            return;
+        }
+        let wis = vec![wi; m.len().min(MAX_BATCH)];
+        let got = chunked(m.len(), |r| {
+            let n = r.len();
+            self.values(
+                &Request::PdfWmVisible {
+                    wi: &wis[..n],
+                    m: &m[r.clone()],
+                },
+                &|i| format!("wi = {}, m = {}", show(wi), show(m[r.start + i])),
+            )
+        });
+        fill(out, got);
     }
 }

@@ -24,7 +24,7 @@
 //! 5. **p-value** Q(dof/2, χ²/2), the upper regularized incomplete gamma function (accurate in
 //!    the far tail, unlike 1 − CDF); the test rejects when p < α.
 
-use crate::oracle::cubature::{integrate_rectangle, Tolerance};
+use crate::oracle::cubature::{integrate_rectangle, integrate_rectangles_batch, Tolerance};
 use crate::oracle::domain::{CellFinder, DomainError, HemisphereGrid};
 use crate::oracle::lobe::{self, Lobe};
 use crate::oracle::Estimate;
@@ -56,6 +56,13 @@ pub const CELL_ABSOLUTE_TOLERANCE: f64 = 1e-14;
 /// cells, so 1e-6 keeps a margin of over 1000 while the cubature no longer subdivides the kink
 /// to 1e-9 (2–5 s per test instead of ~0.3 s).
 pub const KINKED_CELL_RELATIVE_TOLERANCE: f64 = 1e-6;
+/// [`KINKED_CELL_RELATIVE_TOLERANCE`] for a remote model (an external process, where each of
+/// the tens of millions of evaluations the kink costs at 1e-6 is protocol traffic): 1e-5 still
+/// keeps a margin of 500 on the 5e-3 the expected counts need at 2·10⁷ samples.
+pub const REMOTE_KINKED_CELL_RELATIVE_TOLERANCE: f64 = 1e-5;
+/// [`CELL_ABSOLUTE_TOLERANCE`] for a remote model: 1e-11 of mass per cell is 2e-4 counts at
+/// 2·10⁷ samples, far below the ≥ 5 counts a cell needs to enter the statistic unpooled.
+pub const REMOTE_CELL_ABSOLUTE_TOLERANCE: f64 = 1e-11;
 
 /// The parameters of one chi-square test.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -237,8 +244,25 @@ pub fn observe_batch<S>(sample: &S, grid: HemisphereGrid, samples: u64, seed: u6
 where
     S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
 {
+    observe_blocks(sample, grid, samples, seed, BATCH)
+}
+
+/// [`observe_batch`] with blocks of `block` samples (at most [`CHUNK`]): the same counts for
+/// any block size (the streams' pairs do not depend on how they are read); a whole chunk per
+/// call suits an external model (one round trip per 65 536 samples).
+pub fn observe_blocks<S>(
+    sample: &S,
+    grid: HemisphereGrid,
+    samples: u64,
+    seed: u64,
+    block: usize,
+) -> Observed
+where
+    S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
+{
     let chunks = samples.div_ceil(CHUNK);
     let finder = CellFinder::new(grid);
+    let block = block.clamp(1, CHUNK as usize);
     (0..chunks)
         .into_par_iter()
         .fold(
@@ -247,12 +271,12 @@ where
                 let mut rng = stream(seed, chunk);
                 let start = chunk * CHUNK;
                 let end = (start + CHUNK).min(samples);
-                let mut u = [[0.0; 2]; BATCH];
-                let mut m = [[0.0; 3]; BATCH];
-                let mut cells = [0usize; BATCH];
+                let mut u = vec![[0.0; 2]; block];
+                let mut m = vec![[0.0; 3]; block];
+                let mut cells = vec![0usize; block];
                 let mut first = start;
                 while first < end {
-                    let n = (end - first).min(BATCH as u64) as usize;
+                    let n = (end - first).min(block as u64) as usize;
                     rng.fill_pairs(&mut u[..n]);
                     sample(&u[..n], &mut m[..n]);
                     if finder.cells_of(&m[..n], &mut cells[..n]) {
@@ -348,6 +372,88 @@ where
                     sum.evaluations += e.evaluations;
                 }
             }
+            sum
+        })
+        .collect();
+    Expected {
+        mass: estimates.iter().map(|e| e.value).collect(),
+        total: estimates.iter().map(|e| e.value).sum(),
+        error_bound: estimates.iter().map(|e| e.error_bound).sum(),
+        evaluations: estimates.iter().map(|e| e.evaluations).sum(),
+    }
+}
+
+/// A batch sampler: writes the normal of u[i] into m[i].
+pub type BatchSampler<'a> = dyn Fn(&[[f64; 2]], &mut [Vec3]) + Sync + 'a;
+
+/// A batch density: writes pdf(m[i]) into out[i].
+pub type BatchPdf<'a> = dyn Fn(&[Vec3], &mut [f64]) + Sync + 'a;
+
+/// [`expected_mass_in`] for a batch density, to the per-cell (relative, absolute) tolerances
+/// (`expected_mass_in` takes [`CELL_ABSOLUTE_TOLERANCE`]): the pieces of every cell are integrated together
+/// ([`integrate_rectangles_batch`], the density evaluated in parallel chunks of 16 384 points),
+/// so an external model pays a round trip per chunk, not per node. The same masses bit for bit.
+pub fn expected_mass_in_batch(
+    pdf: &BatchPdf<'_>,
+    grid: HemisphereGrid,
+    (relative, absolute): (f64, f64),
+    lobe: &Lobe,
+) -> Expected {
+    let polar = lobe.polar_cuts(FRAC_PI_2);
+    let azimuth = lobe.azimuth_cuts();
+    let mut rectangles = Vec::new();
+    let mut per_cell = Vec::with_capacity(grid.cells());
+    for i in 0..grid.cells() {
+        let cell = grid.cell(i);
+        let theta = [
+            cell.z[1].clamp(0.0, 1.0).acos(),
+            cell.z[0].clamp(0.0, 1.0).acos(),
+        ];
+        let thetas = inside(&polar, theta);
+        let phis = inside(&azimuth, cell.phi);
+        let pieces = (thetas.len() - 1) * (phis.len() - 1);
+        let tolerance = Tolerance {
+            absolute: absolute / pieces as f64,
+            relative,
+        };
+        for p in phis.windows(2) {
+            for t in thetas.windows(2) {
+                rectangles.push(([p[0], p[1]], [t[0], t[1]], tolerance));
+            }
+        }
+        per_cell.push(pieces);
+    }
+    let f = |pt: &[[f64; 2]], out: &mut [f64]| {
+        const CHUNK: usize = 16_384;
+        out.par_chunks_mut(CHUNK)
+            .zip(pt.par_chunks(CHUNK))
+            .for_each(|(out, pt)| {
+                let dirs: Vec<Vec3> = pt
+                    .iter()
+                    .map(|&[phi, theta]| {
+                        let (s, c) = theta.sin_cos();
+                        let (sp, cp) = phi.sin_cos();
+                        [s * cp, s * sp, c.max(0.0)]
+                    })
+                    .collect();
+                pdf(&dirs, out);
+                for (o, &[_, theta]) in out.iter_mut().zip(pt) {
+                    *o *= theta.sin();
+                }
+            });
+    };
+    let pieces = integrate_rectangles_batch(&f, &rectangles);
+    let mut at = 0;
+    let estimates: Vec<Estimate> = per_cell
+        .iter()
+        .map(|&n| {
+            let mut sum = Estimate::default();
+            for e in &pieces[at..at + n] {
+                sum.value += e.value;
+                sum.error_bound += e.error_bound;
+                sum.evaluations += e.evaluations;
+            }
+            at += n;
             sum
         })
         .collect();
@@ -471,6 +577,25 @@ where
         None => expected_mass_to(pdf, grid, cell_relative),
     };
     let integration_seconds = t.elapsed().as_secs_f64();
+    judge(
+        config,
+        grid,
+        observed,
+        expected,
+        sampling_seconds,
+        integration_seconds,
+    )
+}
+
+/// The verdict from the observed and expected counts.
+fn judge(
+    config: &Chi2Config,
+    grid: HemisphereGrid,
+    observed: Observed,
+    expected: Expected,
+    sampling_seconds: f64,
+    integration_seconds: f64,
+) -> Chi2Result {
     let n = config.samples as f64;
     let mut result = Chi2Result {
         resolution: grid.rows(),
@@ -514,6 +639,44 @@ where
         });
     }
     result
+}
+
+/// The chi-square test with a batch sampler and a batch density (an external model: a round
+/// trip per batch), the expected masses integrated to the per-cell (relative, absolute)
+/// `cell_tolerance`: with ([`CELL_RELATIVE_TOLERANCE`] or the kinked one,
+/// [`CELL_ABSOLUTE_TOLERANCE`]) the same result as [`chi2_test_batch_in`] with the scalar
+/// density. With no
+/// `lobe`, it is measured from the density ([`lobe::measure_with_batch`]).
+pub fn chi2_test_batches_in(
+    sample: &BatchSampler<'_>,
+    pdf: &BatchPdf<'_>,
+    config: &Chi2Config,
+    cell_tolerance: (f64, f64),
+    lobe: Option<&Lobe>,
+) -> Chi2Result {
+    let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
+    let t = Instant::now();
+    let observed = observe_blocks(sample, grid, config.samples, config.seed, CHUNK as usize);
+    let sampling_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let expected = match lobe {
+        Some(lobe) => expected_mass_in_batch(pdf, grid, cell_tolerance, lobe),
+        None => {
+            let lobe = lobe::measure_with_batch(pdf, &lobe::Options::default());
+            let mut e = expected_mass_in_batch(pdf, grid, cell_tolerance, &lobe);
+            e.evaluations += lobe.evaluations;
+            e
+        }
+    };
+    let integration_seconds = t.elapsed().as_secs_f64();
+    judge(
+        config,
+        grid,
+        observed,
+        expected,
+        sampling_seconds,
+        integration_seconds,
+    )
 }
 
 /// Tests a model's `sample_wm` against its own `pdf_wm`.

@@ -4,6 +4,7 @@
 pub mod chi2;
 pub mod cubature;
 pub mod domain;
+pub mod double_exponential;
 pub mod gtr;
 pub mod ks;
 pub mod lobe;

@@ -71,6 +71,39 @@ where
             m
         })
         .collect();
+    finish(parts, samples)
+}
+
+/// [`estimate`] for a batch integrand (`f(u, out)` writes f(u[i]) into out[i]): each chunk's
+/// uniforms are drawn as [`estimate`] draws them and handed to `f` in one call, then pushed in
+/// order, so the estimate is the scalar form's bit for bit (an external model pays one round
+/// trip per chunk of [`CHUNK`] samples, not per sample).
+pub fn estimate_batch<F>(f: &F, samples: u64, seed: u64) -> McEstimate
+where
+    F: Fn(&[[f64; 2]], &mut [f64]) + Sync + ?Sized,
+{
+    let chunks = samples.div_ceil(CHUNK);
+    let parts: Vec<Moments> = (0..chunks)
+        .into_par_iter()
+        .map(|chunk| {
+            let mut rng = stream(seed, chunk);
+            let end = ((chunk + 1) * CHUNK).min(samples);
+            let u: Vec<[f64; 2]> = (chunk * CHUNK..end)
+                .map(|_| [uniform(&mut rng), uniform(&mut rng)])
+                .collect();
+            let mut values = vec![0.0; u.len()];
+            f(&u, &mut values);
+            let mut m = Moments::default();
+            for v in values {
+                m.push(v);
+            }
+            m
+        })
+        .collect();
+    finish(parts, samples)
+}
+
+fn finish(parts: Vec<Moments>, samples: u64) -> McEstimate {
     let all = parts.into_iter().fold(Moments::default(), Moments::merge);
     let variance = if all.n > 1.0 {
         all.m2 / (all.n - 1.0)
@@ -113,6 +146,20 @@ mod tests {
             .install(|| estimate(&f, 100_000, 11));
         assert_eq!(many, one);
         assert_ne!(estimate(&f, 100_000, 12).mean, many.mean);
+    }
+
+    #[test]
+    fn the_batch_form_is_the_scalar_form_bit_for_bit() {
+        let f = |u: [f64; 2]| (u[0] * 7.0).sin() + u[1];
+        let batch = |u: &[[f64; 2]], out: &mut [f64]| {
+            for (o, &u) in out.iter_mut().zip(u) {
+                *o = f(u);
+            }
+        };
+        assert_eq!(
+            estimate(&f, 3 * CHUNK + 17, 4),
+            estimate_batch(&batch, 3 * CHUNK + 17, 4)
+        );
     }
 
     #[test]

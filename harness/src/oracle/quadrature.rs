@@ -7,6 +7,7 @@
 //! rule family so that it shares no failure mode with them, and tanh–sinh is robust to the
 //! integrable end-point singularities of heavy-tailed slope densities.
 
+use super::double_exponential::{integrate_many_tagged, BatchFn, TaggedBatchFn};
 use super::lobe::Lobe;
 use super::Estimate;
 use mfh_reference::Vec3;
@@ -60,56 +61,134 @@ impl Accuracy {
 /// error is checked against a second rule (see `estimate`), so that a double-exponential
 /// estimate that stopped early cannot pass unseen.
 pub fn integrate_pieces(f: &dyn Fn(f64) -> f64, points: &[f64], accuracy: Accuracy) -> Estimate {
-    struct Piece {
-        lo: f64,
-        hi: f64,
-        value: f64,
-        error: f64,
-        refined: bool,
+    integrate_pieces_batch(&scalar_batch(f), points, accuracy)
+}
+
+/// A scalar integrand as a batch one (a loop).
+fn scalar_batch<'f>(f: &'f dyn Fn(f64) -> f64) -> impl Fn(&[f64], &mut [f64]) + 'f {
+    move |x: &[f64], out: &mut [f64]| {
+        for (o, &x) in out.iter_mut().zip(x) {
+            *o = f(x);
+        }
     }
-    let evaluations = Cell::new(0u64);
-    let de = |lo: f64, hi: f64, tol: f64| {
-        let o = quadrature::double_exponential::integrate(f, lo, hi, tol.max(1e-300));
-        evaluations.set(evaluations.get() + u64::from(o.num_function_evaluations));
-        o
-    };
-    // A refined estimate is the sum over the two halves, and its error the larger of their
-    // double-exponential estimates and the disagreement with the whole-piece rule: the crate's
-    // own estimate can stop at a level where two successive levels agree by accident (seen: a
-    // GGX Λ tail piece off by 2e-9 relative, reported as 1e-17).
-    let estimate = |lo: f64, hi: f64, tol: f64, refined: bool| {
-        if !refined {
-            let o = de(lo, hi, tol);
-            return Piece {
-                lo,
-                hi,
-                value: o.integral,
-                error: o.error_estimate,
-                refined,
-            };
+}
+
+/// [`integrate_pieces`] for a batch integrand (`f(x, out)` writes f(x[i]) into out[i]): the
+/// same nodes and arithmetic, so the same result bit for bit, but each step of the rule
+/// evaluates its nodes in one call ([`integrate_pieces_many`]).
+pub fn integrate_pieces_batch(f: &BatchFn<'_>, points: &[f64], accuracy: Accuracy) -> Estimate {
+    let mut xs = Vec::new();
+    integrate_pieces_many(
+        &mut |tx: &[(usize, f64)], out: &mut [f64]| {
+            xs.clear();
+            xs.extend(tx.iter().map(|&(_, x)| x));
+            f(&xs, out)
+        },
+        &[(points.to_vec(), accuracy)],
+    )[0]
+}
+
+struct Piece {
+    lo: f64,
+    hi: f64,
+    value: f64,
+    error: f64,
+    refined: bool,
+}
+
+/// What one piecewise integral asks for next.
+enum Step {
+    /// The first (cheap) estimate of every piece.
+    First(Vec<(f64, f64)>),
+    /// Refined estimates of these parts `(lo, hi, share of the target)`: three rules each.
+    Refine(Vec<(f64, f64, f64)>),
+    /// Finished.
+    Done(Estimate),
+}
+
+/// The adaptive loop of [`integrate_pieces`] as a state machine, so that many integrals advance
+/// in lockstep ([`integrate_pieces_many`]).
+struct Pieces {
+    pieces: Vec<Piece>,
+    span: f64,
+    accuracy: Accuracy,
+    evaluations: u64,
+    step: Step,
+}
+
+impl Pieces {
+    fn new(points: &[f64], accuracy: Accuracy) -> Self {
+        Self {
+            pieces: Vec::new(),
+            span: points.windows(2).map(|w| (w[1] - w[0]).abs()).sum(),
+            accuracy,
+            evaluations: 0,
+            step: Step::First(
+                points
+                    .windows(2)
+                    .filter(|w| w[1] > w[0])
+                    .map(|w| (w[0], w[1]))
+                    .collect(),
+            ),
         }
-        let mid = 0.5 * (lo + hi);
-        let (whole, left, right) = (
-            de(lo, hi, tol),
-            de(lo, mid, 0.5 * tol),
-            de(mid, hi, 0.5 * tol),
-        );
-        let value = left.integral + right.integral;
-        Piece {
-            lo,
-            hi,
-            value,
-            error: (left.error_estimate + right.error_estimate).max((whole.integral - value).abs()),
-            refined,
+    }
+
+    /// The double-exponential rules the current step needs, `(lo, hi, target)`.
+    fn intervals(&self, out: &mut Vec<(f64, f64, f64)>) {
+        match &self.step {
+            Step::First(parts) => out.extend(parts.iter().map(|&(lo, hi)| (lo, hi, f64::INFINITY))),
+            Step::Refine(parts) => {
+                for &(lo, hi, tol) in parts {
+                    let mid = 0.5 * (lo + hi);
+                    out.extend([(lo, hi, tol), (lo, mid, 0.5 * tol), (mid, hi, 0.5 * tol)]);
+                }
+            }
+            Step::Done(_) => {}
         }
-    };
-    let span: f64 = points.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
-    let mut pieces: Vec<Piece> = points
-        .windows(2)
-        .filter(|w| w[1] > w[0])
-        .map(|w| estimate(w[0], w[1], f64::INFINITY, false))
-        .collect();
-    loop {
+    }
+
+    /// Takes the rules' outputs (in the order of `intervals`) and decides the next step.
+    fn advance(&mut self, o: &[quadrature::Output]) {
+        for o in o {
+            self.evaluations += u64::from(o.num_function_evaluations);
+        }
+        match &self.step {
+            Step::First(parts) => self
+                .pieces
+                .extend(parts.iter().zip(o).map(|(&(lo, hi), o)| Piece {
+                    lo,
+                    hi,
+                    value: o.integral,
+                    error: o.error_estimate,
+                    refined: false,
+                })),
+            // A refined estimate is the sum over the two halves, and its error the larger of
+            // their double-exponential estimates and the disagreement with the whole-piece
+            // rule: the crate's own estimate can stop at a level where two successive levels
+            // agree by accident (seen: a GGX Λ tail piece off by 2e-9 relative, reported as
+            // 1e-17).
+            Step::Refine(parts) => {
+                self.pieces
+                    .extend(parts.iter().zip(o.chunks(3)).map(|(&(lo, hi, _), o)| {
+                        let (whole, left, right) = (o[0], o[1], o[2]);
+                        let value = left.integral + right.integral;
+                        Piece {
+                            lo,
+                            hi,
+                            value,
+                            error: (left.error_estimate + right.error_estimate)
+                                .max((whole.integral - value).abs()),
+                            refined: true,
+                        }
+                    }))
+            }
+            Step::Done(_) => return,
+        }
+        self.step = self.decide();
+    }
+
+    fn decide(&mut self) -> Step {
+        let pieces = &mut self.pieces;
         let value: f64 = pieces.iter().map(|p| p.value).sum();
         let error: f64 = pieces.iter().map(|p| p.error).sum();
         let magnitude: f64 = pieces
@@ -119,16 +198,16 @@ pub fn integrate_pieces(f: &dyn Fn(f64) -> f64, points: &[f64], accuracy: Accura
         // Never ask for less than the round-off of the sum: past it, bisection only trades one
         // rounding error for another (and used to run to MAX_PIECES on every inner integral of
         // a nested cubature).
-        let target = (accuracy.relative * value.abs())
-            .max(accuracy.absolute)
+        let target = (self.accuracy.relative * value.abs())
+            .max(self.accuracy.absolute)
             .max(ROUNDOFF * magnitude);
         let unrefined = pieces.iter().position(|p| !p.refined);
         if unrefined.is_none() && (!(error > target) || pieces.len() >= MAX_PIECES) {
-            return Estimate {
+            return Step::Done(Estimate {
                 value,
                 error_bound: error,
-                evaluations: evaluations.get(),
-            };
+                evaluations: self.evaluations,
+            });
         }
         let worst = unrefined.unwrap_or_else(|| {
             pieces
@@ -142,21 +221,77 @@ pub fn integrate_pieces(f: &dyn Fn(f64) -> f64, points: &[f64], accuracy: Accura
         // A piece's share of the target, but not below its own round-off (a double-exponential
         // rule asked for less runs to its deepest level for nothing).
         let floor = ROUNDOFF * piece.value.abs() * node_noise(piece.lo, piece.hi);
+        let span = self.span;
         let share = |lo: f64, hi: f64| {
-            (0.5 * target * (hi - lo) / span.max(f64::MIN_POSITIVE))
-                .max(floor * (hi - lo) / (piece.hi - piece.lo))
+            ((0.5 * target * (hi - lo) / span.max(f64::MIN_POSITIVE))
+                .max(floor * (hi - lo) / (piece.hi - piece.lo)))
+            .max(1e-300)
         };
-        if !piece.refined {
-            pieces.push(estimate(
-                piece.lo,
-                piece.hi,
-                share(piece.lo, piece.hi),
-                true,
-            ));
+        Step::Refine(if !piece.refined {
+            vec![(piece.lo, piece.hi, share(piece.lo, piece.hi))]
         } else {
             let mid = 0.5 * (piece.lo + piece.hi);
-            pieces.push(estimate(piece.lo, mid, share(piece.lo, mid), true));
-            pieces.push(estimate(mid, piece.hi, share(mid, piece.hi), true));
+            vec![
+                (piece.lo, mid, share(piece.lo, mid)),
+                (mid, piece.hi, share(mid, piece.hi)),
+            ]
+        })
+    }
+}
+
+/// Several [`integrate_pieces`] at once, `problems[k] = (points, accuracy)` integrating f_k:
+/// `f` receives `(k, x)` pairs and writes f_k(x). The integrals advance in lockstep — every
+/// step of every adaptive loop, and every level of its double-exponential rules, is one call of
+/// `f` for all of them — with each integral's arithmetic that of [`integrate_pieces`], so the
+/// results are the same bit for bit. An external model (one round trip per call) pays a round
+/// trip per step, not per node (nested integrals: the inner integrals of one outer step
+/// together).
+pub fn integrate_pieces_many(
+    f: &mut TaggedBatchFn<'_>,
+    problems: &[(Vec<f64>, Accuracy)],
+) -> Vec<Estimate> {
+    let mut states: Vec<Pieces> = problems.iter().map(|(p, a)| Pieces::new(p, *a)).collect();
+    let (mut intervals, mut tagged, mut counts) = (Vec::new(), Vec::new(), Vec::new());
+    loop {
+        tagged.clear();
+        counts.clear();
+        let mut pending = false;
+        for (k, s) in states.iter().enumerate() {
+            if matches!(s.step, Step::Done(_)) {
+                continue;
+            }
+            pending = true;
+            intervals.clear();
+            s.intervals(&mut intervals);
+            counts.push(intervals.len());
+            tagged.extend(
+                intervals
+                    .iter()
+                    .map(|&(lo, hi, t)| (k, lo, hi, t.max(1e-300))),
+            );
+        }
+        if !pending {
+            return states
+                .iter()
+                .map(|s| match s.step {
+                    Step::Done(e) => e,
+                    // Not reached: `pending` is false only when every state is done.
+                    _ => Estimate {
+                        value: f64::NAN,
+                        ..Estimate::default()
+                    },
+                })
+                .collect();
+        }
+        let outputs = integrate_many_tagged(f, &tagged);
+        let mut at = 0;
+        for (s, n) in states
+            .iter_mut()
+            .filter(|s| !matches!(s.step, Step::Done(_)))
+            .zip(counts.iter())
+        {
+            s.advance(&outputs[at..at + n]);
+            at += n;
         }
     }
 }
@@ -332,6 +467,35 @@ fn cap_polar(
     cuts: Option<Cuts<'_>>,
     accuracy: Accuracy,
 ) -> Estimate {
+    cap_polar_batch(
+        &|tp: &[[f64; 2]], out: &mut [f64]| {
+            for (o, &[theta, phi]) in out.iter_mut().zip(tp) {
+                *o = f(theta, phi);
+            }
+        },
+        theta_max,
+        polar_cuts,
+        phi_cuts,
+        cuts,
+        accuracy,
+    )
+}
+
+/// A batch integrand over a cap: writes f(θ[i], φ[i]) into out[i] for each `[θ, φ]`.
+pub type PolarBatchFn<'a> = dyn Fn(&[[f64; 2]], &mut [f64]) + 'a;
+
+/// [`cap_polar`] for a batch integrand: the inner (polar) integrals of one step of the outer
+/// (azimuthal) rule run in lockstep ([`integrate_pieces_many`]), so each call of `f` carries
+/// the nodes of all of them. Values are those of the scalar form bit for bit (the summed inner
+/// error bounds may differ in the last bits: they are added in another order).
+fn cap_polar_batch(
+    f: &PolarBatchFn<'_>,
+    theta_max: f64,
+    polar_cuts: &[f64],
+    phi_cuts: &[f64],
+    cuts: Option<Cuts<'_>>,
+    accuracy: Accuracy,
+) -> Estimate {
     let evaluations = Cell::new(0u64);
     let inner_error = Cell::new(0.0f64);
     // The inner integrals are asked for a little more than the outer one, but not below
@@ -340,7 +504,7 @@ fn cap_polar(
         relative: (0.2 * accuracy.relative).max(2e-15),
         absolute: 0.05 * accuracy.absolute / std::f64::consts::TAU,
     };
-    let inner = |phi: f64| {
+    let points_at = |phi: f64| {
         let mut points = polar_cuts.to_vec();
         if let Some(c) = cuts {
             points.extend(
@@ -352,21 +516,32 @@ fn cap_polar(
         points.push(theta_max);
         points.sort_by(f64::total_cmp);
         points.dedup();
-        let e = integrate_pieces(
-            &|theta| {
-                let v = f(theta, phi);
-                if v == 0.0 {
-                    0.0
-                } else {
-                    v * theta.sin()
+        points
+    };
+    let calls = Cell::new(0u64);
+    let inner = |phis: &[f64], out: &mut [f64]| {
+        calls.set(calls.get() + phis.len() as u64);
+        let problems: Vec<(Vec<f64>, Accuracy)> = phis
+            .iter()
+            .map(|&phi| (points_at(phi), inner_accuracy))
+            .collect();
+        let mut tp = Vec::new();
+        let estimates = integrate_pieces_many(
+            &mut |tx: &[(usize, f64)], values: &mut [f64]| {
+                tp.clear();
+                tp.extend(tx.iter().map(|&(k, theta)| [theta, phis[k]]));
+                f(&tp, values);
+                for (v, &(_, theta)) in values.iter_mut().zip(tx) {
+                    *v = if *v == 0.0 { 0.0 } else { *v * theta.sin() };
                 }
             },
-            &points,
-            inner_accuracy,
+            &problems,
         );
-        evaluations.set(evaluations.get() + e.evaluations);
-        inner_error.set(inner_error.get() + e.error_bound.abs());
-        e.value
+        for (o, e) in out.iter_mut().zip(estimates) {
+            evaluations.set(evaluations.get() + e.evaluations);
+            inner_error.set(inner_error.get() + e.error_bound.abs());
+            *o = e.value;
+        }
     };
     let tau = std::f64::consts::TAU;
     let mut phi_points: Vec<f64> = phi_cuts.to_vec();
@@ -375,15 +550,7 @@ fn cap_polar(
     }
     phi_points.sort_by(f64::total_cmp);
     phi_points.dedup();
-    let calls = Cell::new(0u64);
-    let outer = integrate_pieces(
-        &|phi| {
-            calls.set(calls.get() + 1);
-            inner(phi)
-        },
-        &phi_points,
-        accuracy,
-    );
+    let outer = integrate_pieces_batch(&inner, &phi_points, accuracy);
     // The outer estimate's error bound covers its own rule; each inner error enters the outer
     // sum with a weight of at most the largest outer weight, bounded here by the mean inner
     // error times the azimuthal range.
@@ -421,6 +588,72 @@ pub fn integrate_hemisphere_lobe(
         cuts,
         accuracy,
     )
+}
+
+/// [`integrate_hemisphere_lobe`] for a batch integrand (`f(m, out)` writes f(m[i]) into
+/// out[i]): the same value bit for bit, with the nodes of each step in one call.
+pub fn integrate_hemisphere_lobe_batch(
+    f: &dyn Fn(&[Vec3], &mut [f64]),
+    lobe: &Lobe,
+    cuts: Option<Cuts<'_>>,
+    accuracy: Accuracy,
+) -> Estimate {
+    let polar = lobe.polar_cuts(std::f64::consts::FRAC_PI_2);
+    cap_polar_batch(
+        &|tp: &[[f64; 2]], out: &mut [f64]| {
+            let dirs: Vec<Vec3> = tp
+                .iter()
+                .map(|&[t, p]| direction(&IDENTITY, t, p))
+                .collect();
+            f(&dirs, out)
+        },
+        std::f64::consts::FRAC_PI_2,
+        &polar[..polar.len() - 1],
+        &lobe.azimuth_cuts(),
+        cuts,
+        accuracy,
+    )
+}
+
+/// [`integrate_hemisphere`] for a batch integrand (`f(m, out)` writes f(m[i]) into out[i]):
+/// the same value bit for bit, with the nodes of each step in one call.
+pub fn integrate_hemisphere_batch(
+    f: &dyn Fn(&[Vec3], &mut [f64]),
+    width: f64,
+    cuts: Option<Cuts<'_>>,
+    accuracy: Accuracy,
+) -> Estimate {
+    let frame = frame_about([0.0, 0.0, 1.0]);
+    integrate_hemisphere_polar_batch(
+        &|tp: &[[f64; 2]], out: &mut [f64]| {
+            let dirs: Vec<Vec3> = tp.iter().map(|&[t, p]| direction(&frame, t, p)).collect();
+            f(&dirs, out)
+        },
+        width,
+        cuts,
+        accuracy,
+    )
+}
+
+/// [`integrate_hemisphere_polar`] for a batch integrand of `[θ, φ]` pairs: the same value bit
+/// for bit, with the nodes of each step in one call.
+pub fn integrate_hemisphere_polar_batch(
+    f: &PolarBatchFn<'_>,
+    width: f64,
+    cuts: Option<Cuts<'_>>,
+    accuracy: Accuracy,
+) -> Estimate {
+    let theta_max = std::f64::consts::FRAC_PI_2;
+    let mut polar_cuts = vec![0.0];
+    for k in [1e-3, 1e-2, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0] {
+        let t = width * k;
+        if t > 0.0 && t < theta_max {
+            polar_cuts.push(t);
+        }
+    }
+    let tau = std::f64::consts::TAU;
+    let phi_points = [0.0, 0.25 * tau, 0.5 * tau, 0.75 * tau, tau];
+    cap_polar_batch(f, theta_max, &polar_cuts, &phi_points, cuts, accuracy)
 }
 
 /// [`integrate_hemisphere_lobe`] for an integrand of (θ, φ) about +z, φ from +x.

@@ -8,6 +8,7 @@ use crate::oracle::ks::{self, KsConfig, Marginal};
 use crate::record::{CheckRecord, Measured, Verdict};
 use crate::subject::Subject;
 use crate::tolerance::STATISTICAL_ALPHA;
+use mfh_reference::Vec3;
 use serde_json::{json, Value};
 use std::sync::Arc;
 
@@ -45,9 +46,9 @@ pub(super) fn plan_ks<'a>(
                 seed: ctx.seed,
                 alpha: STATISTICAL_ALPHA.value,
             };
-            let kept = ks::ks_test_lobe_kept(
-                &|u| sampler.sample_wm(u),
-                &|m| sampler.pdf_wm(m),
+            let kept = ks::ks_test_lobe_batch_kept(
+                &|u: &[[f64; 2]], out: &mut [Vec3]| sampler.sample_wm_batch(u, out),
+                &|m: &[Vec3], out: &mut [f64]| sampler.pdf_wm_batch(m, out),
                 marginal,
                 model.lobe(),
                 &kinks,

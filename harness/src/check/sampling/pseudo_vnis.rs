@@ -10,7 +10,7 @@ use crate::oracle::monte_carlo::{estimate, two_sided_p};
 use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
 use crate::tolerance::STATISTICAL_ALPHA;
-use mfh_reference::geometry::{dot, from_spherical};
+use mfh_reference::geometry::{dot, from_spherical, Vec3};
 use mfh_reference::ndf::student_vnis::{reflect, PseudoVnis};
 use mfh_reference::{Masking, ModelSpec, Ndf, Smith};
 use serde_json::{json, Value};
@@ -102,9 +102,22 @@ pub fn plan_pseudo_vnis(
             .statistical()
             .run(move |r, ctx| {
                 let wi = from_spherical(theta, phi);
-                chi2_kinked(r, ctx, resolution, samples, &|u| v.sample_wm(wi, u), &|m| {
-                    v.pdf_wm(wi, m)
-                });
+                chi2_kinked(
+                    r,
+                    ctx,
+                    (resolution, samples),
+                    &|u: &[[f64; 2]], out: &mut [Vec3]| {
+                        for (o, &u) in out.iter_mut().zip(u) {
+                            *o = v.sample_wm(wi, u);
+                        }
+                    },
+                    &|m: &[Vec3], out: &mut [f64]| {
+                        for (o, &m) in out.iter_mut().zip(m) {
+                            *o = v.pdf_wm(wi, m);
+                        }
+                    },
+                    false,
+                );
                 Ok(())
             }),
         );

@@ -4,7 +4,7 @@
 use super::{chi2_kinked, skipped};
 use crate::check::{compare, covers, PlannedCheck, Profile};
 use crate::check::{need, Check};
-use crate::oracle::quadrature::{integrate_hemisphere, Accuracy, Cuts};
+use crate::oracle::quadrature::{integrate_hemisphere_batch, Accuracy, Cuts};
 use crate::subject::Subject;
 use crate::tolerance::NORMALIZATION;
 use mfh_reference::geometry::{from_spherical, Vec3};
@@ -85,10 +85,10 @@ pub fn plan_visible<'a>(
                     chi2_kinked(
                         r,
                         ctx,
-                        resolution,
-                        samples,
-                        &|u| v.sample_wm_visible(wi, u),
-                        &|mm| v.pdf_wm_visible(wi, mm),
+                        (resolution, samples),
+                        &|u: &[[f64; 2]], out: &mut [Vec3]| v.sample_wm_visible_batch(wi, u, out),
+                        &|mm: &[Vec3], out: &mut [f64]| v.pdf_wm_visible_batch(wi, mm, out),
+                        m.model.is_remote(),
                     );
                     Ok(())
                 }),
@@ -110,8 +110,8 @@ pub fn plan_visible<'a>(
                 let v = need(m.model.as_visible_sampler(), "visible-normal sampler")?;
                 let wi = from_spherical(theta, phi);
                 let kinks = |p: f64| visible_kinks(wi, p);
-                let e = integrate_hemisphere(
-                    &|mm| v.pdf_wm_visible(wi, mm),
+                let e = integrate_hemisphere_batch(
+                    &|mm: &[Vec3], out: &mut [f64]| v.pdf_wm_visible_batch(wi, mm, out),
                     m.lobe().width(),
                     Some(Cuts {
                         theta: &kinks,

@@ -49,9 +49,11 @@ mod kolmogorov;
 mod table;
 
 pub use kolmogorov::{kolmogorov_q, ks_p_value, stephens_lambda};
-pub use table::{marginal_cdf, marginal_cdf_lobe, CdfTable};
+pub use table::{
+    marginal_cdf, marginal_cdf_batch, marginal_cdf_lobe, marginal_cdf_lobe_batch, CdfTable,
+};
 
-use crate::oracle::chi2::{Verdict, CHUNK, MASS_TOLERANCE};
+use crate::oracle::chi2::{BatchSampler, Verdict, CHUNK, MASS_TOLERANCE};
 use crate::oracle::domain::{validate, DomainError};
 use crate::oracle::lobe::{self, Lobe};
 use crate::oracle::quadrature::Accuracy;
@@ -256,12 +258,9 @@ struct Drawn {
     first_outside: Option<(u64, DomainError)>,
 }
 
-/// Draws `samples` normals with `sample` (seeded streams per chunk, as the chi-square test)
-/// and returns the marginal's values in sample order.
-fn draw<S>(sample: &S, marginal: Marginal, samples: u64, seed: u64) -> Drawn
-where
-    S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
-{
+/// Draws `samples` normals with `sample` (seeded streams per chunk, as the chi-square test;
+/// each chunk's uniforms in one call) and returns the marginal's values in sample order.
+fn draw_batch(sample: &BatchSampler<'_>, marginal: Marginal, samples: u64, seed: u64) -> Drawn {
     let chunks: Vec<Drawn> = (0..samples.div_ceil(CHUNK))
         .into_par_iter()
         .map(|chunk| {
@@ -272,9 +271,12 @@ where
                 outside: 0,
                 first_outside: None,
             };
-            for index in start..end {
-                let u = [uniform(&mut rng), uniform(&mut rng)];
-                let m = sample(u);
+            let u: Vec<[f64; 2]> = (start..end)
+                .map(|_| [uniform(&mut rng), uniform(&mut rng)])
+                .collect();
+            let mut normals = vec![[0.0; 3]; u.len()];
+            sample(&u, &mut normals);
+            for (index, m) in (start..end).zip(normals) {
                 match validate(m) {
                     Ok(_) => d.values.push(marginal.value(m)),
                     Err(error) => {
@@ -395,12 +397,52 @@ where
     S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
+    ks_test_lobe_batch_kept(
+        &|u: &[[f64; 2]], m: &mut [Vec3]| {
+            for (m, &u) in m.iter_mut().zip(u) {
+                *m = sample(u);
+            }
+        },
+        &|m: &[Vec3], out: &mut [f64]| {
+            for (o, &m) in out.iter_mut().zip(m) {
+                *o = pdf(m);
+            }
+        },
+        marginal,
+        lobe,
+        theta_kinks,
+        config,
+    )
+}
+
+/// [`ks_test_lobe`] with a batch sampler and a batch density (an external model: a round trip
+/// per chunk of samples and per step of each table integral): the same result.
+pub fn ks_test_lobe_batch(
+    sample: &BatchSampler<'_>,
+    pdf: &(dyn Fn(&[Vec3], &mut [f64]) + Sync),
+    marginal: Marginal,
+    lobe: &Lobe,
+    theta_kinks: &[f64],
+    config: &KsConfig,
+) -> KsResult {
+    ks_test_lobe_batch_kept(sample, pdf, marginal, lobe, theta_kinks, config).result
+}
+
+/// [`ks_test_lobe_batch`], keeping the sorted samples and the CDF table ([`KsKept`]).
+pub fn ks_test_lobe_batch_kept(
+    sample: &BatchSampler<'_>,
+    pdf: &(dyn Fn(&[Vec3], &mut [f64]) + Sync),
+    marginal: Marginal,
+    lobe: &Lobe,
+    theta_kinks: &[f64],
+    config: &KsConfig,
+) -> KsKept {
     let t = Instant::now();
-    let mut drawn = draw(sample, marginal, config.samples, config.seed);
+    let mut drawn = draw_batch(sample, marginal, config.samples, config.seed);
     drawn.values.par_sort_unstable_by(f64::total_cmp);
     let sampling_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let table = marginal_cdf_lobe(pdf, marginal, lobe, theta_kinks);
+    let table = marginal_cdf_lobe_batch(pdf, marginal, lobe, theta_kinks);
     let mut result = KsResult {
         marginal,
         statistic: f64::NAN,

@@ -4,7 +4,7 @@
 use super::{LobeHints, Marginal, INITIAL_PER_PIECE, INNER_ACCURACY, INTERPOLATION_TOLERANCE};
 use super::{MAX_DEPTH, MAX_SPANS, QUADRATURE_TOLERANCE};
 use crate::oracle::lobe::{self, Lobe};
-use crate::oracle::quadrature::integrate_pieces;
+use crate::oracle::quadrature::integrate_pieces_batch;
 use crate::oracle::Estimate;
 use mfh_reference::geometry::{from_spherical, Vec3};
 use rayon::prelude::*;
@@ -263,12 +263,34 @@ pub fn marginal_cdf<P>(pdf: &P, marginal: Marginal, hints: &LobeHints<'_>) -> Cd
 where
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
+    marginal_cdf_batch(&scalar_batch(pdf), marginal, hints)
+}
+
+/// A scalar density as a batch one (a loop).
+fn scalar_batch<P>(pdf: &P) -> impl Fn(&[Vec3], &mut [f64]) + Sync + '_
+where
+    P: Fn(Vec3) -> f64 + Sync + ?Sized,
+{
+    move |m: &[Vec3], out: &mut [f64]| {
+        for (o, &m) in out.iter_mut().zip(m) {
+            *o = pdf(m);
+        }
+    }
+}
+
+/// [`marginal_cdf`] for a batch density (`pdf(m, out)` writes pdf(m[i]) into out[i]): the same
+/// table bit for bit, each step of each inner integral one call of `pdf`.
+pub fn marginal_cdf_batch(
+    pdf: &(dyn Fn(&[Vec3], &mut [f64]) + Sync),
+    marginal: Marginal,
+    hints: &LobeHints<'_>,
+) -> CdfTable {
     let options = lobe::Options {
         hint: Some(hints.width),
         seeds: &[],
     };
-    let lobe = lobe::measure_with(&|m| pdf(m), &options);
-    let mut table = marginal_cdf_lobe(pdf, marginal, &lobe, hints.theta_kinks);
+    let lobe = lobe::measure_with_batch(pdf, &options);
+    let mut table = marginal_cdf_lobe_batch(pdf, marginal, &lobe, hints.theta_kinks);
     table.evaluations += lobe.evaluations;
     table
 }
@@ -285,6 +307,16 @@ pub fn marginal_cdf_lobe<P>(
 where
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
+    marginal_cdf_lobe_batch(&scalar_batch(pdf), marginal, lobe, theta_kinks)
+}
+
+/// [`marginal_cdf_lobe`] for a batch density: the same table bit for bit.
+pub fn marginal_cdf_lobe_batch(
+    pdf: &(dyn Fn(&[Vec3], &mut [f64]) + Sync),
+    marginal: Marginal,
+    lobe: &Lobe,
+    theta_kinks: &[f64],
+) -> CdfTable {
     let mut polar = lobe.polar_cuts(FRAC_PI_2);
     polar.extend(
         theta_kinks
@@ -302,8 +334,12 @@ where
                 if s == 0.0 {
                     return Estimate::default();
                 }
-                let e = integrate_pieces(
-                    &|phi| pdf(from_spherical(theta, phi)),
+                let e = integrate_pieces_batch(
+                    &|phis: &[f64], out: &mut [f64]| {
+                        let m: Vec<Vec3> =
+                            phis.iter().map(|&phi| from_spherical(theta, phi)).collect();
+                        pdf(&m, out)
+                    },
                     &azimuth,
                     INNER_ACCURACY,
                 );
@@ -317,13 +353,15 @@ where
         }
         Marginal::Phi => {
             let density = |phi: f64| {
-                integrate_pieces(
-                    &|theta| {
-                        let v = pdf(from_spherical(theta, phi));
-                        if v == 0.0 {
-                            0.0
-                        } else {
-                            v * theta.sin()
+                integrate_pieces_batch(
+                    &|thetas: &[f64], out: &mut [f64]| {
+                        let m: Vec<Vec3> = thetas
+                            .iter()
+                            .map(|&theta| from_spherical(theta, phi))
+                            .collect();
+                        pdf(&m, out);
+                        for (v, &theta) in out.iter_mut().zip(thetas) {
+                            *v = if *v == 0.0 { 0.0 } else { *v * theta.sin() };
                         }
                     },
                     &polar,

@@ -278,7 +278,12 @@ fn ks_p_values_of_a_correct_sampler_spread_over_seeds() {
     let table = marginal_cdf(&|m| g.pdf_wm(m), Marginal::CosTheta, &h);
     let p: Vec<f64> = (0..12u64)
         .map(|seed| {
-            let mut d = draw(&|u| g.sample_wm(u), Marginal::CosTheta, 50_000, seed);
+            let mut d = draw_batch(
+                &|u: &[[f64; 2]], m: &mut [Vec3]| g.sample_wm_batch(u, m),
+                Marginal::CosTheta,
+                50_000,
+                seed,
+            );
             d.values.sort_unstable_by(f64::total_cmp);
             ks_p_value(ks_statistic(&d.values, &|x| table.cdf(x)).0, 50_000)
         })

@@ -1,0 +1,243 @@
+//! `mfh audit-external` and `mfh chi2 --cmd` end to end on the examples under
+//! examples/external/: the pure-Python GGX and Beckmann and the numpy GGX pass the ci profile,
+//! the deliberately wrong sampler fails `sampling.chi2` (and nothing that does not depend on its
+//! samples), and `mfh chi2 --cmd` tests an external sampler as `--model` tests a reference one.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn example(file: &str) -> String {
+    format!("python3 {}/examples/external/{file}", root().display())
+}
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let (mut out, mut err) = (Vec::new(), Vec::new());
+    let code = mfh_harness::cli::run(
+        std::iter::once("mfh").chain(args.iter().copied()),
+        &mut std::io::empty(),
+        &mut out,
+        &mut err,
+    );
+    (
+        code,
+        String::from_utf8(out).unwrap(),
+        String::from_utf8(err).unwrap(),
+    )
+}
+
+fn temp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("mfh-{name}-{}", std::process::id()))
+}
+
+/// Runs `mfh audit-external` at the ci profile; returns the exit status and the ids of the
+/// checks whose records failed (or erred), printing the time it took.
+fn audit(file: &str, against: Option<&str>) -> (i32, Vec<String>, Value) {
+    let out = temp(&format!("audit-{file}"));
+    let cmd = example(file);
+    let mut args = vec![
+        "audit-external",
+        "--cmd",
+        &cmd,
+        "--profile",
+        "ci",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    if let Some(a) = against {
+        args.extend(["--against", a]);
+    }
+    let t = Instant::now();
+    let (code, stdout, stderr) = run(&args);
+    let report: Value = serde_json::from_str(stdout.trim())
+        .unwrap_or_else(|e| panic!("{file}: no report ({e}): {stdout}{stderr}"));
+    let failing: Vec<String> = report["records"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| matches!(r["verdict"].as_str(), Some("fail") | Some("error")))
+        .map(|r| r["check"].as_str().unwrap_or("").to_string())
+        .collect();
+    eprintln!(
+        "{file}: exit {code} in {:.1} s, {} records, failing {failing:?}",
+        t.elapsed().as_secs_f64(),
+        report["records"].as_array().unwrap().len()
+    );
+    let _ = std::fs::remove_dir_all(&out);
+    (code, failing, report)
+}
+
+#[test]
+fn the_pure_python_ggx_passes_the_ci_audit() {
+    let (code, failing, report) = audit("ggx.py", Some(r#"{"family":"ggx","alpha":0.3}"#));
+    assert_eq!(code, 0, "failing: {failing:?}");
+    assert!(failing.is_empty());
+    // It was audited for what it declares: D, Λ, sampling, visible sampling, and the values.
+    let checks: Vec<&str> = report["records"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["check"].as_str().unwrap())
+        .collect();
+    for want in [
+        "normalization.projected_area",
+        "smith.white_furnace",
+        "sampling.chi2",
+        "sampling.ks_marginals",
+        "sampling.chi2_visible",
+        "against.reference",
+    ] {
+        assert!(checks.contains(&want), "{want} not run: {checks:?}");
+    }
+}
+
+#[test]
+fn the_pure_python_beckmann_passes_the_ci_audit() {
+    let (code, failing, _) = audit("beckmann.py", Some(r#"{"family":"beckmann","alpha":0.3}"#));
+    assert_eq!(code, 0, "failing: {failing:?}");
+}
+
+#[test]
+fn the_numpy_ggx_passes_the_ci_audit() {
+    let has_numpy = std::process::Command::new("python3")
+        .args(["-c", "import numpy"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !has_numpy {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI is set but numpy is missing: .ci/run installs it"
+        );
+        eprintln!("SKIPPED: numpy is not installed (python3 -m pip install numpy)");
+        return;
+    }
+    let (code, failing, _) = audit("ggx_numpy.py", Some(r#"{"family":"ggx","alpha":0.3}"#));
+    assert_eq!(code, 0, "failing: {failing:?}");
+}
+
+/// The wrong sampler (GGX with Beckmann's slope radius) fails `sampling.chi2`; what does not
+/// look at its samples (D, Λ, the value comparison) passes.
+#[test]
+fn the_wrong_sampler_fails_the_chi_square_check() {
+    let (code, failing, _) = audit("ggx_wrong_sampler.py", None);
+    assert_eq!(code, 1);
+    assert!(
+        failing.iter().any(|c| c == "sampling.chi2"),
+        "failing: {failing:?}"
+    );
+    for c in &failing {
+        assert!(
+            c.starts_with("sampling."),
+            "{c} fails, but only the sampler is wrong"
+        );
+        assert_ne!(c, "sampling.chi2_visible", "the visible sampler is right");
+    }
+}
+
+/// `mfh chi2 --cmd` prints what `--model` prints and writes the same tables and heat maps; the
+/// expected counts come from the child's pdf (GGX α = 0.3: the reference's, to 1e-9); the
+/// wrong sampler fails; a child without the capability is bad input.
+#[test]
+fn chi2_cmd_tests_an_external_sampler() {
+    let out = temp("chi2-cmd");
+    let dir = out.to_str().unwrap();
+    let common = ["--samples", "200000", "--resolution", "8", "--seed", "3"];
+    let cmd = example("ggx.py");
+    let mut args = vec!["chi2", "--cmd", &cmd, "--json", "--out", dir];
+    args.extend(common);
+    let (code, stdout, stderr) = run(&args);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let external: Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(external["verdict"], "pass");
+    assert_eq!(external["model"]["name"], "ggx.py");
+    for file in [
+        "chi2_observed.json",
+        "chi2_expected.json",
+        "chi2_observed.svg",
+        "chi2_expected.svg",
+        "chi2_difference.svg",
+    ] {
+        assert!(
+            external["artefacts"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|a| a.as_str().unwrap().ends_with(file)),
+            "{file} not written: {}",
+            external["artefacts"]
+        );
+    }
+    let mut args = vec![
+        "chi2",
+        "--model",
+        r#"{"family":"ggx","alpha":0.3}"#,
+        "--json",
+    ];
+    args.extend(common);
+    let (code, stdout, _) = run(&args);
+    assert_eq!(code, 0);
+    let reference: Value = serde_json::from_str(stdout.trim()).unwrap();
+    let (a, b) = (
+        external["expected_mass"].as_f64().unwrap(),
+        reference["expected_mass"].as_f64().unwrap(),
+    );
+    assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+    // The same keys, so that scripts read both alike.
+    let keys = |v: &Value| {
+        let mut k: Vec<String> = v.as_object().unwrap().keys().cloned().collect();
+        k.sort();
+        k
+    };
+    assert_eq!(keys(&external), keys(&reference));
+    // Text output names the child and says how to reproduce.
+    let mut args = vec!["chi2", "--cmd", &cmd, "--quiet"];
+    args.extend(common);
+    let (code, stdout, _) = run(&args);
+    assert_eq!(code, 0);
+    assert!(
+        stdout.contains("ggx.py") && stdout.contains("mfh chi2 --cmd"),
+        "{stdout}"
+    );
+    // Visible normals at an incidence.
+    let mut args = vec![
+        "chi2",
+        "--cmd",
+        &cmd,
+        "--sampling",
+        "visible",
+        "--incidence",
+        "1.2",
+        "--json",
+    ];
+    args.extend(common);
+    let (code, stdout, stderr) = run(&args);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    // The wrong sampler fails.
+    let wrong = example("ggx_wrong_sampler.py");
+    let mut args = vec!["chi2", "--cmd", &wrong, "--json"];
+    args.extend(common);
+    let (code, stdout, _) = run(&args);
+    assert_eq!(code, 1, "{stdout}");
+    // No visible sampler declared (the numpy example): bad input naming the capability; and
+    // --cmd with --model is bad input.
+    let numpy = example("ggx_numpy.py");
+    let mut args = vec!["chi2", "--cmd", &numpy, "--sampling", "visible"];
+    args.extend(common);
+    let (code, _, stderr) = run(&args);
+    if std::process::Command::new("python3")
+        .args(["-c", "import numpy"])
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        assert_eq!(code, 2, "{stderr}");
+        assert!(stderr.contains("sample_wm_visible"), "{stderr}");
+    }
+    let (code, _, stderr) = run(&["chi2", "--cmd", &cmd, "--model", "{}"]);
+    assert_eq!(code, 2, "{stderr}");
+    let _ = std::fs::remove_dir_all(&out);
+}
