@@ -41,7 +41,7 @@ pub struct Cli {
 pub enum ProfileArg {
     /// One model in CI: the quick grids, 10⁶ chi-square samples, no document-level checks.
     Ci,
-    /// A few cases per property, 2·10⁵ samples per sampler.
+    /// A few cases per property, 2·10⁵ chi-square and 2·10⁶ KS samples per sampler.
     Quick,
     /// More incidence angles and 2·10⁶ samples per sampler.
     Standard,

@@ -26,7 +26,8 @@ pub struct SelftestArgs {
     /// Which mutants: the CI subset or all.
     #[arg(long, value_enum, default_value = "all")]
     pub subset: SubsetArg,
-    /// Only the mutants whose id contains this text.
+    /// Only the mutants whose id contains this text (with --calibrate: the samplers whose
+    /// spec contains it, e.g. `ggx`).
     #[arg(long)]
     pub only: Option<String>,
     /// Instead of the mutants, run N seeded chi-square and KS runs of the correct GGX and
@@ -85,7 +86,7 @@ pub fn run(args: SelftestArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
         },
         filter: args.only.clone(),
     };
-    if args.calibrate.is_none() && selftest::selected(&options).is_empty() {
+    if args.calibrate.is_none() && !args.power && selftest::selected(&options).is_empty() {
         let _ = writeln!(
             stderr,
             "mfh selftest: --only {:?} matches no mutant of the {:?} subset",
@@ -104,12 +105,22 @@ pub fn run(args: SelftestArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
         Some(n) => {
             let t = std::time::Instant::now();
             let mut report = selftest::SelftestReport::empty(&options);
-            match calibrate::calibrate(
-                &calibrate::DEFAULT_MODELS,
-                n,
-                options.profile,
-                Some(&progress),
-            ) {
+            // `--only` picks the calibrated samplers by a substring of their spec.
+            let models: Vec<&str> = calibrate::DEFAULT_MODELS
+                .iter()
+                .copied()
+                .filter(|m| args.only.as_ref().is_none_or(|o| m.contains(o.as_str())))
+                .collect();
+            if models.is_empty() {
+                let _ = writeln!(
+                    stderr,
+                    "mfh selftest: --only {:?} matches none of the calibrated samplers {:?}",
+                    args.only.as_deref().unwrap_or(""),
+                    calibrate::DEFAULT_MODELS
+                );
+                return EXIT_BAD_INPUT;
+            }
+            match calibrate::calibrate(&models, n, options.profile, Some(&progress)) {
                 Ok(c) => {
                     report.calibration = Some(c);
                     report.wall_seconds = t.elapsed().as_secs_f64();

@@ -19,6 +19,10 @@ pub enum Route {
     /// not audit visible-slope moments of a user model (they need the reference spec for the
     /// oracle), so the check is called on the trait object directly.
     VisibleMoments,
+    /// Through the `sg.product` check (`check::sg::product_check`) with the mutated product
+    /// as the function it checks, over the profile's sharpness grid: the SG checks take no
+    /// model (they exercise mfh's own SG closed forms), so there is no capability to wrap.
+    SgProduct,
 }
 
 /// One mutant of the catalog.
@@ -55,11 +59,21 @@ const PIECEWISE_ANISO: &str = r#"{"family":"piecewise_linear","x":{"theta":[0,0.
 const GAUSSIAN: &str =
     r#"{"family":"gaussian_slopes","mean":[0.1,-0.05],"cov":[[0.04,0.01],[0.01,0.09]]}"#;
 
+/// The SG mutants have no model: their base is the empty spec.
+const SG: &str = "{}";
+
 const GATE: Route = Route::Gate {
     slope_moments: false,
 };
 const NORM: &[&str] = &["normalization.projected_area"];
 const LAMBDA: &[&str] = &["smith.lambda_route"];
+/// D with its axes swapped keeps its normalization; Λ (from the reference) and pdf_wm (the
+/// reference's D cos θ) no longer match it.
+const D_SWAPPED: &[&str] = &[
+    "smith.lambda_route",
+    "smith.white_furnace",
+    "sampling.pdf_consistency",
+];
 const STAB: &[&str] = &["stability.incidence"];
 const G2: &[&str] = &["smith.g1_g2"];
 const STAT: &[&str] = &["sampling.chi2", "sampling.ks_marginals"];
@@ -158,7 +172,7 @@ pub const CATALOG: &[Entry] = &[
         GGX,
         Defect::LambdaLowerBranch,
         &["smith.identities"],
-        true
+        false
     ),
     entry!(
         "ggx.lambda_nan_at_normal",
@@ -241,8 +255,8 @@ pub const CATALOG: &[Entry] = &[
         "α_x and α_y swapped in D only",
         GGX_ANISO,
         Defect::DAxesSwapped,
-        LAMBDA,
-        true
+        D_SWAPPED,
+        false
     ),
     entry!(
         "ggx_aniso.lambda_axes_swapped",
@@ -258,6 +272,22 @@ pub const CATALOG: &[Entry] = &[
         GGX_ANISO,
         Defect::SamplerAxesSwapped,
         STAT,
+        false
+    ),
+    entry!(
+        "ggx_vis.d_axes_swapped",
+        "α_x and α_y swapped in D only",
+        GGX_VIS,
+        Defect::DAxesSwapped,
+        D_SWAPPED,
+        true
+    ),
+    entry!(
+        "ggx_vis.lambda_axes_swapped",
+        "α_x and α_y swapped in Λ only",
+        GGX_VIS,
+        Defect::LambdaAxesSwapped,
+        LAMBDA,
         true
     ),
     // GGX with a visible-normal sampler.
@@ -330,7 +360,7 @@ pub const CATALOG: &[Entry] = &[
             e: 1e-2
         },
         STAT,
-        true
+        false
     ),
     entry!(
         "beckmann.sampler_half_phi",
@@ -357,7 +387,7 @@ pub const CATALOG: &[Entry] = &[
         Route::Gate {
             slope_moments: true
         },
-        true
+        false
     ),
     // Beckmann anisotropic, visible-normal sampler.
     entry!(
@@ -365,7 +395,7 @@ pub const CATALOG: &[Entry] = &[
         "α_x and α_y swapped in D only",
         BECKMANN_ANISO,
         Defect::DAxesSwapped,
-        LAMBDA,
+        D_SWAPPED,
         false
     ),
     entry!(
@@ -522,7 +552,7 @@ pub const CATALOG: &[Entry] = &[
         "the x and y profiles swapped in D only",
         PIECEWISE_ANISO,
         Defect::DAxesSwapped,
-        LAMBDA,
+        D_SWAPPED,
         false
     ),
     // Gaussian slopes: visible-slope moments (through the D_s check).
@@ -553,6 +583,16 @@ pub const CATALOG: &[Entry] = &[
         Route::VisibleMoments,
         false
     ),
+    // Spherical Gaussians.
+    entry!(
+        "sg.product_amplitude_0.1pct",
+        "SG vector product amplitude off by 0.1 %",
+        SG,
+        Defect::SgProductAmplitude { e: 1e-3 },
+        &["sg.product"],
+        Route::SgProduct,
+        true
+    ),
 ];
 
 #[cfg(test)]
@@ -567,7 +607,7 @@ mod tests {
         ids.sort_unstable();
         ids.dedup();
         assert_eq!(ids.len(), CATALOG.len());
-        for e in CATALOG {
+        for e in CATALOG.iter().filter(|e| e.route != Route::SgProduct) {
             let spec: ModelSpec = serde_json::from_str(e.base).expect(e.id);
             spec.build().expect(e.id);
             assert!(!e.expected.is_empty(), "{}", e.id);

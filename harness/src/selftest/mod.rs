@@ -213,27 +213,72 @@ fn hints_of(base: &Value) -> Hints {
     }
 }
 
-/// Audits `model` by `route` at `seed`: the records.
+/// The sharpness of the lobe pairs the SG product is checked at (per profile: the quick
+/// grids span three decades, like the SG checks' own).
+fn sg_sharpness(profile: Profile) -> &'static [f64] {
+    match profile {
+        Profile::Ci | Profile::Quick => &[1.0, 30.0, 1000.0],
+        Profile::Standard | Profile::Thorough => &[0.1, 1.0, 10.0, 100.0, 1000.0, 1e4],
+    }
+}
+
+/// The `sg.product` records of a product with `defect`: one per sharpness, lobes a (axis n,
+/// amplitude 1.7) and b (axis 0.3 rad away, sharpness λ/2 + 0.3, amplitude 0.6).
+fn sg_records(defect: mutant::Defect, profile: Profile) -> Vec<CheckRecord> {
+    use mfh_reference::sg::Sg;
+    let src = "seed 003 §1: G₁⊗G₂ = G(p_m/‖p_m‖, λ_m‖p_m‖, μ₁μ₂e^{λ_m(‖p_m‖−1)})";
+    sg_sharpness(profile)
+        .iter()
+        .map(|&lambda| {
+            let case = serde_json::json!({"sharpness": [lambda, 0.5 * lambda + 0.3]});
+            let mut r = CheckRecord::new("sg.product", Value::Null, case, src);
+            let b_axis = [0.3f64.sin(), 0.0, 0.3f64.cos()];
+            match (
+                Sg::new([0.0, 0.0, 1.0], lambda, 1.7),
+                Sg::new(b_axis, 0.5 * lambda + 0.3, 0.6),
+            ) {
+                (Ok(a), Ok(b)) => crate::check::sg::product_check(&mut r, &a, &b, &|a, b| {
+                    mutant::sg_product(a, b, defect)
+                }),
+                (a, b) => {
+                    r.verdict = Verdict::Error {
+                        message: format!("invalid lobes: {:?} {:?}", a.err(), b.err()),
+                    }
+                }
+            }
+            r
+        })
+        .collect()
+}
+
+/// Audits the model of `base` with `defect` by `route` at `seed`: the records.
 fn audit(
-    model: Arc<Mutated>,
+    base: &str,
+    defect: mutant::Defect,
     name: &str,
-    base: &Value,
     route: Route,
     profile: Profile,
     seed: u64,
-) -> Vec<CheckRecord> {
-    match route {
+) -> Result<Vec<CheckRecord>, String> {
+    if route == Route::SgProduct {
+        return Ok(sg_records(defect, profile));
+    }
+    let spec: ModelSpec =
+        serde_json::from_str(base).map_err(|e| format!("mutant {name}: base spec: {e}"))?;
+    let value = serde_json::to_value(&spec).map_err(|e| e.to_string())?;
+    let model = Arc::new(Mutated::new(&spec, defect).map_err(|e| format!("{name}: {e}"))?);
+    Ok(match route {
         Route::Gate { slope_moments } => {
             Audit::of(model.as_ref())
                 .name(name)
-                .hint(hints_of(base))
+                .hint(hints_of(&value))
                 .profile(profile)
                 .seed(seed)
                 .slope_moments(slope_moments)
                 .run()
                 .records
         }
-        Route::VisibleMoments => {
+        Route::VisibleMoments | Route::SgProduct => {
             let model: Arc<dyn Model> = model;
             let plan = crate::check::ds::plan(
                 model,
@@ -249,7 +294,15 @@ fn audit(
             };
             run_plan(&plan, &options).0
         }
-    }
+    })
+}
+
+/// A base spec as JSON (the empty object for the SG mutants).
+fn base_value(base: &str) -> Value {
+    serde_json::from_str::<ModelSpec>(base)
+        .ok()
+        .and_then(|s| serde_json::to_value(s).ok())
+        .unwrap_or_else(|| serde_json::from_str(base).unwrap_or(Value::Null))
 }
 
 fn describe(r: &CheckRecord) -> String {
@@ -288,14 +341,6 @@ pub fn selected(options: &SelftestOptions) -> Vec<&'static Entry> {
         .collect()
 }
 
-/// A spec of the catalog (the catalog's unit test parses them all).
-fn spec_of(entry: &Entry) -> Result<(ModelSpec, Value), String> {
-    let spec: ModelSpec = serde_json::from_str(entry.base)
-        .map_err(|e| format!("mutant {}: base spec: {e}", entry.id))?;
-    let value = serde_json::to_value(&spec).map_err(|e| e.to_string())?;
-    Ok((spec, value))
-}
-
 /// Runs the self-test: the controls, then every selected mutant at every seed.
 pub fn run(options: &SelftestOptions, progress: Option<Progress<'_>>) -> SelftestReport {
     let t = Instant::now();
@@ -305,7 +350,7 @@ pub fn run(options: &SelftestOptions, progress: Option<Progress<'_>>) -> Selftes
             p(&line);
         }
     };
-    // Controls: each (base, route) once per seed.
+    // Controls: each (base, route) once per seed, with the identity defect.
     let mut bases: Vec<(&str, Route)> = Vec::new();
     for e in &entries {
         if !bases.contains(&(e.base, e.route)) {
@@ -314,40 +359,29 @@ pub fn run(options: &SelftestOptions, progress: Option<Progress<'_>>) -> Selftes
     }
     let mut controls = Vec::new();
     for &(base, route) in &bases {
-        let entry = Entry {
-            id: "control",
-            description: "",
-            base,
-            defect: mutant::Defect::DScale { e: 0.0 },
-            expected: &[],
-            route,
-            ci: true,
+        let identity = match route {
+            Route::SgProduct => mutant::Defect::SgProductAmplitude { e: 0.0 },
+            _ => mutant::Defect::DScale { e: 0.0 },
         };
         for &seed in &options.seeds {
-            let (passed, failures, value) = match spec_of(&entry).and_then(|(s, v)| {
-                Mutated::new(&s, entry.defect)
-                    .map(|m| (m, v))
-                    .map_err(|e| e.to_string())
-            }) {
-                Ok((m, value)) => {
-                    let records =
-                        audit(Arc::new(m), "control", &value, route, options.profile, seed);
-                    let failures: Vec<String> = records
-                        .iter()
-                        .filter(|r| r.verdict.is_failure())
-                        .map(describe)
-                        .collect();
-                    (failures.is_empty(), failures, value)
-                }
-                Err(e) => (false, vec![e], Value::String(base.to_string())),
-            };
+            let (passed, failures) =
+                match audit(base, identity, "control", route, options.profile, seed) {
+                    Ok(records) => {
+                        let failures: Vec<String> = records
+                            .iter()
+                            .filter(|r| r.verdict.is_failure())
+                            .map(describe)
+                            .collect();
+                        (failures.is_empty() && !records.is_empty(), failures)
+                    }
+                    Err(e) => (false, vec![e]),
+                };
             say(format!(
-                "control {} seed {seed:#x}: {}",
-                value,
+                "control {base} seed {seed:#x}: {}",
                 if passed { "pass" } else { "FAIL" }
             ));
             controls.push(ControlRun {
-                base: value,
+                base: base_value(base),
                 route,
                 seed,
                 passed,
@@ -357,38 +391,32 @@ pub fn run(options: &SelftestOptions, progress: Option<Progress<'_>>) -> Selftes
     }
     let mut mutants = Vec::new();
     for e in entries {
-        let (runs, value) = match spec_of(e) {
-            Ok((spec, value)) => {
-                let runs = options
-                    .seeds
-                    .iter()
-                    .map(|&seed| {
-                        let t = Instant::now();
-                        let records = match Mutated::new(&spec, e.defect) {
-                            Ok(m) => {
-                                audit(Arc::new(m), e.id, &value, e.route, options.profile, seed)
-                            }
-                            Err(_) => Vec::new(),
-                        };
-                        let run = kill_run(&records, e.expected, seed, t.elapsed().as_secs_f64());
-                        say(format!(
-                            "{} seed {seed:#x}: {} by {:?} ({:.1} s)",
-                            e.id,
-                            if run.killed { "killed" } else { "SURVIVED" },
-                            run.killers,
-                            run.seconds
-                        ));
-                        run
-                    })
-                    .collect();
-                (runs, value)
-            }
-            Err(_) => (Vec::new(), Value::Null),
-        };
+        let runs = options
+            .seeds
+            .iter()
+            .map(|&seed| {
+                let t = Instant::now();
+                let (records, error) =
+                    match audit(e.base, e.defect, e.id, e.route, options.profile, seed) {
+                        Ok(r) => (r, None),
+                        Err(err) => (Vec::new(), Some(err)),
+                    };
+                let run = kill_run(&records, e.expected, seed, t.elapsed().as_secs_f64());
+                say(format!(
+                    "{} seed {seed:#x}: {} by {:?} ({:.1} s){}",
+                    e.id,
+                    if run.killed { "killed" } else { "SURVIVED" },
+                    run.killers,
+                    run.seconds,
+                    error.map(|e| format!(" error: {e}")).unwrap_or_default()
+                ));
+                run
+            })
+            .collect();
         mutants.push(MutantResult {
             id: e.id.to_string(),
             description: e.description.to_string(),
-            base: value,
+            base: base_value(e.base),
             defect: e.defect,
             expected: e.expected.iter().map(|s| s.to_string()).collect(),
             route: e.route,

@@ -9,6 +9,7 @@ use mfh_reference::model::{
     Model, NormalSampler, SlopeDistribution, VisibleMoments, VisibleNormalSampler,
     VisibleSlopeMoments,
 };
+use mfh_reference::sg::Sg;
 use mfh_reference::{Masking, ModelSpec, Ndf, QueryError, Smith, Vec3};
 use serde::Serialize;
 
@@ -106,6 +107,23 @@ pub enum Defect {
         /// The relative error.
         e: f64,
     },
+    /// The SG vector product's amplitude multiplied by 1 + `e` (not a model defect: applied
+    /// by [`sg_product`]).
+    SgProductAmplitude {
+        /// The relative error.
+        e: f64,
+    },
+}
+
+/// The SG vector product G₁ ⊗ G₂ (seed 003 §1) with `defect` applied.
+pub fn sg_product(a: &Sg, b: &Sg, defect: Defect) -> Sg {
+    let p = a.product(b);
+    match defect {
+        Defect::SgProductAmplitude { e } => {
+            Sg::new(p.axis(), p.sharpness(), p.amplitude() * (1.0 + e)).unwrap_or(p)
+        }
+        _ => p,
+    }
 }
 
 /// A reference model with one [`Defect`].
