@@ -163,7 +163,7 @@ pub fn run(args: SelftestArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
         return EXIT_BAD_INPUT;
     }
     let html = args.out.join("report.html");
-    match crate::report::html::render_selftest(&report) {
+    match crate::report::selftest_html::render_selftest(&report) {
         Ok(text) => {
             if let Err(e) = std::fs::write(&html, text) {
                 let _ = writeln!(stderr, "mfh selftest: cannot write {}: {e}", html.display());

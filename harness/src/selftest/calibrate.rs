@@ -104,11 +104,17 @@ impl Calibration {
     }
 }
 
-/// The [`INTERVAL_CONFIDENCE`] interval of Binomial(n, p).
+/// The [`INTERVAL_CONFIDENCE`] interval of Binomial(n, p): the smallest k with
+/// F(k) ≥ 0.005 and the smallest with F(k) ≥ 0.995, F from statrs. (statrs 0.18's default
+/// `inverse_cdf` for discrete distributions panics on an internal unwrap for Binomial; a
+/// linear scan of the CDF is exact and cheap for the n of a calibration.)
 pub fn binomial_interval(n: u64, p: f64) -> [u64; 2] {
     let tail = 0.5 * (1.0 - INTERVAL_CONFIDENCE);
     match Binomial::new(p, n) {
-        Ok(b) => [b.inverse_cdf(tail), b.inverse_cdf(1.0 - tail)],
+        Ok(b) => {
+            let quantile = |q: f64| (0..=n).find(|&k| b.cdf(k) >= q).unwrap_or(n);
+            [quantile(tail), quantile(1.0 - tail)]
+        }
         Err(_) => [0, n],
     }
 }

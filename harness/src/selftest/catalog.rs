@@ -188,7 +188,7 @@ pub const CATALOG: &[Entry] = &[
         GGX,
         Defect::LambdaViaG1,
         LAMBDA,
-        true
+        false
     ),
     entry!(
         "ggx.g2_uncorrelated",
@@ -288,7 +288,7 @@ pub const CATALOG: &[Entry] = &[
         GGX_VIS,
         Defect::LambdaAxesSwapped,
         LAMBDA,
-        true
+        false
     ),
     // GGX with a visible-normal sampler.
     entry!(

@@ -88,8 +88,9 @@ pub fn measure(
             let (full, _) = Audit::of(&m).hint(hints.clone()).profile(profile).plan();
             let k = full.iter().filter(|p| p.statistical).count();
             let alpha = sidak_alpha(STATISTICAL_ALPHA.value, k);
-            let name = format!("{}", std::any::type_name::<Mutated>());
-            let subject = Subject::user(Arc::new(&m), &name, hints);
+            // The name `Audit::of` gives the model by default (it seeds the checks).
+            let name = std::any::type_name::<Mutated>();
+            let subject = Subject::user(Arc::new(&m), name, hints);
             let plan: Vec<_> = sampling::plan(&subject, profile, "power")
                 .into_iter()
                 .filter(|p| p.check == "sampling.chi2" || p.check == "sampling.ks_marginals")
@@ -108,6 +109,7 @@ pub fn measure(
                     .filter(|r| r.verdict.is_failure())
                     .map(|r| r.check.clone())
                     .collect();
+                killers.sort_unstable();
                 killers.dedup();
                 let min_p = records
                     .iter()
