@@ -25,6 +25,7 @@ pub mod record;
 pub mod record_serde;
 pub mod report;
 pub mod scene;
+pub mod selftest;
 pub mod shard;
 pub mod subject;
 pub mod tolerance;

@@ -12,7 +12,7 @@ fn layer(module: &str) -> Option<u32> {
         "check" | "subject" | "scene" | "mitsuba" => 2,
         "plan" | "plan_table" => 3,
         "audit" | "gate" | "external" | "shard" | "merge" | "baseline" | "cost" | "chi2_run"
-        | "readback" => 4,
+        | "readback" | "selftest" => 4,
         "report" | "heatmap" => 5,
         "cli" | "chi2_command" | "eval" | "eval_sg" | "main" | "lib" => 6,
         _ => return None,

@@ -15,6 +15,7 @@ use crate::check::Check;
 use asg::plan_asg;
 use circular::plan_circular;
 use sg::plan_sg;
+pub use sg::product_check;
 
 use super::{compare, compare_exact, covers, Planned, Profile};
 use crate::oracle::quadrature::{frame_about, integrate_cap, Accuracy, Cuts};

@@ -11,6 +11,7 @@ pub mod eval;
 pub mod external;
 pub mod plan;
 pub mod progress;
+pub mod selftest;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::ffi::OsString;
@@ -40,7 +41,7 @@ pub struct Cli {
 pub enum ProfileArg {
     /// One model in CI: the quick grids, 10⁶ chi-square samples, no document-level checks.
     Ci,
-    /// A few cases per property, 2·10⁵ samples per sampler.
+    /// A few cases per property, 2·10⁵ chi-square and 2·10⁶ KS samples per sampler.
     Quick,
     /// More incidence angles and 2·10⁶ samples per sampler.
     Standard,
@@ -115,6 +116,13 @@ pub enum Command {
     ///
     /// Exit status 0 if the test passes, 1 if it fails, 2 on bad input.
     Chi2(chi2::Chi2Args),
+    /// Prove the harness's power and calibration: audit a catalog of mutants (reference
+    /// models with one injected defect each) for several seeds and print the kill matrix, or
+    /// (`--calibrate N`) run seeded chi-square and KS tests of correct samplers.
+    ///
+    /// Exit status 0 if every mutant is killed at every seed by an expected check (and the
+    /// calibration is within its bounds), 1 otherwise, 2 on bad input.
+    Selftest(selftest::SelftestArgs),
 }
 
 /// Runs the command line `args` (including the program name) with the given streams and
@@ -149,6 +157,7 @@ where
         Command::Plan(args) => plan::run(args, stdout, stderr),
         Command::Chi2(args) => chi2::run(args, stdout, stderr),
         Command::Eval(args) => eval::run(args, stdin, stdout, stderr),
+        Command::Selftest(args) => selftest::run(args, stdout, stderr),
     }
 }
 

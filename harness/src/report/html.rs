@@ -24,7 +24,7 @@ pub fn escape(s: &str) -> String {
 
 /// An `<img>` of an SVG as a base64 `data:` URI (so that the page is one file and the browser
 /// reports the image's natural size).
-fn img(svg: &str, alt: &str) -> String {
+pub(crate) fn img(svg: &str, alt: &str) -> String {
     format!(
         "<img alt=\"{}\" src=\"data:image/svg+xml;base64,{}\">",
         escape(alt),
@@ -32,7 +32,8 @@ fn img(svg: &str, alt: &str) -> String {
     )
 }
 
-const STYLE: &str = "body{font-family:sans-serif;max-width:1340px;margin:1em auto;padding:0 1em;\
+pub(crate) const STYLE: &str =
+    "body{font-family:sans-serif;max-width:1340px;margin:1em auto;padding:0 1em;\
 color:#222;line-height:1.4}h1{margin-bottom:.2em}h2{border-bottom:2px solid #ccc;margin-top:1.6em}\
 .verdict{font-size:1.4em;font-weight:bold;padding:.4em .8em;border-radius:6px;display:inline-block}\
 .pass{background:#d8f0dc;color:#145c24}.fail{background:#f8d7da;color:#842029}\
@@ -43,7 +44,7 @@ border:1px solid #ddd;vertical-align:top;max-width:100%}.failure{border-left:4px
 padding-left:.8em;margin:1em 0}.num{text-align:right;font-variant-numeric:tabular-nums}\
 nav a{margin-right:1em}details{margin:.4em 0}.note{color:#555;font-size:.9em}";
 
-fn fmt_num(x: f64) -> String {
+pub(crate) fn fmt_num(x: f64) -> String {
     if x == 0.0 {
         "0".into()
     } else if !x.is_finite() {

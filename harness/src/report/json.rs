@@ -23,3 +23,14 @@ pub fn to_string(report: &AuditReport) -> String {
 pub fn write(report: &AuditReport, path: &Path) -> std::io::Result<()> {
     std::fs::write(path, to_string(report) + "\n")
 }
+
+/// `report.json` of `mfh selftest`: the self-test report (kill matrix, controls, calibration)
+/// under a `selftest` key, beside the schema and mfh versions.
+pub fn selftest_to_string(report: &crate::selftest::SelftestReport) -> String {
+    let doc = serde_json::json!({
+        "schema_version": report.schema_version,
+        "mfh_version": report.mfh_version,
+        "selftest": report,
+    });
+    serde_json::to_string_pretty(&doc).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+}

@@ -7,6 +7,7 @@ pub mod html;
 pub mod json;
 pub mod junit;
 pub mod plot;
+pub mod selftest_html;
 pub mod terminal;
 
 use crate::audit::AuditReport;

@@ -6,6 +6,7 @@ use super::{accuracy, around, axis, compare_claim, compare_worst, cover, error};
 use super::{planned, sharpness_grid, sphere, unit, width, FAMILY};
 use crate::check::{apply_expected, compare, Planned, Profile};
 use crate::oracle::quadrature::integrate_pieces;
+use crate::record::CheckRecord;
 use crate::tolerance::{
     Tolerance, CLAMPED_COSINE_FIT, CLOSED_FORM, NUMERICAL_ROUTE, SG_IDENTITY, SG_WARP_AREA,
 };
@@ -25,6 +26,21 @@ const SRC_SUPPORT: &str = "seed 003 §1: ∫_{G ≥ ε} dv = −2π ln ε / λ (
 const SRC_CLAMPED: &str = "seed 003 §2.4: max(v·n, 0) ≈ G(v; n, 2.133, 1.170), no error stated";
 const SRC_WARP: &str =
     "seed 003 §2.1: p_W = 2(o·p)p − o, λ_W = λ/(4|p·o|), μ_W = μ (f_a(λ_W) ≈ area of ψ(A))";
+
+/// The `sg.product` comparison for one pair of lobes: `product(a, b)` evaluated at points
+/// around its axis against a(v)·b(v). Takes the product as a function so that `mfh selftest`
+/// can pass a mutant through the same check.
+pub fn product_check(r: &mut CheckRecord, a: &Sg, b: &Sg, product: &dyn Fn(&Sg, &Sg) -> Sg) {
+    let m = product(a, b);
+    let pairs: Vec<(f64, f64)> = [(0.0, 0.0), (1.0, 0.3), (2.0, 2.0), (0.5, 4.0)]
+        .iter()
+        .map(|&(k, phi)| {
+            let v = around(m.axis(), (k * width(m.sharpness())).min(PI), phi);
+            (m.eval(v), a.eval(v) * b.eval(v))
+        })
+        .collect();
+    compare_worst(r, &pairs, &SG_IDENTITY);
+}
 
 pub(super) fn plan_sg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
     let p = axis();
@@ -119,17 +135,7 @@ pub(super) fn plan_sg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
             &format!("{why}: SG vector product"),
             vec![cover("sg_product", "default")],
             SRC_PRODUCT,
-            move |r| {
-                let m = a.product(&b);
-                let pairs: Vec<(f64, f64)> = [(0.0, 0.0), (1.0, 0.3), (2.0, 2.0), (0.5, 4.0)]
-                    .iter()
-                    .map(|&(k, phi)| {
-                        let v = around(m.axis(), (k * width(m.sharpness())).min(PI), phi);
-                        (m.eval(v), a.eval(v) * b.eval(v))
-                    })
-                    .collect();
-                compare_worst(r, &pairs, &SG_IDENTITY);
-            },
+            move |r| product_check(r, &a, &b, &|a, b| a.product(b)),
         ));
         // The cap integral, every route, at two caps.
         for theta_d in [0.4, 2.0] {
