@@ -436,50 +436,121 @@ fn cost_section(cost: Option<&str>) -> String {
                 h.push_str("<p class=note>cost.json lists no quantities.</p>\n");
             }
             for q in quantities {
-                let name = q.get("name").and_then(Value::as_str).unwrap_or("?");
-                let routes: Vec<(String, f64, f64)> = q
-                    .get("routes")
-                    .and_then(Value::as_array)
-                    .map(|rs| {
-                        rs.iter()
-                            .map(|r| {
-                                (
-                                    r.get("route")
-                                        .and_then(Value::as_str)
-                                        .unwrap_or("?")
-                                        .to_string(),
-                                    r.get("seconds_per_eval")
-                                        .and_then(Value::as_f64)
-                                        .unwrap_or(f64::NAN),
-                                    r.get("max_error")
-                                        .and_then(Value::as_f64)
-                                        .unwrap_or(f64::NAN),
-                                )
-                            })
-                            .collect()
-                    })
-                    .unwrap_or_default();
-                let _ = writeln!(h, "<h3>{}</h3><div class=plots>", escape(name));
-                h.push_str(&img(&super::plot::pareto_svg(name, &routes), name));
-                h.push_str("</div><table><tr><th>route</th><th>seconds per evaluation</th><th>max error</th><th>on the frontier</th></tr>");
-                let pts: Vec<(f64, f64)> = routes.iter().map(|r| (r.1, r.2)).collect();
-                let front = super::plot::pareto_frontier(&pts);
-                for (i, (route, t, e)) in routes.iter().enumerate() {
-                    let _ = write!(
-                        h,
-                        "<tr><td>{}</td><td class=num>{}</td><td class=num>{}</td><td>{}</td></tr>",
-                        escape(route),
-                        fmt_num(*t),
-                        fmt_num(*e),
-                        if front.contains(&i) { "yes" } else { "" }
-                    );
-                }
-                h.push_str("</table>\n");
+                h.push_str(&cost_quantity(&q));
             }
         }
     }
     h.push_str("<!-- END accuracy-versus-time -->\n");
     h
+}
+
+/// One quantity of `cost.json`: its Pareto plot (routes with a time and a finite error) and a
+/// table of every route (refused ones with their reason).
+fn cost_quantity(q: &Value) -> String {
+    let text = |v: &Value, k: &str| v.get(k).and_then(Value::as_str).unwrap_or("").to_string();
+    let num = |v: &Value, k: &str| v.get(k).and_then(Value::as_f64);
+    let name = q.get("name").and_then(Value::as_str).unwrap_or("?");
+    let routes = q
+        .get("routes")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    let frontier: Vec<String> = q
+        .get("frontier")
+        .and_then(Value::as_array)
+        .map(|f| {
+            f.iter()
+                .filter_map(|r| r.as_str().map(String::from))
+                .collect()
+        })
+        .unwrap_or_default();
+    let points: Vec<(String, f64, f64)> = routes
+        .iter()
+        .filter_map(|r| {
+            Some((
+                text(r, "route"),
+                num(r, "seconds_per_eval")?,
+                num(r, "max_error")?,
+            ))
+        })
+        .collect();
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<h3>{}</h3><p class=note>reference: {} · error: {} · inputs: {}</p>",
+        escape(name),
+        escape(&text(q, "reference")),
+        escape(&text(q, "error")),
+        escape(&text(q, "inputs"))
+    );
+    if points.is_empty() {
+        h.push_str("<p class=note>No timed route with a finite error: no plot.</p>");
+    } else {
+        let _ = write!(
+            h,
+            "<div class=plots>{}</div>",
+            img(&super::plot::pareto_svg(name, &points), name)
+        );
+    }
+    h.push_str(
+        "<table><tr><th>route</th><th>max error</th><th>seconds per evaluation (median)</th>\
+         <th>spread (fastest – slowest batch)</th><th>frontier</th><th>note</th></tr>",
+    );
+    for r in &routes {
+        let route = text(r, "route");
+        let error = if text(r, "status") == "refused" {
+            "refused".to_string()
+        } else if r.get("non_finite").and_then(Value::as_u64).unwrap_or(0) > 0 {
+            "non-finite".to_string()
+        } else {
+            num(r, "max_error")
+                .map(fmt_num)
+                .unwrap_or_else(|| "—".into())
+        };
+        let spread = r
+            .get("timing")
+            .map(|t| {
+                format!(
+                    "{} – {}",
+                    num(t, "min").map(fmt_num).unwrap_or_default(),
+                    num(t, "max").map(fmt_num).unwrap_or_default()
+                )
+            })
+            .unwrap_or_default();
+        let note = [text(r, "reason"), text(r, "note")]
+            .into_iter()
+            .filter(|s| !s.is_empty())
+            .collect::<Vec<_>>()
+            .join("; ");
+        let _ = write!(
+            h,
+            "<tr><td>{}</td><td class=num>{}</td><td class=num>{}</td><td class=num>{}</td>\
+             <td>{}</td><td>{}</td></tr>",
+            escape(&route),
+            escape(&error),
+            num(r, "seconds_per_eval")
+                .map(fmt_num)
+                .unwrap_or_else(|| "—".into()),
+            escape(&spread),
+            if frontier.contains(&route) { "yes" } else { "" },
+            escape(&note)
+        );
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+/// `cost.html`: the accuracy-versus-time section of the report as a page of its own (what
+/// `mfh cost --out DIR` writes beside cost.json).
+pub fn cost_page(cost_json: &str) -> String {
+    format!(
+        "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8><title>mfh cost</title>\
+         <style>{STYLE}</style></head><body>\n<h1>mfh cost — what accuracy costs in time</h1>\n\
+         <p class=note>Timings are medians of repeated batches on the machine and load of this \
+         run; errors are against independent high-precision references (deterministic).</p>\n\
+         {}</body></html>\n",
+        cost_section(Some(cost_json))
+    )
 }
 
 fn errata_section(records: &[CheckRecord]) -> String {

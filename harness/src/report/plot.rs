@@ -485,22 +485,9 @@ pub fn heat_map_svg(map: &HeatMap<'_>) -> Result<String, PlotError> {
     Ok(svg)
 }
 
-/// The indices of the Pareto frontier of (time, error) points: those no other point beats in
-/// both (≤ in both and < in one), sorted by time. Points with a non-finite or negative
-/// coordinate are never on it.
+/// The indices of the Pareto frontier of (time, error) points ([`crate::cost::frontier`]).
 pub fn pareto_frontier(points: &[(f64, f64)]) -> Vec<usize> {
-    let ok = |p: &(f64, f64)| p.0.is_finite() && p.1.is_finite() && p.0 >= 0.0 && p.1 >= 0.0;
-    let mut front: Vec<usize> = (0..points.len())
-        .filter(|&i| ok(&points[i]))
-        .filter(|&i| {
-            let (t, e) = points[i];
-            !points
-                .iter()
-                .any(|q| ok(q) && q.0 <= t && q.1 <= e && (q.0 < t || q.1 < e))
-        })
-        .collect();
-    front.sort_by(|&a, &b| points[a].0.total_cmp(&points[b].0));
-    front
+    crate::cost::frontier::pareto_frontier(points)
 }
 
 /// Accuracy against time: every route a point (time per evaluation on x, max error on y, both
