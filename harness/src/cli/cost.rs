@@ -70,6 +70,16 @@ pub fn run(args: CostArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
             return EXIT_BAD_INPUT;
         }
     }
+    // The output folder is created before the (minutes-long) measurement, so that an
+    // unwritable --out is reported at once.
+    if let Err(e) = std::fs::create_dir_all(&args.out) {
+        let _ = writeln!(
+            stderr,
+            "mfh cost: cannot create the output folder {}: {e}",
+            args.out.display()
+        );
+        return EXIT_BAD_INPUT;
+    }
     let options = CostOptions {
         quick: args.quick,
         timed: !args.no_time,
