@@ -376,6 +376,16 @@ fn limit_plot(r: &CheckRecord) -> Result<Option<String>, PlotError> {
     Ok(Some(img(&line_svg(&plot)?, &plot.title)))
 }
 
+/// Whether a record with data gets its plots under its material: an expected failure always,
+/// a failure never (its plots are in the failures section above), a passing record when it is
+/// the first of its check family (`plotted` remembers the families drawn).
+fn plot_policy(r: &CheckRecord, plotted: &mut std::collections::BTreeSet<String>) -> bool {
+    if r.verdict.is_failure() {
+        return false;
+    }
+    matches!(r.verdict, Verdict::ExpectedFailure { .. }) || plotted.insert(r.check.clone())
+}
+
 /// The checks that have their own section (not under the materials).
 fn own_section(check: &str) -> bool {
     ["errata.", "claims.", "limits.", "stability."]
@@ -709,6 +719,8 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
         h.push_str("</div>\n");
     }
     h.push_str("<h2 id=materials>Materials</h2>\n");
+    // Check families whose passing plot has been drawn (one each keeps the page small).
+    let mut plotted: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
     for (i, (_, records)) in materials.iter().enumerate() {
         let name = model_name(&records[0].model);
         let bad = records.iter().filter(|r| r.verdict.is_failure()).count();
@@ -720,14 +732,36 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
             bad
         );
         let mut plots = String::new();
-        if let Some(p) = smith_plots(records, &name)? {
-            plots.push_str(&p);
+        let mut left_out = 0usize;
+        let smith_shown = records.iter().any(|r| {
+            r.check == "smith.lambda_route"
+                && (r.verdict.is_failure() || matches!(r.verdict, Verdict::ExpectedFailure { .. }))
+        }) || (records.iter().any(|r| r.check == "smith.lambda_route")
+            && plotted.insert("smith.lambda_route".to_string()));
+        if smith_shown {
+            if let Some(p) = smith_plots(records, &name)? {
+                plots.push_str(&p);
+            }
+        } else if records.iter().any(|r| r.check == "smith.lambda_route") {
+            left_out += 2;
         }
         for r in records.iter().filter(|r| r.data.is_some()) {
-            plots.push_str(&data_plots(r)?);
+            if plot_policy(r, &mut plotted) {
+                plots.push_str(&data_plots(r)?);
+            } else if !r.verdict.is_failure() {
+                left_out += 1;
+            }
         }
         if !plots.is_empty() {
             let _ = writeln!(h, "<div class=plots>{plots}</div>");
+        }
+        if left_out > 0 {
+            let _ = writeln!(
+                h,
+                "<p class=note>{left_out} plot(s) of passing checks left out (one per check \
+                 family is drawn in this report, failures and expected failures always): their \
+                 measured errors are in the table below, their data in chi2/ and ks/.</p>"
+            );
         }
         let _ = writeln!(
             h,
