@@ -208,11 +208,23 @@ fn case_f64(r: &CheckRecord, key: &str) -> Option<f64> {
 /// Λ of the model against the oracle over θ (one series per route and φ), with the relative
 /// error on a log axis below; then G1 = 1/(1 + Λ) (seed 001 eq 16) of the same records,
 /// likewise. None when the material has no `smith.lambda_route` records.
-fn smith_plots(records: &[&CheckRecord], material: &str) -> Result<Option<String>, PlotError> {
+///
+/// `routes`: only these routes (a material drawn for its expected failures shows the routes
+/// that fail, not the passing ones, which the first material of the report already shows).
+fn smith_plots(
+    records: &[&CheckRecord],
+    material: &str,
+    routes: Option<&std::collections::BTreeSet<String>>,
+) -> Result<Option<String>, PlotError> {
     // series key → (θ, value, oracle)
     let mut series: BTreeMap<String, Vec<(f64, f64, f64)>> = BTreeMap::new();
     let mut tolerance: Option<(f64, &str)> = None;
-    for r in records.iter().filter(|r| r.check == "smith.lambda_route") {
+    for r in records.iter().filter(|r| {
+        r.check == "smith.lambda_route"
+            && routes.is_none_or(|set| {
+                set.contains(r.case.get("route").and_then(Value::as_str).unwrap_or("?"))
+            })
+    }) {
         let (Some(theta), Some(phi), Some(v), Some(o)) =
             (case_f64(r, "theta"), case_f64(r, "phi"), r.value, r.oracle)
         else {
@@ -246,10 +258,14 @@ fn smith_plots(records: &[&CheckRecord], material: &str) -> Result<Option<String
         let mut oracles: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
         let mut errors: Vec<Series> = Vec::new();
         for (key, points) in &series {
-            values.push(Series::new(
-                key.clone(),
-                points.iter().map(|&(t, v, _)| (t, f(v))).collect(),
-            ));
+            // Lines only: the routes' values coincide with the oracle's at plot scale (the
+            // error panel below has the markers); a marker per point doubled the page.
+            values.push(Series {
+                label: key.clone(),
+                points: points.iter().map(|&(t, v, _)| (t, f(v))).collect(),
+                markers: false,
+                line: true,
+            });
             let okey = key
                 .split_once(", ")
                 .map(|(_, phi)| format!("oracle, {phi}"))
@@ -733,16 +749,31 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
         );
         let mut plots = String::new();
         let mut left_out = 0usize;
-        let smith_shown = records.iter().any(|r| {
-            r.check == "smith.lambda_route"
-                && (r.verdict.is_failure() || matches!(r.verdict, Verdict::ExpectedFailure { .. }))
-        }) || (records.iter().any(|r| r.check == "smith.lambda_route")
-            && plotted.insert("smith.lambda_route".to_string()));
-        if smith_shown {
-            if let Some(p) = smith_plots(records, &name)? {
+        let has_smith = records.iter().any(|r| r.check == "smith.lambda_route");
+        let failing_routes: std::collections::BTreeSet<String> = records
+            .iter()
+            .filter(|r| {
+                r.check == "smith.lambda_route"
+                    && (r.verdict.is_failure()
+                        || matches!(r.verdict, Verdict::ExpectedFailure { .. }))
+            })
+            .map(|r| {
+                r.case
+                    .get("route")
+                    .and_then(Value::as_str)
+                    .unwrap_or("?")
+                    .to_string()
+            })
+            .collect();
+        if has_smith && plotted.insert("smith.lambda_route".to_string()) {
+            if let Some(p) = smith_plots(records, &name, None)? {
                 plots.push_str(&p);
             }
-        } else if records.iter().any(|r| r.check == "smith.lambda_route") {
+        } else if !failing_routes.is_empty() {
+            if let Some(p) = smith_plots(records, &name, Some(&failing_routes))? {
+                plots.push_str(&p);
+            }
+        } else if has_smith {
             left_out += 2;
         }
         for r in records.iter().filter(|r| r.data.is_some()) {
