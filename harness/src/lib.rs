@@ -9,6 +9,7 @@ pub mod baseline;
 pub mod check;
 pub mod chi2_run;
 pub mod cli;
+pub mod cost;
 pub mod eval;
 pub mod eval_sg;
 pub mod external;

@@ -167,6 +167,25 @@ fn the_audit_writes_a_report_html_that_chromium_renders() {
     ] {
         assert!(html.contains(section), "report.html lacks {section:?}");
     }
+    // A size a browser opens at once (issue 14: report.html of the default scene's quick audit
+    // was 19 MB; plots now only for failures, expected failures and one per check family,
+    // decimated paths, heat maps as embedded bitmaps): the bound 3 MB, and no image over
+    // 200 kB of data URI.
+    assert!(
+        html.len() < 3_000_000,
+        "report.html is {} bytes, over the 3 MB bound",
+        html.len()
+    );
+    let largest_image = html
+        .split("src=\"data:")
+        .skip(1)
+        .map(|rest| rest.find('"').unwrap_or(rest.len()))
+        .max()
+        .unwrap_or(0);
+    assert!(
+        largest_image < 200_000,
+        "an embedded image of {largest_image} bytes"
+    );
     let images = html.matches("<img ").count();
     // Per material Λ and G1 (2 + 2); GGX: 3 chi-square maps and 2 KS plots; 2 limits (D and
     // Λ); 1 Pareto plot; and Λ and G1 of each of the six stressed shapes the STD material's

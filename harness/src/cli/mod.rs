@@ -7,6 +7,7 @@
 
 pub mod audit;
 pub mod chi2;
+pub mod cost;
 pub mod eval;
 pub mod external;
 pub mod plan;
@@ -123,6 +124,12 @@ pub enum Command {
     /// Exit status 0 if every mutant is killed at every seed by an expected check (and the
     /// calibration is within its bounds), 1 otherwise, 2 on bad input.
     Selftest(selftest::SelftestArgs),
+    /// What accuracy costs in time: every route of every quantity with more than one route
+    /// (and the oracles' knobs), its max error against a high-precision reference and its time
+    /// per evaluation; cost.json, Pareto plots, cost.html and a terminal table.
+    ///
+    /// Exit status 0, or 2 on bad input or an output that cannot be written.
+    Cost(cost::CostArgs),
 }
 
 /// Runs the command line `args` (including the program name) with the given streams and
@@ -156,6 +163,7 @@ where
         Command::Merge(args) => audit::run_merge(args, stdout, stderr),
         Command::Plan(args) => plan::run(args, stdout, stderr),
         Command::Chi2(args) => chi2::run(args, stdout, stderr),
+        Command::Cost(args) => cost::run(args, stdout, stderr),
         Command::Eval(args) => eval::run(args, stdin, stdout, stderr),
         Command::Selftest(args) => selftest::run(args, stdout, stderr),
     }

@@ -480,6 +480,28 @@ pub fn student_norm(c: f64) -> Result<Certified, PreciseError> {
     Certified::checked(value, relative, q.evaluations)
 }
 
+/// Λ of the standardized Student slope distribution at the f64 argument x = μ/s > 0 (the
+/// argument every f64 route of `student_lambda` takes), C ∈ (3/2, 1e8]: the reference of
+/// `mfh cost`, which compares the routes at the same x so that the rounding of x is no one's
+/// error.
+pub fn student_lambda_standardized(c: f64, x: f64) -> Result<Certified, PreciseError> {
+    if !(c > 1.5 && c <= 1e8) {
+        return Err(PreciseError::Parameter {
+            name: "C",
+            value: c,
+            requirement: "> 3/2 and ≤ 1e8",
+        });
+    }
+    if !(x > 0.0 && x.is_finite()) {
+        return Err(PreciseError::Parameter {
+            name: "x",
+            value: x,
+            requirement: "finite and > 0",
+        });
+    }
+    student_lambda(c, DoubleDouble::from(x))
+}
+
 /// Λ of the standardized Student slope distribution at x = μ/s > 0, C > 3/2 (module docs).
 fn student_lambda(c: f64, x: DoubleDouble) -> Result<Certified, PreciseError> {
     let norm = student_norm(c)?;

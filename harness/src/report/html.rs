@@ -209,11 +209,23 @@ fn case_f64(r: &CheckRecord, key: &str) -> Option<f64> {
 /// Λ of the model against the oracle over θ (one series per route and φ), with the relative
 /// error on a log axis below; then G1 = 1/(1 + Λ) (seed 001 eq 16) of the same records,
 /// likewise. None when the material has no `smith.lambda_route` records.
-fn smith_plots(records: &[&CheckRecord], material: &str) -> Result<Option<String>, PlotError> {
+///
+/// `routes`: only these routes (a material drawn for its expected failures shows the routes
+/// that fail, not the passing ones, which the first material of the report already shows).
+fn smith_plots(
+    records: &[&CheckRecord],
+    material: &str,
+    routes: Option<&std::collections::BTreeSet<String>>,
+) -> Result<Option<String>, PlotError> {
     // series key → (θ, value, oracle)
     let mut series: BTreeMap<String, Vec<(f64, f64, f64)>> = BTreeMap::new();
     let mut tolerance: Option<(f64, &str)> = None;
-    for r in records.iter().filter(|r| r.check == "smith.lambda_route") {
+    for r in records.iter().filter(|r| {
+        r.check == "smith.lambda_route"
+            && routes.is_none_or(|set| {
+                set.contains(r.case.get("route").and_then(Value::as_str).unwrap_or("?"))
+            })
+    }) {
         let (Some(theta), Some(phi), Some(v), Some(o)) =
             (case_f64(r, "theta"), case_f64(r, "phi"), r.value, r.oracle)
         else {
@@ -247,10 +259,14 @@ fn smith_plots(records: &[&CheckRecord], material: &str) -> Result<Option<String
         let mut oracles: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
         let mut errors: Vec<Series> = Vec::new();
         for (key, points) in &series {
-            values.push(Series::new(
-                key.clone(),
-                points.iter().map(|&(t, v, _)| (t, f(v))).collect(),
-            ));
+            // Lines only: the routes' values coincide with the oracle's at plot scale (the
+            // error panel below has the markers); a marker per point doubled the page.
+            values.push(Series {
+                label: key.clone(),
+                points: points.iter().map(|&(t, v, _)| (t, f(v))).collect(),
+                markers: false,
+                line: true,
+            });
             let okey = key
                 .split_once(", ")
                 .map(|(_, phi)| format!("oracle, {phi}"))
@@ -377,6 +393,16 @@ fn limit_plot(r: &CheckRecord) -> Result<Option<String>, PlotError> {
     Ok(Some(img(&line_svg(&plot)?, &plot.title)))
 }
 
+/// Whether a record with data gets its plots under its material: an expected failure always,
+/// a failure never (its plots are in the failures section above), a passing record when it is
+/// the first of its check family (`plotted` remembers the families drawn).
+fn plot_policy(r: &CheckRecord, plotted: &mut std::collections::BTreeSet<String>) -> bool {
+    if r.verdict.is_failure() {
+        return false;
+    }
+    matches!(r.verdict, Verdict::ExpectedFailure { .. }) || plotted.insert(r.check.clone())
+}
+
 /// The checks that have their own section (not under the materials).
 fn own_section(check: &str) -> bool {
     ["errata.", "claims.", "limits.", "stability."]
@@ -437,50 +463,121 @@ fn cost_section(cost: Option<&str>) -> String {
                 h.push_str("<p class=note>cost.json lists no quantities.</p>\n");
             }
             for q in quantities {
-                let name = q.get("name").and_then(Value::as_str).unwrap_or("?");
-                let routes: Vec<(String, f64, f64)> = q
-                    .get("routes")
-                    .and_then(Value::as_array)
-                    .map(|rs| {
-                        rs.iter()
-                            .map(|r| {
-                                (
-                                    r.get("route")
-                                        .and_then(Value::as_str)
-                                        .unwrap_or("?")
-                                        .to_string(),
-                                    r.get("seconds_per_eval")
-                                        .and_then(Value::as_f64)
-                                        .unwrap_or(f64::NAN),
-                                    r.get("max_error")
-                                        .and_then(Value::as_f64)
-                                        .unwrap_or(f64::NAN),
-                                )
-                            })
-                            .collect()
-                    })
-                    .unwrap_or_default();
-                let _ = writeln!(h, "<h3>{}</h3><div class=plots>", escape(name));
-                h.push_str(&img(&super::plot::pareto_svg(name, &routes), name));
-                h.push_str("</div><table><tr><th>route</th><th>seconds per evaluation</th><th>max error</th><th>on the frontier</th></tr>");
-                let pts: Vec<(f64, f64)> = routes.iter().map(|r| (r.1, r.2)).collect();
-                let front = super::plot::pareto_frontier(&pts);
-                for (i, (route, t, e)) in routes.iter().enumerate() {
-                    let _ = write!(
-                        h,
-                        "<tr><td>{}</td><td class=num>{}</td><td class=num>{}</td><td>{}</td></tr>",
-                        escape(route),
-                        fmt_num(*t),
-                        fmt_num(*e),
-                        if front.contains(&i) { "yes" } else { "" }
-                    );
-                }
-                h.push_str("</table>\n");
+                h.push_str(&cost_quantity(&q));
             }
         }
     }
     h.push_str("<!-- END accuracy-versus-time -->\n");
     h
+}
+
+/// One quantity of `cost.json`: its Pareto plot (routes with a time and a finite error) and a
+/// table of every route (refused ones with their reason).
+fn cost_quantity(q: &Value) -> String {
+    let text = |v: &Value, k: &str| v.get(k).and_then(Value::as_str).unwrap_or("").to_string();
+    let num = |v: &Value, k: &str| v.get(k).and_then(Value::as_f64);
+    let name = q.get("name").and_then(Value::as_str).unwrap_or("?");
+    let routes = q
+        .get("routes")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    let frontier: Vec<String> = q
+        .get("frontier")
+        .and_then(Value::as_array)
+        .map(|f| {
+            f.iter()
+                .filter_map(|r| r.as_str().map(String::from))
+                .collect()
+        })
+        .unwrap_or_default();
+    let points: Vec<(String, f64, f64)> = routes
+        .iter()
+        .filter_map(|r| {
+            Some((
+                text(r, "route"),
+                num(r, "seconds_per_eval")?,
+                num(r, "max_error")?,
+            ))
+        })
+        .collect();
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<h3>{}</h3><p class=note>reference: {} · error: {} · inputs: {}</p>",
+        escape(name),
+        escape(&text(q, "reference")),
+        escape(&text(q, "error")),
+        escape(&text(q, "inputs"))
+    );
+    if points.is_empty() {
+        h.push_str("<p class=note>No timed route with a finite error: no plot.</p>");
+    } else {
+        let _ = write!(
+            h,
+            "<div class=plots>{}</div>",
+            img(&super::plot::pareto_svg(name, &points), name)
+        );
+    }
+    h.push_str(
+        "<table><tr><th>route</th><th>max error</th><th>seconds per evaluation (median)</th>\
+         <th>spread (fastest – slowest batch)</th><th>frontier</th><th>note</th></tr>",
+    );
+    for r in &routes {
+        let route = text(r, "route");
+        let error = if text(r, "status") == "refused" {
+            "refused".to_string()
+        } else if r.get("non_finite").and_then(Value::as_u64).unwrap_or(0) > 0 {
+            "non-finite".to_string()
+        } else {
+            num(r, "max_error")
+                .map(fmt_num)
+                .unwrap_or_else(|| "—".into())
+        };
+        let spread = r
+            .get("timing")
+            .map(|t| {
+                format!(
+                    "{} – {}",
+                    num(t, "min").map(fmt_num).unwrap_or_default(),
+                    num(t, "max").map(fmt_num).unwrap_or_default()
+                )
+            })
+            .unwrap_or_default();
+        let note = [text(r, "reason"), text(r, "note")]
+            .into_iter()
+            .filter(|s| !s.is_empty())
+            .collect::<Vec<_>>()
+            .join("; ");
+        let _ = write!(
+            h,
+            "<tr><td>{}</td><td class=num>{}</td><td class=num>{}</td><td class=num>{}</td>\
+             <td>{}</td><td>{}</td></tr>",
+            escape(&route),
+            escape(&error),
+            num(r, "seconds_per_eval")
+                .map(fmt_num)
+                .unwrap_or_else(|| "—".into()),
+            escape(&spread),
+            if frontier.contains(&route) { "yes" } else { "" },
+            escape(&note)
+        );
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+/// `cost.html`: the accuracy-versus-time section of the report as a page of its own (what
+/// `mfh cost --out DIR` writes beside cost.json).
+pub fn cost_page(cost_json: &str) -> String {
+    format!(
+        "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8><title>mfh cost</title>\
+         <style>{STYLE}</style></head><body>\n<h1>mfh cost — what accuracy costs in time</h1>\n\
+         <p class=note>Timings are medians of repeated batches on the machine and load of this \
+         run; errors are against independent high-precision references (deterministic).</p>\n\
+         {}</body></html>\n",
+        cost_section(Some(cost_json))
+    )
 }
 
 fn errata_section(records: &[CheckRecord]) -> String {
@@ -639,6 +736,8 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
         h.push_str("</div>\n");
     }
     h.push_str("<h2 id=materials>Materials</h2>\n");
+    // Check families whose passing plot has been drawn (one each keeps the page small).
+    let mut plotted: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
     for (i, (_, records)) in materials.iter().enumerate() {
         let name = model_name(&records[0].model);
         let bad = records.iter().filter(|r| r.verdict.is_failure()).count();
@@ -650,14 +749,51 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
             bad
         );
         let mut plots = String::new();
-        if let Some(p) = smith_plots(records, &name)? {
-            plots.push_str(&p);
+        let mut left_out = 0usize;
+        let has_smith = records.iter().any(|r| r.check == "smith.lambda_route");
+        let failing_routes: std::collections::BTreeSet<String> = records
+            .iter()
+            .filter(|r| {
+                r.check == "smith.lambda_route"
+                    && (r.verdict.is_failure()
+                        || matches!(r.verdict, Verdict::ExpectedFailure { .. }))
+            })
+            .map(|r| {
+                r.case
+                    .get("route")
+                    .and_then(Value::as_str)
+                    .unwrap_or("?")
+                    .to_string()
+            })
+            .collect();
+        if has_smith && plotted.insert("smith.lambda_route".to_string()) {
+            if let Some(p) = smith_plots(records, &name, None)? {
+                plots.push_str(&p);
+            }
+        } else if !failing_routes.is_empty() {
+            if let Some(p) = smith_plots(records, &name, Some(&failing_routes))? {
+                plots.push_str(&p);
+            }
+        } else if has_smith {
+            left_out += 2;
         }
         for r in records.iter().filter(|r| r.data.is_some()) {
-            plots.push_str(&data_plots(r)?);
+            if plot_policy(r, &mut plotted) {
+                plots.push_str(&data_plots(r)?);
+            } else if !r.verdict.is_failure() {
+                left_out += 1;
+            }
         }
         if !plots.is_empty() {
             let _ = writeln!(h, "<div class=plots>{plots}</div>");
+        }
+        if left_out > 0 {
+            let _ = writeln!(
+                h,
+                "<p class=note>{left_out} plot(s) of passing checks left out (one per check \
+                 family is drawn in this report, failures and expected failures always): their \
+                 measured errors are in the table below, their data in chi2/ and ks/.</p>"
+            );
         }
         let _ = writeln!(
             h,

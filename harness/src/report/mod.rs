@@ -3,6 +3,7 @@
 //! self-contained `report.html`. Checks do no I/O: everything written is written here.
 
 pub mod artefacts;
+pub mod cost;
 pub mod html;
 pub mod json;
 pub mod junit;

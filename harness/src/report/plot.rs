@@ -8,6 +8,7 @@
 //! coordinate type for every plot, and non-positive or non-finite values are left out (and
 //! counted in the caption) instead of breaking the scale.
 
+use base64::Engine as _;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::fmt::Write as _;
@@ -165,6 +166,35 @@ fn tick_label(v: f64, log: bool) -> String {
     }
 }
 
+/// The most points a series is drawn with: a 640-pixel-wide plot cannot show more, and every
+/// point is a path vertex (or a marker) in the SVG.
+pub const MAX_DRAWN_POINTS: usize = 320;
+
+/// At most [`MAX_DRAWN_POINTS`] of a series' points, evenly by index, the first and the last
+/// kept, and the point of largest y of each stride (so that a spike, e.g. the largest error,
+/// is never decimated away).
+pub fn decimate(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    if points.len() <= MAX_DRAWN_POINTS {
+        return points.to_vec();
+    }
+    let stride = points.len().div_ceil(MAX_DRAWN_POINTS - 1);
+    let mut out: Vec<(f64, f64)> = points
+        .chunks(stride)
+        .map(|c| {
+            *c.iter()
+                .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+                .expect("chunks are non-empty")
+        })
+        .collect();
+    if out.first() != points.first() {
+        out.insert(0, points[0]);
+    }
+    if out.last() != points.last() {
+        out.push(points[points.len() - 1]);
+    }
+    out
+}
+
 /// Draws a line plot into an area.
 fn draw_lines(area: &DrawingArea<SVGBackend<'_>, Shift>, plot: &LinePlot) -> Result<(), PlotError> {
     let err = plot_error(&plot.title);
@@ -173,9 +203,9 @@ fn draw_lines(area: &DrawingArea<SVGBackend<'_>, Shift>, plot: &LinePlot) -> Res
         .series
         .iter()
         .map(|s| {
-            s.points
-                .iter()
-                .filter_map(|&(x, y)| {
+            decimate(&s.points)
+                .into_iter()
+                .filter_map(|(x, y)| {
                     let p = axis_value(x, plot.x_log).zip(axis_value(y, plot.y_log));
                     if p.is_none() {
                         dropped += 1;
@@ -410,6 +440,7 @@ pub fn heat_map_svg(map: &HeatMap<'_>) -> Result<String, PlotError> {
         });
     }
     let mut svg = String::new();
+    let cells_image: Option<String>;
     {
         let root = SVGBackend::with_string(&mut svg, (WIDTH, HEAT_MAP_HEIGHT)).into_drawing_area();
         root.fill(&WHITE).map_err(&err)?;
@@ -431,20 +462,18 @@ pub fn heat_map_svg(map: &HeatMap<'_>) -> Result<String, PlotError> {
             .label_style(("sans-serif", 12))
             .draw()
             .map_err(&err)?;
-        let (rows, columns) = (map.rows as f64, map.columns as f64);
-        let theta = |c: f64| c.clamp(0.0, 1.0).acos().to_degrees();
-        chart
-            .draw_series(map.values.iter().enumerate().map(|(k, &v)| {
-                let (i, j) = ((k / map.columns) as f64, (k % map.columns) as f64);
-                Rectangle::new(
-                    [
-                        (360.0 * j / columns, theta(i / rows)),
-                        (360.0 * (j + 1.0) / columns, theta((i + 1.0) / rows)),
-                    ],
-                    colour(v, map.scale).filled(),
-                )
-            }))
-            .map_err(&err)?;
+        // The cells as one embedded bitmap stretched over the plotting area (one `<rect>` per
+        // cell made a 32-row map ~250 kB): placed after drawing, under the axes' labels.
+        let (x0, y0) = chart.backend_coord(&(0.0, 0.0));
+        let (x1, y1) = chart.backend_coord(&(360.0, 90.0));
+        cells_image = Some(format!(
+            "<image x=\"{x0}\" y=\"{y0}\" width=\"{}\" height=\"{}\" \
+             preserveAspectRatio=\"none\" style=\"image-rendering:pixelated\" \
+             href=\"data:image/bmp;base64,{}\"/>",
+            x1 - x0,
+            y1 - y0,
+            base64::engine::general_purpose::STANDARD.encode(cells_bitmap(map))
+        ));
         let (lo, hi) = match map.scale {
             ColourScale::Sequential { min, max } => (min, if max > min { max } else { min + 1.0 }),
             ColourScale::Diverging { limit } => {
@@ -482,25 +511,55 @@ pub fn heat_map_svg(map: &HeatMap<'_>) -> Result<String, PlotError> {
             .map_err(&err)?;
         root.present().map_err(&err)?;
     }
+    if let Some(image) = cells_image {
+        // After the background: the first element the backend writes is its fill.
+        let at = svg
+            .find("<rect")
+            .and_then(|r| svg[r..].find("/>").map(|e| r + e + 2))
+            .unwrap_or(0);
+        svg.insert_str(at, &image);
+    }
     Ok(svg)
 }
 
-/// The indices of the Pareto frontier of (time, error) points: those no other point beats in
-/// both (≤ in both and < in one), sorted by time. Points with a non-finite or negative
-/// coordinate are never on it.
+/// Pixel rows of a heat map's bitmap: one per degree of θ (the cos θ-rows are uneven in θ).
+const BITMAP_ROWS: usize = 90;
+
+/// The heat map's cells as an uncompressed 24-bit BMP, one column per φ-column and one row per
+/// degree of θ (each pixel the colour of the cos θ-row its θ falls in). Hand-written because
+/// BMP needs only a 54-byte header and browsers display it: the dependency tree has no PNG
+/// encoder, and at 64 × 90 pixels (17 kB) the image is an eighth of the per-cell SVG.
+pub fn cells_bitmap(map: &HeatMap<'_>) -> Vec<u8> {
+    let (w, h) = (map.columns, BITMAP_ROWS);
+    let stride = (3 * w).div_ceil(4) * 4;
+    let size = 54 + stride * h;
+    let mut b = Vec::with_capacity(size);
+    b.extend_from_slice(b"BM");
+    b.extend_from_slice(&(size as u32).to_le_bytes());
+    b.extend_from_slice(&[0; 4]);
+    b.extend_from_slice(&54u32.to_le_bytes());
+    b.extend_from_slice(&40u32.to_le_bytes());
+    b.extend_from_slice(&(w as i32).to_le_bytes());
+    b.extend_from_slice(&(h as i32).to_le_bytes()); // positive: rows stored bottom-up
+    b.extend_from_slice(&1u16.to_le_bytes());
+    b.extend_from_slice(&24u16.to_le_bytes());
+    b.extend_from_slice(&[0; 24]); // BI_RGB, no sizes, no palette
+    for k in (0..h).rev() {
+        let theta = ((k as f64 + 0.5) * 90.0 / h as f64).to_radians();
+        let row = ((theta.cos() * map.rows as f64) as usize).min(map.rows - 1);
+        let start = b.len();
+        for j in 0..w {
+            let RGBColor(r, g, bl) = colour(map.values[row * map.columns + j], map.scale);
+            b.extend_from_slice(&[bl, g, r]);
+        }
+        b.resize(start + stride, 0);
+    }
+    b
+}
+
+/// The indices of the Pareto frontier of (time, error) points ([`crate::cost::frontier`]).
 pub fn pareto_frontier(points: &[(f64, f64)]) -> Vec<usize> {
-    let ok = |p: &(f64, f64)| p.0.is_finite() && p.1.is_finite() && p.0 >= 0.0 && p.1 >= 0.0;
-    let mut front: Vec<usize> = (0..points.len())
-        .filter(|&i| ok(&points[i]))
-        .filter(|&i| {
-            let (t, e) = points[i];
-            !points
-                .iter()
-                .any(|q| ok(q) && q.0 <= t && q.1 <= e && (q.0 < t || q.1 < e))
-        })
-        .collect();
-    front.sort_by(|&a, &b| points[a].0.total_cmp(&points[b].0));
-    front
+    crate::cost::frontier::pareto_frontier(points)
 }
 
 /// Accuracy against time: every route a point (time per evaluation on x, max error on y, both

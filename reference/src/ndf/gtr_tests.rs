@@ -748,7 +748,7 @@ fn stable_at_the_edges_of_the_domain() {
 /// elsewhere; G1 = 1/(1 + Λ_oracle); the normalization ∫ D cos θ dω by quadrature; the
 /// sampler by F(θ(u)) = 2π∫_0^θ D cos t sin t dt against u. Grid: α ∈ {1e-4, 1e-3, 0.05,
 /// 0.3, 0.9, 1 − 1e-6, 1}, θ ∈ {1e-6, 1e-3, 0.05, 0.3, 0.9, 1.3, 1.5, 1.57, π/2 − 1e-6}.
-/// Run: `cargo test -p mfh-reference --release accuracy_table_gtr -- --ignored --nocapture`.
+/// Run: `MFH_EXTENSIVE=1 cargo test -p mfh-reference --release accuracy_table_gtr -- --nocapture`.
 mod accuracy_table {
     use super::*;
     use crate::test_support::integrate;
@@ -805,8 +805,11 @@ mod accuracy_table {
     }
 
     #[test]
-    #[ignore = "prints the seed 004 accuracy table (a few minutes in release)"]
     fn accuracy_table_gtr() {
+        if std::env::var_os("MFH_EXTENSIVE").is_none() {
+            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")");
+            return;
+        }
         // route label, quantity compared ("Λ" or "G1").
         let rows = [
             ("exact", "Λ"),

@@ -923,7 +923,7 @@ fn eq34_display_is_i11_not_i1() {
 /// conditional cdf of θ, ∫_0^θ D(t, φ) cos t sin t dt / ∫_0^{π/2}; Λ as the back-facing
 /// projected area (`lambda_integral`, eq 10); G1 = 1/(1 + Λ). The last column is the
 /// eq-1 blend of analytic GGX α = 0.2 and Beckmann α = 0.4 (`Blend`, no sampler).
-/// Run: `cargo test -p mfh-reference --release accuracy_table_piecewise -- --ignored --nocapture`.
+/// Run: `MFH_EXTENSIVE=1 cargo test -p mfh-reference --release accuracy_table_piecewise -- --nocapture`.
 mod accuracy_table {
     use super::*;
     use crate::ndf::Blend;
@@ -974,8 +974,11 @@ mod accuracy_table {
     }
 
     #[test]
-    #[ignore = "prints the seed 000 accuracy table (a few minutes in release)"]
     fn accuracy_table_piecewise() {
+        if std::env::var_os("MFH_EXTENSIVE").is_none() {
+            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")");
+            return;
+        }
         let models: Vec<(&str, PiecewiseLinear)> =
             small_models().into_iter().chain(big_models()).collect();
         let blend = Blend::new(

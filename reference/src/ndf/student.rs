@@ -886,7 +886,7 @@ mod tests {
 
 /// The accuracy table of the closing note of issue 2: the max relative error of each Λ route
 /// against the defining integral (test quadrature), over γ, α ∈ {0.05, 0.3, 1} and θ from 0 to
-/// π/2. Run: `cargo test -p mfh-reference --release accuracy_table -- --ignored --nocapture`.
+/// π/2. Run: `MFH_EXTENSIVE=1 cargo test -p mfh-reference --release accuracy_table -- --nocapture`.
 #[cfg(test)]
 mod accuracy_table {
     use super::*;
@@ -896,8 +896,11 @@ mod accuracy_table {
     use std::f64::consts::FRAC_PI_2;
 
     #[test]
-    #[ignore = "prints the accuracy table (about a minute)"]
     fn accuracy_table() {
+        if std::env::var_os("MFH_EXTENSIVE").is_none() {
+            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")");
+            return;
+        }
         let gammas = [1.6, 2.0, 2.5, 3.0, 3.5, 4.0, 7.5, 20.0, 100.0, 1e4];
         let thetas: Vec<f64> = (1..=40)
             .map(|i| FRAC_PI_2 * i as f64 / 41.0)
@@ -936,8 +939,13 @@ mod accuracy_table {
                         } else {
                             f64::INFINITY
                         };
-                        if *route == "stable" && e > 1e-12 {
-                            eprintln!("stable γ={g} α={a} θ={theta}: {v:e} vs {want:e} ({e:.1e})");
+                        // The stable route's stated accuracy (1e-14 level; the integral
+                        // oracle's own floor is ~1e-13): 1e-12 is the bound.
+                        if *route == "stable" {
+                            assert!(
+                                e <= 1e-12,
+                                "stable γ={g} α={a} θ={theta}: {v:e} vs {want:e} ({e:.1e})"
+                            );
                         }
                         worst = Some(worst.unwrap_or(0.0).max(e));
                     }

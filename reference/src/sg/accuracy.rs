@@ -2,7 +2,7 @@
 //! approximation and `_exact` route against an independent numerical integral (the test
 //! oracle `sg::oracle`, double-exponential quadrature), over sharpness 1e-3 … 1e4.
 //!
-//! Run: `cargo test -p mfh-reference --release accuracy_table_sg -- --ignored --nocapture`.
+//! Run: `MFH_EXTENSIVE=1 cargo test -p mfh-reference --release accuracy_table_sg -- --nocapture`.
 
 use super::asg::tests::{asg_at, integral_oracle};
 use super::circular::{decompose_sg, fiber_direction, von_mises_integral_scaled};
@@ -314,8 +314,13 @@ fn circular_rows() -> Vec<Row> {
 }
 
 #[test]
-#[ignore = "prints the seed 003 accuracy table (a few minutes in release)"]
 fn accuracy_table_sg() {
+    if std::env::var_os("MFH_EXTENSIVE").is_none() {
+        eprintln!(
+            "skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")"
+        );
+        return;
+    }
     let sg = sg_rows();
     let asg = asg_rows();
     let circular = circular_rows();

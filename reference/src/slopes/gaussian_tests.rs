@@ -858,10 +858,15 @@ fn corrected_pseudocode_fails_far_below_the_cut() {
 /// (columns: the regular and near-singular cases above), over θ ∈ {0, 1e-6, 0.3, 0.8, 1.2,
 /// 1.5, π/2 − 1e-3, π/2 − 1e-6, π/2} and each case's azimuths; and the relative error of
 /// the normalization N (eq 16, 24; `visible_area`) where the quadrature gives it.
-/// Run: `cargo test -p mfh-reference --release accuracy_table_gaussian_slopes -- --ignored --nocapture`.
+/// Run: `MFH_EXTENSIVE=1 cargo test -p mfh-reference --release accuracy_table_gaussian_slopes -- --nocapture`.
 #[test]
-#[ignore = "prints the seed 002 accuracy table (about a minute in release)"]
 fn accuracy_table_gaussian_slopes() {
+    if std::env::var_os("MFH_EXTENSIVE").is_none() {
+        eprintln!(
+            "skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")"
+        );
+        return;
+    }
     let thetas = [
         0.0,
         1e-6,
