@@ -21,7 +21,7 @@ use super::{compare, compare_exact, covers, Planned, Profile};
 use crate::oracle::quadrature::{frame_about, integrate_cap, Accuracy, Cuts};
 use crate::oracle::Estimate;
 use crate::record::{CheckRecord, Verdict};
-use crate::tolerance::Tolerance;
+use crate::tolerance::{Tolerance, CLOSED_FORM, NUMERICAL_ROUTE};
 use mfh_reference::geometry::dot;
 use mfh_reference::Vec3;
 use serde_json::Value;
@@ -184,6 +184,19 @@ fn compare_worst(r: &mut CheckRecord, pairs: &[(f64, f64)], tolerance: &Toleranc
 /// that is the approximation's claimed (or measured) bound.
 fn compare_claim(r: &mut CheckRecord, value: f64, oracle: Estimate, tolerance: &Tolerance) {
     compare(r, value, oracle, tolerance);
+}
+
+/// Fills `r` with a route's value against the oracle: the `exact` route (a numerical
+/// evaluation) to [`NUMERICAL_ROUTE`], the closed forms to [`CLOSED_FORM`], then the table of
+/// expected failures for (`sg`, route).
+fn compare_route(r: &mut CheckRecord, value: f64, oracle: Estimate, route: &str) {
+    let tol = if route == "exact" {
+        &NUMERICAL_ROUTE
+    } else {
+        &CLOSED_FORM
+    };
+    compare(r, value, oracle, tol);
+    super::apply_expected(r, FAMILY, route);
 }
 
 /// Sharpness grid of the profile.

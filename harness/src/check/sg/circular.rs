@@ -2,11 +2,11 @@
 //! each against quadrature over the period or its definition.
 
 use super::{accuracy, compare_worst, cover, error};
-use super::{planned, sharpness_grid, width, FAMILY};
-use crate::check::{apply_expected, compare, Planned, Profile};
+use super::{compare_route, planned, sharpness_grid, width};
+use crate::check::{compare, Planned, Profile};
 use crate::oracle::quadrature::integrate_pieces;
 use crate::oracle::Estimate;
-use crate::tolerance::{CLOSED_FORM, NUMERICAL_ROUTE, SG_IDENTITY};
+use crate::tolerance::{CLOSED_FORM, SG_IDENTITY};
 use mfh_reference::geometry::dot;
 use mfh_reference::sg::circular::{decompose_sg, von_mises_integral, von_mises_integral_scaled};
 use mfh_reference::sg::CircularGaussian;
@@ -125,13 +125,7 @@ pub(super) fn plan_circular(profile: Profile, why: &str, out: &mut Vec<Planned>)
                         &pts,
                         accuracy(),
                     );
-                    let tol = if route == "exact" {
-                        &NUMERICAL_ROUTE
-                    } else {
-                        &CLOSED_FORM
-                    };
-                    compare(r, value, o, tol);
-                    apply_expected(r, FAMILY, route);
+                    compare_route(r, value, o, route);
                 },
             ));
         }

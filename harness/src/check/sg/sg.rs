@@ -3,8 +3,8 @@
 //! quadrature or its definition.
 
 use super::{accuracy, around, axis, compare_claim, compare_worst, cover, error};
-use super::{planned, sharpness_grid, sphere, unit, width, FAMILY};
-use crate::check::{apply_expected, compare, Planned, Profile};
+use super::{compare_route, planned, sharpness_grid, sphere, unit, width};
+use crate::check::{compare, Planned, Profile};
 use crate::oracle::quadrature::integrate_pieces;
 use crate::record::CheckRecord;
 use crate::tolerance::{
@@ -87,13 +87,7 @@ pub(super) fn plan_sg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
                         a.integral()
                     };
                     let o = sphere(&|v| a.eval(v), p, PI, width(lambda), None);
-                    let tol = if route == "exact" {
-                        &NUMERICAL_ROUTE
-                    } else {
-                        &CLOSED_FORM
-                    };
-                    compare(r, value, o, tol);
-                    apply_expected(r, FAMILY, route);
+                    compare_route(r, value, o, route);
                 },
             ));
         }
@@ -118,13 +112,7 @@ pub(super) fn plan_sg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
                         la * p[2] + lb * q[2],
                     ]);
                     let o = sphere(&|v| a.eval(v) * b.eval(v), peak, PI, width(la + lb), None);
-                    let tol = if route == "exact" {
-                        &NUMERICAL_ROUTE
-                    } else {
-                        &CLOSED_FORM
-                    };
-                    compare(r, value, o, tol);
-                    apply_expected(r, FAMILY, route);
+                    compare_route(r, value, o, route);
                 },
             ));
         }
@@ -157,13 +145,7 @@ pub(super) fn plan_sg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
                             Err(e) => return error(r, e),
                         };
                         let o = sphere(&|v| a.eval(v), p, theta_d, width(lambda), None);
-                        let tol = if route == "exact" {
-                            &NUMERICAL_ROUTE
-                        } else {
-                            &CLOSED_FORM
-                        };
-                        compare(r, value, o, tol);
-                        apply_expected(r, FAMILY, route);
+                        compare_route(r, value, o, route);
                     },
                 ));
             }
