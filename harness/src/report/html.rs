@@ -770,9 +770,23 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
             if let Some(p) = smith_plots(records, &name, None)? {
                 plots.push_str(&p);
             }
-        } else if !failing_routes.is_empty() {
+        } else if !failing_routes.is_empty()
+            && plotted.insert(format!(
+                "smith.lambda_route failing {}",
+                failing_routes.iter().cloned().collect::<Vec<_>>().join(",")
+            ))
+        {
+            // The first material failing (as expected) in this set of routes: Λ of those
+            // routes (G1 = 1/(1 + Λ) adds nothing there); later materials with the same set
+            // are table rows.
             if let Some(p) = smith_plots(records, &name, Some(&failing_routes))? {
-                plots.push_str(&p);
+                plots.push_str(
+                    p.split("<img")
+                        .nth(1)
+                        .map(|i| format!("<img{i}"))
+                        .as_deref()
+                        .unwrap_or(&p),
+                );
             }
         } else if has_smith {
             left_out += 2;
