@@ -74,6 +74,13 @@ fn audit(file: &str, against: Option<&str>) -> (i32, Vec<String>, Value) {
 
 #[test]
 fn the_pure_python_ggx_passes_the_ci_audit() {
+    if std::env::var_os("MFH_EXTENSIVE").is_none() {
+        eprintln!(
+            "skipped: extensive tier (the pure-Python child answers ~46 000 small KS-table \
+             requests; minutes on 2 cores), run with MFH_EXTENSIVE=1"
+        );
+        return;
+    }
     let (code, failing, report) = audit("ggx.py", Some(r#"{"family":"ggx","alpha":0.3}"#));
     assert_eq!(code, 0, "failing: {failing:?}");
     assert!(failing.is_empty());
@@ -124,6 +131,13 @@ fn the_numpy_ggx_passes_the_ci_audit() {
 /// look at its samples (D, Λ, the value comparison) passes.
 #[test]
 fn the_wrong_sampler_fails_the_chi_square_check() {
+    if std::env::var_os("MFH_EXTENSIVE").is_none() {
+        eprintln!(
+            "skipped: extensive tier (the pure-Python child answers ~46 000 small KS-table \
+             requests; minutes on 2 cores), run with MFH_EXTENSIVE=1"
+        );
+        return;
+    }
     let (code, failing, _) = audit("ggx_wrong_sampler.py", None);
     assert_eq!(code, 1);
     assert!(

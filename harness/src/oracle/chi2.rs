@@ -345,15 +345,7 @@ where
     let estimates: Vec<_> = (0..grid.cells())
         .into_par_iter()
         .map(|i| {
-            let cell = grid.cell(i);
-            // θ decreases with z: the top of the row (z₁) is the smaller θ.
-            let theta = [
-                cell.z[1].clamp(0.0, 1.0).acos(),
-                cell.z[0].clamp(0.0, 1.0).acos(),
-            ];
-            let thetas = inside(&polar, theta);
-            let phis = inside(&azimuth, cell.phi);
-            let pieces = (thetas.len() - 1) * (phis.len() - 1);
+            let (thetas, phis, pieces) = cell_pieces(grid, i, &polar, &azimuth);
             let tolerance = Tolerance {
                 absolute: CELL_ABSOLUTE_TOLERANCE / pieces as f64,
                 relative,
@@ -389,6 +381,25 @@ pub type BatchSampler<'a> = dyn Fn(&[[f64; 2]], &mut [Vec3]) + Sync + 'a;
 /// A batch density: writes pdf(m[i]) into out[i].
 pub type BatchPdf<'a> = dyn Fn(&[Vec3], &mut [f64]) + Sync + 'a;
 
+/// The pieces of cell `i` between the lobe's cuts: the polar and azimuthal breakpoints inside
+/// the cell (θ decreases with z: the top of the row, z₁, is the smaller θ) and their count.
+fn cell_pieces(
+    grid: HemisphereGrid,
+    i: usize,
+    polar: &[f64],
+    azimuth: &[f64],
+) -> (Vec<f64>, Vec<f64>, usize) {
+    let cell = grid.cell(i);
+    let theta = [
+        cell.z[1].clamp(0.0, 1.0).acos(),
+        cell.z[0].clamp(0.0, 1.0).acos(),
+    ];
+    let thetas = inside(polar, theta);
+    let phis = inside(azimuth, cell.phi);
+    let pieces = (thetas.len() - 1) * (phis.len() - 1);
+    (thetas, phis, pieces)
+}
+
 /// [`expected_mass_in`] for a batch density, to the per-cell (relative, absolute) tolerances
 /// (`expected_mass_in` takes [`CELL_ABSOLUTE_TOLERANCE`]): the pieces of every cell are integrated together
 /// ([`integrate_rectangles_batch`], the density evaluated in parallel chunks of 16 384 points),
@@ -404,14 +415,7 @@ pub fn expected_mass_in_batch(
     let mut rectangles = Vec::new();
     let mut per_cell = Vec::with_capacity(grid.cells());
     for i in 0..grid.cells() {
-        let cell = grid.cell(i);
-        let theta = [
-            cell.z[1].clamp(0.0, 1.0).acos(),
-            cell.z[0].clamp(0.0, 1.0).acos(),
-        ];
-        let thetas = inside(&polar, theta);
-        let phis = inside(&azimuth, cell.phi);
-        let pieces = (thetas.len() - 1) * (phis.len() - 1);
+        let (thetas, phis, pieces) = cell_pieces(grid, i, &polar, &azimuth);
         let tolerance = Tolerance {
             absolute: absolute / pieces as f64,
             relative,

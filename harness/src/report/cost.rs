@@ -249,7 +249,7 @@ pub fn write_all(report: &CostReport, dir: &Path) -> Result<Vec<PathBuf>, Report
     }
     written.push(write(
         dir.join("cost.html"),
-        &super::html::cost_page(&json),
+        &super::cost_html::cost_page(&json),
     )?);
     Ok(written)
 }

@@ -4,6 +4,7 @@
 
 pub mod artefacts;
 pub mod cost;
+pub mod cost_html;
 pub mod html;
 pub mod json;
 pub mod junit;

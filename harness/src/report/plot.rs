@@ -663,19 +663,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_frontier_keeps_exactly_the_undominated_points() {
-        let points = [
-            (1.0, 1e-3),
-            (2.0, 1e-6),
-            (3.0, 1e-6),
-            (0.5, 1e-2),
-            (2.5, 1e-1),
-        ];
-        assert_eq!(pareto_frontier(&points), vec![3, 0, 1]);
-        assert_eq!(pareto_frontier(&[(f64::NAN, 1.0), (1.0, 1.0)]), vec![1]);
-    }
-
-    #[test]
     fn plots_are_svg_with_their_titles_and_every_point() {
         let svg = pareto_svg(
             "STD Λ",
