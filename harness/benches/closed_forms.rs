@@ -22,6 +22,9 @@
 //! Run: `cargo bench -p mfh-harness --bench closed_forms` (about three minutes), or with
 //! `-- --quick` for a fast pass, or with a filter (`-- lambda/std`).
 
+mod common;
+
+use common::{config, directions, golden, over, thetas, N};
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, Throughput};
 use mfh_reference::geometry::from_spherical;
@@ -32,12 +35,8 @@ use mfh_reference::ndf::{student_lambda, Beckmann, Blend, Ggx, PiecewiseLinear, 
 use mfh_reference::slopes::gaussian::GaussianSlopes;
 use mfh_reference::special::{hyp2f1, student_tail};
 use mfh_reference::{Ndf, NormalSampler, Smith, Vec3};
-use std::f64::consts::FRAC_PI_2;
 use std::hint::black_box;
 use std::time::Duration;
-
-/// Inputs per iteration.
-const N: usize = 64;
 
 /// The roughness of every benchmarked model (isotropic).
 const ALPHA: f64 = 0.3;
@@ -50,31 +49,6 @@ const SLOW_ROUTE: &str = "slope_space";
 
 /// The shape of the single-γ benchmarks (D, sample_wm, the other Student members).
 const GAMMA: f64 = 2.5;
-
-/// θ of the swept directions: four near the ends (1e-6, 1e-3, π/2 − 1e-3, π/2 − 1e-6) and 60
-/// evenly spread over (0, π/2).
-fn thetas() -> [f64; N] {
-    let mut t = [0.0; N];
-    for (i, ti) in t.iter_mut().enumerate().take(N - 4) {
-        *ti = (i as f64 + 0.5) / (N - 4) as f64 * FRAC_PI_2;
-    }
-    t[N - 4] = 1e-6;
-    t[N - 3] = 1e-3;
-    t[N - 2] = FRAC_PI_2 - 1e-3;
-    t[N - 1] = FRAC_PI_2 - 1e-6;
-    t
-}
-
-/// The swept directions: θ from `thetas`, φ by the golden-ratio sequence over [0, 2π).
-fn directions() -> [Vec3; N] {
-    let t = thetas();
-    std::array::from_fn(|i| from_spherical(t[i], golden(i) * std::f64::consts::TAU))
-}
-
-/// The fractional part of 0.1 + i/φ (φ the golden ratio): well spread over [0, 1).
-fn golden(i: usize) -> f64 {
-    (0.1 + i as f64 * 0.618_033_988_749_894_9).fract()
-}
 
 /// The swept sampler inputs: u1 by the golden-ratio sequence, u2 evenly spread over (0, 1)
 /// with 1e-9 and 1 − 1e-9 at the ends.
@@ -89,25 +63,14 @@ fn uniforms() -> [[f64; 2]; N] {
     })
 }
 
-/// A group with the per-element throughput; its benchmarks are named under `name`.
+/// A group of benchmarks that each sweep the 64 inputs.
 fn group<'a>(c: &'a mut Criterion, name: &str) -> BenchmarkGroup<'a, WallTime> {
-    let mut g = c.benchmark_group(name);
-    g.throughput(Throughput::Elements(N as u64));
-    g
+    common::group(c, name, N)
 }
 
 /// Benchmarks `f` over the 64 directions.
 fn over_directions(g: &mut BenchmarkGroup<'_, WallTime>, id: &str, f: impl Fn(Vec3) -> f64) {
-    let dirs = directions();
-    g.bench_function(id, |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for w in black_box(&dirs) {
-                acc += f(black_box(*w));
-            }
-            acc
-        })
-    });
+    over(g, id, &directions(), f);
 }
 
 /// Benchmarks `f` over 64 precomputed arguments (raw special functions).
@@ -117,15 +80,7 @@ fn over_arguments(
     args: [f64; N],
     f: impl Fn(f64) -> f64,
 ) {
-    g.bench_function(id, |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for x in black_box(&args) {
-                acc += f(black_box(*x));
-            }
-            acc
-        })
-    });
+    over(g, id, &args, f);
 }
 
 /// Benchmarks `sample_wm` over the 64 points u.
@@ -393,17 +348,8 @@ fn bench_special(c: &mut Criterion) {
     g.finish();
 }
 
-/// A short default run: 20 samples, 1 s of measurement, 300 ms of warm-up per benchmark
-/// (command-line options such as `--quick`, `--measurement-time` override these).
-fn config() -> Criterion {
-    Criterion::default()
-        .sample_size(20)
-        .measurement_time(Duration::from_secs(1))
-        .warm_up_time(Duration::from_millis(300))
-}
-
 fn main() {
-    let mut c = config().configure_from_args();
+    let mut c = config(Duration::from_secs(1), Duration::from_millis(300));
     bench_beckmann_ggx(&mut c);
     bench_std(&mut c);
     bench_student_members(&mut c);

@@ -18,8 +18,10 @@
 //! Run: `cargo bench -p mfh-harness --bench other_seeds` (a few minutes), `-- --quick` for a
 //! fast pass, or with a filter (`-- sg/`).
 
-use criterion::measurement::WallTime;
-use criterion::{BenchmarkGroup, Criterion, SamplingMode, Throughput};
+mod common;
+
+use common::{config, directions, golden, group, over, slow_group, thetas, N};
+use criterion::Criterion;
 use mfh_reference::geometry::from_spherical;
 use mfh_reference::model::VisibleSlopeMoments;
 use mfh_reference::ndf::gtr::Gtr;
@@ -29,36 +31,7 @@ use mfh_reference::sg::{Asg, Sg};
 use mfh_reference::slopes::gaussian::GaussianSlopes;
 use mfh_reference::{Ndf, Smith, Vec3};
 use std::f64::consts::{FRAC_PI_2, PI};
-use std::hint::black_box;
 use std::time::Duration;
-
-/// Inputs per iteration of the fast benchmarks.
-const N: usize = 64;
-
-/// θ of the swept directions: four near the ends (1e-6, 1e-3, π/2 − 1e-3, π/2 − 1e-6) and 60
-/// evenly spread over (0, π/2) (as in `closed_forms.rs`).
-fn thetas() -> [f64; N] {
-    let mut t = [0.0; N];
-    for (i, ti) in t.iter_mut().enumerate().take(N - 4) {
-        *ti = (i as f64 + 0.5) / (N - 4) as f64 * FRAC_PI_2;
-    }
-    t[N - 4] = 1e-6;
-    t[N - 3] = 1e-3;
-    t[N - 2] = FRAC_PI_2 - 1e-3;
-    t[N - 1] = FRAC_PI_2 - 1e-6;
-    t
-}
-
-/// The fractional part of 0.1 + i/φ (φ the golden ratio): well spread over [0, 1).
-fn golden(i: usize) -> f64 {
-    (0.1 + i as f64 * 0.618_033_988_749_894_9).fract()
-}
-
-/// The swept directions: θ from `thetas`, φ by the golden-ratio sequence over [0, 2π).
-fn directions() -> [Vec3; N] {
-    let t = thetas();
-    std::array::from_fn(|i| from_spherical(t[i], golden(i) * std::f64::consts::TAU))
-}
 
 /// Directions over the whole sphere (for SG evaluation): cos θ evenly spread over (−1, 1).
 fn sphere_directions() -> [Vec3; N] {
@@ -77,33 +50,6 @@ fn uniforms() -> [f64; N] {
         _ if i == N - 1 => 1.0 - 1e-9,
         _ => golden(i),
     })
-}
-
-/// A group whose benchmarks each sweep `n` inputs.
-fn group<'a>(c: &'a mut Criterion, name: &str, n: usize) -> BenchmarkGroup<'a, WallTime> {
-    let mut g = c.benchmark_group(name);
-    g.throughput(Throughput::Elements(n as u64));
-    g
-}
-
-/// A group for slow (quadrature) routes: 10 flat samples.
-fn slow_group<'a>(c: &'a mut Criterion, name: &str, n: usize) -> BenchmarkGroup<'a, WallTime> {
-    let mut g = group(c, name, n);
-    g.sample_size(10).sampling_mode(SamplingMode::Flat);
-    g
-}
-
-/// Benchmarks `f` over the inputs `xs`.
-fn over<T: Copy>(g: &mut BenchmarkGroup<'_, WallTime>, id: &str, xs: &[T], f: impl Fn(T) -> f64) {
-    g.bench_function(id, |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for x in black_box(xs) {
-                acc += f(black_box(*x));
-            }
-            acc
-        })
-    });
 }
 
 /// GTR (seed 004): Λ by every route at γ = 0 and 3 (closed_forms.rs has 1, 1.5, 2, 4), Λ at
@@ -557,17 +503,8 @@ fn bench_circular(c: &mut Criterion) {
     g.finish();
 }
 
-/// A short default run: 20 samples, 0.5 s of measurement, 200 ms of warm-up per benchmark
-/// (the slow groups: 10 samples; command-line options override these).
-fn config() -> Criterion {
-    Criterion::default()
-        .sample_size(20)
-        .measurement_time(Duration::from_millis(500))
-        .warm_up_time(Duration::from_millis(200))
-}
-
 fn main() {
-    let mut c = config().configure_from_args();
+    let mut c = config(Duration::from_millis(500), Duration::from_millis(200));
     bench_gtr(&mut c);
     bench_piecewise(&mut c);
     bench_gaussian_slopes(&mut c);

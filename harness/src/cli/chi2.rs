@@ -58,21 +58,16 @@ pub struct Chi2Args {
     pub quiet: bool,
 }
 
-/// Runs `mfh chi2`; returns the exit status (0 pass, 1 fail, 2 bad input).
-pub fn run(args: Chi2Args, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32 {
-    let bad = |stderr: &mut dyn Write, message: String| {
-        let _ = writeln!(stderr, "mfh chi2: {message}");
-        EXIT_BAD_INPUT
-    };
-    let seed = match resolve_seed(args.seed) {
-        Ok(seed) => seed,
-        Err(e) => return bad(stderr, e),
-    };
-    if let Some(cmd) = args.cmd.clone() {
-        return run_external(&args, &cmd, seed, stdout, stderr);
-    }
+/// Prints a bad-input message; the exit status 2.
+fn bad(stderr: &mut dyn Write, message: String) -> i32 {
+    let _ = writeln!(stderr, "mfh chi2: {message}");
+    EXIT_BAD_INPUT
+}
+
+/// The options as a [`Chi2Request`] for the model `model` (a spec's JSON text), validated.
+fn validate(args: &Chi2Args, model: String, seed: u64) -> Result<chi2_run::Chi2Plan, String> {
     let request = Chi2Request {
-        model: args.model.clone().unwrap_or_default(),
+        model,
         samples: args.samples,
         resolution: args.resolution,
         seed,
@@ -81,9 +76,21 @@ pub fn run(args: Chi2Args, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
         incidence: args.incidence,
         azimuth: args.azimuth,
     };
-    let plan = match chi2_run::validate(&request) {
+    chi2_run::validate(&request).map_err(|e| e.to_string())
+}
+
+/// Runs `mfh chi2`; returns the exit status (0 pass, 1 fail, 2 bad input).
+pub fn run(args: Chi2Args, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32 {
+    let seed = match resolve_seed(args.seed) {
+        Ok(seed) => seed,
+        Err(e) => return bad(stderr, e),
+    };
+    if let Some(cmd) = args.cmd.clone() {
+        return run_external(&args, &cmd, seed, stdout, stderr);
+    }
+    let plan = match validate(&args, args.model.clone().unwrap_or_default(), seed) {
         Ok(plan) => plan,
-        Err(e) => return bad(stderr, e.to_string()),
+        Err(e) => return bad(stderr, e),
     };
     let result = run_with_progress(&plan, args.quiet);
     let name = crate::report::artefacts::model_name(&serde_json::json!(plan.model.spec()));
@@ -112,29 +119,15 @@ fn run_external(
     stdout: &mut dyn Write,
     stderr: &mut dyn Write,
 ) -> i32 {
-    let bad = |stderr: &mut dyn Write, message: String| {
-        let _ = writeln!(stderr, "mfh chi2: {message}");
-        EXIT_BAD_INPUT
-    };
     if !(args.timeout > 0.0 && args.timeout <= 86_400.0) {
         return bad(
             stderr,
             format!("--timeout {} is outside (0, 86400] seconds", args.timeout),
         );
     }
-    let request = Chi2Request {
-        model: r#"{"family":"ggx","alpha":0.5}"#.into(),
-        samples: args.samples,
-        resolution: args.resolution,
-        seed,
-        alpha: args.alpha,
-        sampling: args.sampling.kind(),
-        incidence: args.incidence,
-        azimuth: args.azimuth,
-    };
-    let plan = match chi2_run::validate(&request) {
+    let plan = match validate(args, r#"{"family":"ggx","alpha":0.5}"#.into(), seed) {
         Ok(plan) => plan,
-        Err(e) => return bad(stderr, e.to_string()),
+        Err(e) => return bad(stderr, e),
     };
     let timeout = std::time::Duration::from_secs_f64(args.timeout);
     let model = match crate::external::ExternalModel::start(cmd, timeout) {
@@ -151,7 +144,8 @@ fn run_external(
                 return bad(
                     stderr,
                     format!(
-                        "--sampling visible: `{name}` does not declare sample_wm_visible;                          nothing to test"
+                        "--sampling visible: `{name}` does not declare sample_wm_visible; \
+                         nothing to test"
                     ),
                 );
             };
@@ -235,10 +229,6 @@ fn report(
     stdout: &mut dyn Write,
     stderr: &mut dyn Write,
 ) -> i32 {
-    let bad = |stderr: &mut dyn Write, message: String| {
-        let _ = writeln!(stderr, "mfh chi2: {message}");
-        EXIT_BAD_INPUT
-    };
     let mut artefacts = Vec::new();
     if let Some(dir) = &args.out {
         match write_artefacts(dir, name, result) {

@@ -17,6 +17,7 @@
 //!   integral (the document's form, its large-bandwidth form), the ASG–SG convolution (the
 //!   document's approximation, quadrature to a tolerance), against the reference crate's
 //!   adaptive quadrature to 1e-12…1e-13.
+//! - Gaussian visible-slope moments (seed 002): in `super::visible_moments`.
 
 use super::{Candidate, Selection, Sweep};
 use crate::oracle::precise::student_lambda_standardized;
@@ -89,6 +90,9 @@ pub fn sweeps(selection: &Selection, quick: bool) -> Vec<Build> {
         out.push(Box::new(sg_inner));
         out.push(Box::new(asg_integral));
         out.push(Box::new(asg_convolution));
+    }
+    if selection.visible_moments {
+        out.push(Box::new(super::visible_moments::sweep));
     }
     out
 }

@@ -12,6 +12,7 @@ pub mod catalogue;
 pub mod frontier;
 pub mod oracles;
 pub mod timing;
+pub mod visible_moments;
 
 use serde::{Deserialize, Serialize};
 use timing::{time_per_evaluation, Budget, Timing};
@@ -44,6 +45,8 @@ pub struct Selection {
     pub piecewise: bool,
     /// Spherical-Gaussian and ASG approximations.
     pub spherical_gaussians: bool,
+    /// The visible-slope moments of Gaussian slopes (D_s) against cubature.
+    pub visible_moments: bool,
     /// The oracles' knobs (always useful: every audit uses them).
     pub oracles: bool,
 }
@@ -55,6 +58,7 @@ impl Selection {
         gtr: true,
         piecewise: true,
         spherical_gaussians: true,
+        visible_moments: true,
         oracles: true,
     };
 
@@ -79,6 +83,7 @@ impl Selection {
             piecewise: families.contains(&"piecewise_linear"),
             spherical_gaussians: scene.lighting.spherical_gaussians
                 || scene.lighting.anisotropic_spherical_gaussians,
+            visible_moments: families.contains(&"gaussian_slopes"),
             oracles: true,
         }
     }
