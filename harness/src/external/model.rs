@@ -182,11 +182,7 @@ impl ExternalModel {
     /// `sample_wm` for a batch of uniform pairs, written into `out` (same length as `u`). On a
     /// protocol error `out` is filled with NaN directions and the error is recorded.
     pub fn sample_wm_batch(&self, u: &[[f64; 2]], out: &mut [Vec3]) {
-        assert_eq!(
-            u.len(),
-            out.len(),
-            "sample_wm_batch: u and out differ in length"
-        );
+        same_length("sample_wm_batch", "u", u.len(), out.len());
         for (start, chunk) in (0..u.len())
             .step_by(MAX_BATCH)
             .zip(out.chunks_mut(MAX_BATCH))
@@ -223,6 +219,12 @@ fn chunked(
     Ok(out)
 }
 
+/// The batch methods' contract: as many outputs as inputs (a caller's bug otherwise: panics).
+#[track_caller]
+fn same_length(method: &str, input: &str, n_in: usize, n_out: usize) {
+    assert_eq!(n_in, n_out, "{method}: {input} and out differ in length");
+}
+
 fn show(v: Vec3) -> String {
     format!("[{}, {}, {}]", v[0], v[1], v[2])
 }
@@ -245,7 +247,7 @@ impl Ndf for ExternalModel {
     }
     /// D through the protocol: up to 65 536 directions per request.
     fn d_batch(&self, m: &[Vec3], out: &mut [f64]) {
-        assert_eq!(m.len(), out.len(), "d_batch: m and out differ in length");
+        same_length("d_batch", "m", m.len(), out.len());
         fill(out, ExternalModel::d_batch(self, m));
     }
     fn as_smith(&self) -> Option<&dyn Smith> {
@@ -269,11 +271,7 @@ impl Smith for ExternalModel {
     }
     /// Λ through the protocol: up to 65 536 directions per request.
     fn lambda_batch(&self, w: &[Vec3], out: &mut [f64]) {
-        assert_eq!(
-            w.len(),
-            out.len(),
-            "lambda_batch: w and out differ in length"
-        );
+        same_length("lambda_batch", "w", w.len(), out.len());
         fill(out, ExternalModel::lambda_batch(self, w));
     }
     fn g1(&self, w: Vec3, m: Vec3) -> f64 {
@@ -342,11 +340,7 @@ impl NormalSampler for ExternalModel {
     }
     /// pdf_wm through the protocol (D(m) m_z from a `d` batch when not declared).
     fn pdf_wm_batch(&self, m: &[Vec3], out: &mut [f64]) {
-        assert_eq!(
-            m.len(),
-            out.len(),
-            "pdf_wm_batch: m and out differ in length"
-        );
+        same_length("pdf_wm_batch", "m", m.len(), out.len());
         if self.description.has("pdf_wm") {
             return fill(out, ExternalModel::pdf_wm_batch(self, m));
         }
@@ -394,11 +388,7 @@ impl VisibleNormalSampler for ExternalModel {
     /// sample_wm_visible through the protocol: up to 65 536 pairs per request (NaN directions
     /// outside the domain, and after a protocol error).
     fn sample_wm_visible_batch(&self, wi: Vec3, u: &[[f64; 2]], out: &mut [Vec3]) {
-        assert_eq!(
-            u.len(),
-            out.len(),
-            "sample_wm_visible_batch: u and out differ in length"
-        );
+        same_length("sample_wm_visible_batch", "u", u.len(), out.len());
         if !visible_domain(wi) {
             return out.fill(NAN3);
         }
@@ -425,11 +415,7 @@ impl VisibleNormalSampler for ExternalModel {
     }
     /// pdf_wm_visible through the protocol (from `d` and Λ batches when not declared).
     fn pdf_wm_visible_batch(&self, wi: Vec3, m: &[Vec3], out: &mut [f64]) {
-        assert_eq!(
-            m.len(),
-            out.len(),
-            "pdf_wm_visible_batch: m and out differ in length"
-        );
+        same_length("pdf_wm_visible_batch", "m", m.len(), out.len());
         if !visible_domain(wi) {
             return out.fill(0.0);
         }

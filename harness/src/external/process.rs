@@ -384,7 +384,11 @@ fn read_lines(stdout: impl Read, tx: Sender<Line>) {
             Ok(_) if buf.last() != Some(&b'\n') && buf.len() as u64 >= MAX_LINE_BYTES => {
                 Line::TooLong
             }
-            Ok(_) => Line::Text(String::from_utf8_lossy(&buf).into_owned()),
+            // Valid UTF-8 (every well-formed answer) is taken without a copy.
+            Ok(_) => Line::Text(
+                String::from_utf8(buf)
+                    .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()),
+            ),
             Err(e) => Line::Failed(e.to_string()),
         };
         let stop = !matches!(line, Line::Text(_));
