@@ -58,13 +58,13 @@ pub enum ExternalError {
         stderr: String,
     },
     /// The answer is not the JSON object the protocol asks for.
-    #[error("request {request}: malformed answer ({reason}); got: {got}")]
+    #[error("request {request}: malformed answer ({reason}){}", got_suffix(.got))]
     Malformed {
         /// The request.
         request: String,
         /// What is wrong.
         reason: String,
-        /// The start of what came back.
+        /// The start of what came back (empty when the reason quotes it, or nothing came).
         got: String,
     },
     /// The child answered with its own error.
@@ -417,6 +417,15 @@ fn keep_tail(mut pipe: impl Read, tail: Arc<Mutex<Vec<u8>>>) {
             let excess = t.len().saturating_sub(STDERR_TAIL_BYTES);
             t.drain(..excess);
         }
+    }
+}
+
+/// "; got: …" after a malformed-answer message, unless there is nothing to show.
+fn got_suffix(got: &str) -> String {
+    if got.is_empty() {
+        String::new()
+    } else {
+        format!("; got: {got}")
     }
 }
 
