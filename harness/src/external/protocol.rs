@@ -570,6 +570,9 @@ mod tests {
         assert!(Request::Shutdown
             .to_line(5, 2)
             .contains(r#""op":"shutdown""#));
+        // README's example line: u = (0.25, 0.5).
+        let line = Request::SampleWm { u: &[[0.25, 0.5]] }.to_line(3, 2);
+        assert!(line.contains(r#""u":"AAAAAAAA0D8AAAAAAADgPw==""#), "{line}");
     }
 
     /// Answers: base64 arrays decode in version 2 (also JSON arrays), are refused in version 1,
