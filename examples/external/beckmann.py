@@ -1,23 +1,20 @@
 #!/usr/bin/env python3
-"""A Beckmann microfacet model speaking mfh's external protocol, version 1.
+"""A Beckmann microfacet model speaking mfh's external protocol (version 2, or 1 with
+--protocol 1; the protocol loop is mfh_protocol.py beside this file).
 
 Pure Python, no dependencies. Run by mfh:
 
     mfh audit-external --cmd "python3 examples/external/beckmann.py" --profile ci \
         --against '{"family":"beckmann","alpha_x":0.3,"alpha_y":0.3}'
 
-Options: --alpha A (isotropic) or --alpha-x AX --alpha-y AY (default 0.3).
-Protocol: one JSON request per line on stdin, one JSON answer per line on stdout, carrying the
-request's "id". stdout is the protocol channel: log to stderr only.
+Options: --alpha A (isotropic) or --alpha-x AX --alpha-y AY (default 0.3), --protocol 1|2.
+stdout is the protocol channel: log to stderr only.
 """
-import json
 import math
-import sys
 
-args = sys.argv[1:]
-opts = dict(zip(args[::2], args[1::2]))
-AX = float(opts.get("--alpha-x", opts.get("--alpha", 0.3)))
-AY = float(opts.get("--alpha-y", opts.get("--alpha", AX)))
+import mfh_protocol
+
+AX, AY, PROTOCOL = mfh_protocol.options()
 PI = math.pi
 
 
@@ -58,33 +55,10 @@ def pdf_wm(m):
     return d(m) * m[2] if m[2] > 0.0 else 0.0
 
 
-def answer(req):
-    op = req["op"]
-    if op == "describe":
-        return {"protocol": 1, "name": "beckmann.py",
-                "capabilities": ["d", "lambda", "sample_wm", "pdf_wm"],
-                "parameters": {"family": "beckmann", "alpha_x": AX, "alpha_y": AY}}
-    if op == "d":
-        return {"values": [d(m) for m in req["m"]]}
-    if op == "lambda":
-        return {"values": [lam(w) for w in req["w"]]}
-    if op == "sample_wm":
-        return {"m": [sample_wm(u) for u in req["u"]]}
-    if op == "pdf_wm":
-        return {"values": [pdf_wm(m) for m in req["m"]]}
-    return {"error": "unknown op " + repr(op)}
-
-
-def main():
-    for line in sys.stdin:
-        req = json.loads(line)
-        if req["op"] == "shutdown":
-            return
-        out = answer(req)
-        out["id"] = req["id"]
-        sys.stdout.write(json.dumps(out) + "\n")
-        sys.stdout.flush()
-
-
 if __name__ == "__main__":
-    main()
+    mfh_protocol.serve(
+        "beckmann.py",
+        {"family": "beckmann", "alpha_x": AX, "alpha_y": AY},
+        {"d": d, "lambda": lam, "sample_wm": sample_wm, "pdf_wm": pdf_wm},
+        protocol=PROTOCOL,
+    )

@@ -1,23 +1,20 @@
 #!/usr/bin/env python3
-"""A GGX (Trowbridge-Reitz) microfacet model speaking mfh's external protocol, version 1.
+"""A GGX (Trowbridge-Reitz) microfacet model speaking mfh's external protocol (version 2, or
+1 with --protocol 1; the protocol loop is mfh_protocol.py beside this file).
 
 Pure Python, no dependencies. Run by mfh:
 
     mfh audit-external --cmd "python3 examples/external/ggx.py" --profile ci \
         --against '{"family":"ggx","alpha_x":0.3,"alpha_y":0.3}'
 
-Options: --alpha A (isotropic) or --alpha-x AX --alpha-y AY (default 0.3).
-Protocol: one JSON request per line on stdin, one JSON answer per line on stdout, carrying the
-request's "id". stdout is the protocol channel: log to stderr only.
+Options: --alpha A (isotropic) or --alpha-x AX --alpha-y AY (default 0.3), --protocol 1|2.
+stdout is the protocol channel: log to stderr only.
 """
-import json
 import math
-import sys
 
-args = sys.argv[1:]
-opts = dict(zip(args[::2], args[1::2]))
-AX = float(opts.get("--alpha-x", opts.get("--alpha", 0.3)))
-AY = float(opts.get("--alpha-y", opts.get("--alpha", AX)))
+import mfh_protocol
+
+AX, AY, PROTOCOL = mfh_protocol.options()
 PI = math.pi
 
 
@@ -90,37 +87,15 @@ def pdf_wm_visible(wi, m):
     return c * d(m) / (wi[2] * (1.0 + lam(wi)))
 
 
-def answer(req):
-    op = req["op"]
-    if op == "describe":
-        return {"protocol": 1, "name": "ggx.py",
-                "capabilities": ["d", "lambda", "sample_wm", "pdf_wm",
-                                 "sample_wm_visible", "pdf_wm_visible"],
-                "parameters": {"family": "ggx", "alpha_x": AX, "alpha_y": AY}}
-    if op == "d":
-        return {"values": [d(m) for m in req["m"]]}
-    if op == "lambda":
-        return {"values": [lam(w) for w in req["w"]]}
-    if op == "sample_wm":
-        return {"m": [sample_wm(u) for u in req["u"]]}
-    if op == "pdf_wm":
-        return {"values": [pdf_wm(m) for m in req["m"]]}
-    if op == "sample_wm_visible":
-        return {"m": [sample_wm_visible(wi, u) for wi, u in zip(req["wi"], req["u"])]}
-    if op == "pdf_wm_visible":
-        return {"values": [pdf_wm_visible(wi, m) for wi, m in zip(req["wi"], req["m"])]}
-    return {"error": "unknown op " + repr(op)}
-
-
-def main():
-    for line in sys.stdin:
-        req = json.loads(line)
-        if req["op"] == "shutdown":
-            return
-        out = answer(req)
-        out["id"] = req["id"]
-        sys.stdout.write(json.dumps(out) + "\n")
-        sys.stdout.flush()
+def main(name="ggx.py", sampler=sample_wm):
+    """Serves the protocol; another example may pass its own name and sampler."""
+    mfh_protocol.serve(
+        name,
+        {"family": "ggx", "alpha_x": AX, "alpha_y": AY},
+        {"d": d, "lambda": lam, "sample_wm": sampler, "pdf_wm": pdf_wm,
+         "sample_wm_visible": sample_wm_visible, "pdf_wm_visible": pdf_wm_visible},
+        protocol=PROTOCOL,
+    )
 
 
 if __name__ == "__main__":

@@ -1,21 +1,19 @@
 #!/usr/bin/env python3
-"""A GGX microfacet model speaking mfh's external protocol, version 1, vectorized with numpy:
-each batch is one array operation. Run by mfh:
+"""A GGX microfacet model speaking mfh's external protocol (version 2, or 1 with --protocol 1;
+the protocol loop is mfh_protocol.py beside this file), vectorized with numpy: each batch is one
+array operation, and in version 2 each array crosses the pipe as base64 of float64, decoded by
+np.frombuffer. Run by mfh:
 
     mfh audit-external --cmd "python3 examples/external/ggx_numpy.py" --profile ci \
         --against '{"family":"ggx","alpha_x":0.3,"alpha_y":0.3}'
 
-Options: --alpha A or --alpha-x AX --alpha-y AY (default 0.3). Log to stderr only.
+Options: --alpha A or --alpha-x AX --alpha-y AY (default 0.3), --protocol 1|2. Log to stderr
+only.
 """
-import json
-import sys
-
+import mfh_protocol
 import numpy as np
 
-args = sys.argv[1:]
-opts = dict(zip(args[::2], args[1::2]))
-AX = float(opts.get("--alpha-x", opts.get("--alpha", 0.3)))
-AY = float(opts.get("--alpha-y", opts.get("--alpha", AX)))
+AX, AY, PROTOCOL = mfh_protocol.options()
 
 
 def d(m):
@@ -54,32 +52,11 @@ def pdf_wm(m):
     return np.where(m[:, 2] > 0.0, d(m) * m[:, 2], 0.0)
 
 
-def answer(req):
-    op = req["op"]
-    if op == "describe":
-        return {"protocol": 1, "name": "ggx_numpy.py",
-                "capabilities": ["d", "lambda", "sample_wm", "pdf_wm"],
-                "parameters": {"family": "ggx", "alpha_x": AX, "alpha_y": AY}}
-    if op in ("d", "pdf_wm"):
-        m = np.array(req["m"], dtype=float).reshape(-1, 3)
-        return {"values": (d(m) if op == "d" else pdf_wm(m)).tolist()}
-    if op == "lambda":
-        return {"values": lam(np.array(req["w"], dtype=float).reshape(-1, 3)).tolist()}
-    if op == "sample_wm":
-        return {"m": sample_wm(np.array(req["u"], dtype=float).reshape(-1, 2)).tolist()}
-    return {"error": "unknown op " + repr(op)}
-
-
-def main():
-    for line in sys.stdin:
-        req = json.loads(line)
-        if req["op"] == "shutdown":
-            return
-        out = answer(req)
-        out["id"] = req["id"]
-        sys.stdout.write(json.dumps(out) + "\n")
-        sys.stdout.flush()
-
-
 if __name__ == "__main__":
-    main()
+    mfh_protocol.serve(
+        "ggx_numpy.py",
+        {"family": "ggx", "alpha_x": AX, "alpha_y": AY},
+        {"d": d, "lambda": lam, "sample_wm": sample_wm, "pdf_wm": pdf_wm},
+        protocol=PROTOCOL,
+        numpy=True,
+    )

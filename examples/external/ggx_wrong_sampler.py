@@ -1,52 +1,20 @@
 #!/usr/bin/env python3
-"""DELIBERATELY WRONG: ggx.py with the Beckmann sampler's slope radius rho^2 = -ln(1 - u2) in
-sample_wm (a copy-paste slip between two families). D, Lambda and pdf_wm are right, so the
-samples do not follow the pdf: the check `sampling.chi2` fails.
+"""DELIBERATELY WRONG: ggx.py (imported, not copied) with the Beckmann sampler's slope radius
+rho^2 = -ln(1 - u2) in sample_wm (a copy-paste slip between two families). D, Lambda, pdf_wm and
+the visible sampler are ggx.py's and right, so the samples do not follow the pdf: the check
+`sampling.chi2` fails. Run by mfh:
 
-Pure Python, no dependencies. Run by mfh:
+    mfh audit-external --cmd "python3 examples/external/ggx_wrong_sampler.py" --profile ci
 
-    mfh audit-external --cmd "python3 examples/external/ggx_wrong_sampler.py" --profile ci \
-        --against '{"family":"ggx","alpha_x":0.3,"alpha_y":0.3}'
-
-Options: --alpha A (isotropic) or --alpha-x AX --alpha-y AY (default 0.3).
-Protocol: one JSON request per line on stdin, one JSON answer per line on stdout, carrying the
-request's "id". stdout is the protocol channel: log to stderr only.
+Options: those of ggx.py.
 """
-import json
 import math
-import sys
 
-args = sys.argv[1:]
-opts = dict(zip(args[::2], args[1::2]))
-AX = float(opts.get("--alpha-x", opts.get("--alpha", 0.3)))
-AY = float(opts.get("--alpha-y", opts.get("--alpha", AX)))
-PI = math.pi
+import ggx
+from ggx import AX, AY, PI
 
 
-def d(m):
-    x, y, z = m
-    if z <= 0.0:
-        return 0.0
-    z2 = z * z
-    s2 = ((x / AX) ** 2 + (y / AY) ** 2) / z2
-    return 1.0 / (PI * AX * AY * z2 * z2 * (1.0 + s2) ** 2)
-
-
-def lam(w):
-    x, y, z = w
-    if z < 0.0:
-        return -1.0 - lam((-x, -y, -z))
-    t2 = (AX * x) ** 2 + (AY * y) ** 2
-    if t2 == 0.0:
-        return 0.0
-    if z == 0.0:
-        return math.inf
-    inv_a2 = t2 / (z * z)
-    # (sqrt(1 + a^-2) - 1) / 2 without cancellation.
-    return inv_a2 / (2.0 * (1.0 + math.sqrt(1.0 + inv_a2)))
-
-
-def sample_wm(u):
+def wrong_sample_wm(u):
     phi = 2.0 * PI * u[0]
     rho = math.sqrt(-math.log1p(-u[1]))  # WRONG: Beckmann's radius, GGX needs u2 / (1 - u2)
     px, py = AX * rho * math.cos(phi), AY * rho * math.sin(phi)
@@ -54,75 +22,5 @@ def sample_wm(u):
     return [-px / n, -py / n, 1.0 / n]
 
 
-def pdf_wm(m):
-    return d(m) * m[2] if m[2] > 0.0 else 0.0
-
-
-def sample_wm_visible(wi, u):
-    # Heitz 2018, "Sampling the GGX Distribution of Visible Normals", JCGT 7(4).
-    vx, vy, vz = AX * wi[0], AY * wi[1], wi[2]
-    n = math.sqrt(vx * vx + vy * vy + vz * vz)
-    vx, vy, vz = vx / n, vy / n, vz / n
-    l2 = vx * vx + vy * vy
-    if l2 > 0.0:
-        il = 1.0 / math.sqrt(l2)
-        t1 = (-vy * il, vx * il, 0.0)
-    else:
-        t1 = (1.0, 0.0, 0.0)
-    t2 = (vy * t1[2] - vz * t1[1], vz * t1[0] - vx * t1[2], vx * t1[1] - vy * t1[0])
-    r = math.sqrt(u[0])
-    phi = 2.0 * PI * u[1]
-    p1, p2 = r * math.cos(phi), r * math.sin(phi)
-    s = 0.5 * (1.0 + vz)
-    p2 = (1.0 - s) * math.sqrt(max(0.0, 1.0 - p1 * p1)) + s * p2
-    p3 = math.sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2))
-    hx = p1 * t1[0] + p2 * t2[0] + p3 * vx
-    hy = p1 * t1[1] + p2 * t2[1] + p3 * vy
-    hz = p1 * t1[2] + p2 * t2[2] + p3 * vz
-    mx, my, mz = AX * hx, AY * hy, max(1e-300, hz)
-    n = math.sqrt(mx * mx + my * my + mz * mz)
-    return [mx / n, my / n, mz / n]
-
-
-def pdf_wm_visible(wi, m):
-    c = wi[0] * m[0] + wi[1] * m[1] + wi[2] * m[2]
-    if m[2] <= 0.0 or c <= 0.0:
-        return 0.0
-    return c * d(m) / (wi[2] * (1.0 + lam(wi)))
-
-
-def answer(req):
-    op = req["op"]
-    if op == "describe":
-        return {"protocol": 1, "name": "ggx_wrong_sampler.py",
-                "capabilities": ["d", "lambda", "sample_wm", "pdf_wm",
-                                 "sample_wm_visible", "pdf_wm_visible"],
-                "parameters": {"family": "ggx", "alpha_x": AX, "alpha_y": AY}}
-    if op == "d":
-        return {"values": [d(m) for m in req["m"]]}
-    if op == "lambda":
-        return {"values": [lam(w) for w in req["w"]]}
-    if op == "sample_wm":
-        return {"m": [sample_wm(u) for u in req["u"]]}
-    if op == "pdf_wm":
-        return {"values": [pdf_wm(m) for m in req["m"]]}
-    if op == "sample_wm_visible":
-        return {"m": [sample_wm_visible(wi, u) for wi, u in zip(req["wi"], req["u"])]}
-    if op == "pdf_wm_visible":
-        return {"values": [pdf_wm_visible(wi, m) for wi, m in zip(req["wi"], req["m"])]}
-    return {"error": "unknown op " + repr(op)}
-
-
-def main():
-    for line in sys.stdin:
-        req = json.loads(line)
-        if req["op"] == "shutdown":
-            return
-        out = answer(req)
-        out["id"] = req["id"]
-        sys.stdout.write(json.dumps(out) + "\n")
-        sys.stdout.flush()
-
-
 if __name__ == "__main__":
-    main()
+    ggx.main("ggx_wrong_sampler.py", wrong_sample_wm)

@@ -1,18 +1,18 @@
-//! The external protocol end to end: the examples under examples/external/ speak it (their
-//! values agree with the reference closed forms), and every misbehaviour of the other side
-//! (crash, hang, garbage on stdout, NaN, wrong length, early exit, bad description, wrong id)
-//! becomes a clear error in bounded time, with no child left running.
+//! The external protocol end to end, versions 1 and 2: the examples under examples/external/
+//! speak both (their values agree with the reference closed forms), and every misbehaviour of
+//! the other side (crash, hang, garbage on stdout, NaN, wrong length, early exit, bad
+//! description, wrong id; in version 2 bad base64, a short or ragged array, NaN in the binary
+//! data, an oversized answer) becomes a clear error in bounded time, with no child left running.
 
+#[path = "external/common.rs"]
+mod common;
+
+use common::{example, has_numpy, root, run};
 use mfh_harness::external::{ExternalError, ExternalModel};
 use mfh_reference::model::{NormalSampler, Smith};
 use mfh_reference::ndf::{Beckmann, Ggx};
 use mfh_reference::{Ndf, Vec3};
-use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 fn start(cmd: &str, timeout: f64) -> Result<ExternalModel, ExternalError> {
     ExternalModel::start(cmd, Duration::from_secs_f64(timeout))
@@ -37,21 +37,21 @@ fn directions(n: usize) -> Vec<Vec3> {
 /// The pure-Python examples agree with the reference closed forms (mfh_reference, an
 /// implementation owing nothing to the Python code) to 1e-12 relative (Beckmann Λ 1e-10), in
 /// batches of 20 000; isotropic and anisotropic (values below 1e-100, where the example flushes Beckmann's
-/// Λ to 0, are compared absolutely).
+/// Λ to 0, are compared absolutely). Protocol versions 1 and 2 (the examples' `--protocol`).
 #[test]
 fn pure_python_examples_agree_with_the_reference() {
     let dirs = directions(20_000);
-    for (file, ax, ay) in [
-        ("ggx.py", 0.3, 0.3),
-        ("ggx.py", 0.1, 0.4),
-        ("beckmann.py", 0.3, 0.3),
-        ("beckmann.py", 0.3, 0.15),
+    for (file, ax, ay, protocol) in [
+        ("ggx.py", 0.3, 0.3, 2),
+        ("ggx.py", 0.1, 0.4, 2),
+        ("ggx.py", 0.1, 0.4, 1),
+        ("beckmann.py", 0.3, 0.3, 2),
+        ("beckmann.py", 0.3, 0.15, 2),
+        ("beckmann.py", 0.3, 0.15, 1),
     ] {
-        let cmd = format!(
-            "python3 {}/examples/external/{file} --alpha-x {ax} --alpha-y {ay}",
-            root().display()
-        );
-        let model = start(&cmd, 10.0).expect("the example starts");
+        let args = format!("--alpha-x {ax} --alpha-y {ay} --protocol {protocol}");
+        let model = start(&example(file, &args), 10.0).expect("the example starts");
+        assert_eq!(model.version(), protocol, "{file}: the version it chose");
         let reference: Box<dyn Ndf> = if file == "ggx.py" {
             Box::new(Ggx::new(ax, ay).unwrap())
         } else {
@@ -75,7 +75,8 @@ fn pure_python_examples_agree_with_the_reference() {
             }
         }
         eprintln!(
-            "{file} α = ({ax}, {ay}): worst relative error of D {worst:.2e}, of Λ {worst_lambda:.2e}"
+            "{file} α = ({ax}, {ay}), protocol {protocol}: worst relative error of D \
+             {worst:.2e}, of Λ {worst_lambda:.2e}"
         );
         assert!(worst < 1e-12, "{file}: D {worst}");
         // Beckmann's Λ as the example writes it, (e^{−a²}/(a√π) − erfc a)/2, cancels for large
@@ -92,13 +93,12 @@ fn pure_python_examples_agree_with_the_reference() {
     }
 }
 
-/// Samples per second through the protocol, `sample_wm_batch` in batches of 65 536 (printed;
-/// run with --nocapture). The samples' mean cos θ matches the reference sampler's expectation
-/// E[cos θ] = ∫ D cos² θ dω, computed from 10⁵ reference samples (a 5σ bound).
+/// Samples per second through the protocol, `sample_wm_batch` in batches of 65 536, for
+/// versions 1 and 2 (printed; run with --nocapture). The samples equal the reference sampler's
+/// for the same u (the same map) to 1e-12 in mean cos θ.
 #[test]
 fn batch_throughput_of_the_pure_python_example() {
-    let cmd = format!("python3 {}/examples/external/ggx.py", root().display());
-    let model = start(&cmd, 30.0).unwrap();
+    let reference = Ggx::new(0.3, 0.3).unwrap();
     let n = 200_000usize;
     let u: Vec<[f64; 2]> = (0..n)
         .map(|i| {
@@ -106,50 +106,53 @@ fn batch_throughput_of_the_pure_python_example() {
             [(a * 7919.0).fract(), a]
         })
         .collect();
-    let mut out = vec![[0.0; 3]; n];
-    let t = Instant::now();
-    model.sample_wm_batch(&u, &mut out);
-    let seconds = t.elapsed().as_secs_f64();
-    assert_eq!(model.first_error(), None);
-    let reference = Ggx::new(0.3, 0.3).unwrap();
-    let (mut a, mut b) = (0.0, 0.0);
-    for (ui, m) in u.iter().zip(&out) {
-        a += m[2];
-        b += reference.sample_wm(*ui)[2];
+    let b: f64 = u.iter().map(|ui| reference.sample_wm(*ui)[2]).sum();
+    for protocol in [1, 2] {
+        let model = start(&example("ggx.py", &format!("--protocol {protocol}")), 30.0).unwrap();
+        let mut out = vec![[0.0; 3]; n];
+        let t = Instant::now();
+        model.sample_wm_batch(&u, &mut out);
+        let seconds = t.elapsed().as_secs_f64();
+        assert_eq!(model.first_error(), None);
+        let a: f64 = out.iter().map(|m| m[2]).sum();
+        eprintln!(
+            "pure-Python ggx.py, protocol {protocol}: {n} samples in {seconds:.3} s = {:.3e} \
+             samples/s through the protocol (shared machine: noisy); mean cos θ {:.6} vs \
+             reference {:.6}",
+            n as f64 / seconds,
+            a / n as f64,
+            b / n as f64
+        );
+        assert!((a - b).abs() / (n as f64) < 1e-12, "same u, same sampler");
+        // A scalar trait call is one round trip: its cost, measured.
+        let calls = 1000;
+        let t = Instant::now();
+        let mut sum = 0.0;
+        for i in 0..calls {
+            sum += model.d([0.0, (i as f64 * 1e-4).sin(), (i as f64 * 1e-4).cos()]);
+        }
+        let per_call = t.elapsed().as_secs_f64() / calls as f64;
+        assert!(sum.is_finite() && sum > 0.0, "{sum}");
+        eprintln!(
+            "pure-Python ggx.py, protocol {protocol}: one scalar round trip (d) costs {:.1} µs \
+             (mean of {calls})",
+            per_call * 1e6
+        );
+        model.shutdown();
     }
-    eprintln!(
-        "pure-Python ggx.py: {n} samples in {seconds:.3} s = {:.3e} samples/s through the \
-         protocol (shared machine: noisy); mean cos θ {:.6} vs reference {:.6}",
-        n as f64 / seconds,
-        a / n as f64,
-        b / n as f64
-    );
-    assert!((a - b).abs() / (n as f64) < 1e-12, "same u, same sampler");
-    // A scalar trait call is one round trip: its cost, measured.
-    let calls = 2000;
-    let t = Instant::now();
-    let mut sum = 0.0;
-    for i in 0..calls {
-        sum += model.d([0.0, (i as f64 * 1e-4).sin(), (i as f64 * 1e-4).cos()]);
-    }
-    let per_call = t.elapsed().as_secs_f64() / calls as f64;
-    assert!(sum.is_finite() && sum > 0.0, "{sum}");
-    eprintln!(
-        "pure-Python ggx.py: one scalar round trip (d) costs {:.1} µs (mean of {calls})",
-        per_call * 1e6
-    );
-    model.shutdown();
 }
 
 /// The per-request timeout of the misbehaviour test (seconds).
 const TIMEOUT: f64 = 3.0;
 
-struct Case {
-    mode: &'static str,
-    expect: fn(&ExternalError) -> bool,
-    /// Whether the failure comes at `describe` (start fails) rather than at `d`.
-    at_start: bool,
+/// The first 300 characters of an error message (an error quotes at most ~200 characters of
+/// what came back, but a test failure should not print more in any case).
+fn e_excerpt(text: &str) -> String {
+    text.chars().take(300).collect()
 }
+
+/// What a misbehaviour must produce.
+type Expect = fn(&ExternalError) -> bool;
 
 fn alive(pid: u32) -> bool {
     std::fs::read_to_string(format!("/proc/{pid}/stat"))
@@ -160,110 +163,123 @@ fn alive(pid: u32) -> bool {
         .unwrap_or(false)
 }
 
+/// Whether `e` is a malformed answer to the first `d` request whose reason contains `what`.
+fn malformed_d(e: &ExternalError, what: &str) -> bool {
+    matches!(e, ExternalError::Malformed { request, reason, .. }
+        if request.starts_with("d ") && reason.contains(what))
+}
+
 /// Each misbehaviour becomes its own clear error, naming the request, within the timeout
 /// (3 s here: python3 may take a second to start on a loaded machine) plus 5 s, and the child is
-/// gone afterwards.
+/// gone afterwards. The misbehaviours of version 1, then those of version 2's binary arrays
+/// (the child chose version 2 at describe), then a version-1 child answering base64.
 #[test]
 fn each_misbehaviour_is_a_clear_error_in_bounded_time() {
-    let cases = [
-        Case {
-            mode: "crash",
-            expect: |e| {
-                matches!(e, ExternalError::Exited { request, stderr, .. }
-                    if request.starts_with("d ") && stderr.contains("simulated crash"))
-            },
-            at_start: false,
-        },
-        Case {
-            mode: "hang",
-            expect: |e| matches!(e, ExternalError::Timeout { request, .. } if request.starts_with("d ")),
-            at_start: false,
-        },
-        Case {
-            mode: "garbage",
-            expect: |e| matches!(e, ExternalError::Malformed { got, .. } if got.contains("computing D")),
-            at_start: false,
-        },
-        Case {
-            mode: "nan",
-            expect: |e| matches!(e, ExternalError::NotANumber { index: 99, .. }),
-            at_start: false,
-        },
-        Case {
-            mode: "wrong_length",
-            expect: |e| {
-                matches!(
-                    e,
-                    ExternalError::WrongLength {
-                        asked: 100,
-                        got: 99,
-                        ..
-                    }
-                )
-            },
-            at_start: false,
-        },
-        Case {
-            mode: "wrong_id",
-            expect: |e| matches!(e, ExternalError::Malformed { reason, .. } if reason.contains("id")),
-            at_start: false,
-        },
-        Case {
-            mode: "early_exit",
-            expect: |e| {
-                matches!(e, ExternalError::Exited { request, status, .. }
-                    if request.starts_with("describe") && status.contains("0"))
-            },
-            at_start: true,
-        },
-        Case {
-            mode: "bad_describe",
-            expect: |e| matches!(e, ExternalError::Describe(m) if m.contains("\"d\"")),
-            at_start: true,
-        },
+    // (mode of misbehave.py, whether it fails at describe, what the error must be)
+    let cases: [(&str, bool, Expect); 14] = [
+        ("crash", false, |e| {
+            matches!(e, ExternalError::Exited { request, stderr, .. }
+                if request.starts_with("d ") && stderr.contains("simulated crash"))
+        }),
+        (
+            "hang",
+            false,
+            |e| matches!(e, ExternalError::Timeout { request, .. } if request.starts_with("d ")),
+        ),
+        (
+            "garbage",
+            false,
+            |e| matches!(e, ExternalError::Malformed { got, .. } if got.contains("computing D")),
+        ),
+        ("nan", false, |e| {
+            matches!(e, ExternalError::NotANumber { index: 99, .. })
+        }),
+        ("wrong_length", false, |e| {
+            matches!(
+                e,
+                ExternalError::WrongLength {
+                    asked: 100,
+                    got: 99,
+                    ..
+                }
+            )
+        }),
+        ("wrong_id", false, |e| malformed_d(e, "id")),
+        ("early_exit", true, |e| {
+            matches!(e, ExternalError::Exited { request, status, .. }
+                if request.starts_with("describe") && status.contains('0'))
+        }),
+        (
+            "bad_describe",
+            true,
+            |e| matches!(e, ExternalError::Describe(m) if m.contains("\"d\"")),
+        ),
+        ("bad_base64", false, |e| {
+            malformed_d(e, "\"values\": invalid base64") && e.to_string().contains("0.5, 0.5")
+        }),
+        ("short_array", false, |e| {
+            matches!(
+                e,
+                ExternalError::WrongLength {
+                    asked: 100,
+                    got: 99,
+                    ..
+                }
+            )
+        }),
+        ("ragged_array", false, |e| {
+            malformed_d(e, "798 bytes of base64-decoded data, not a whole number")
+        }),
+        (
+            "nan_binary",
+            false,
+            |e| matches!(e, ExternalError::NotANumber { index: 99, input, .. } if input.starts_with('[')),
+        ),
+        ("oversized", false, |e| {
+            malformed_d(e, &format!("longer than {} bytes", 64 << 20))
+        }),
+        ("base64_in_v1", false, |e| {
+            malformed_d(e, "protocol version 1 wants a JSON array")
+        }),
     ];
     let script = root().join("harness/tests/external/misbehave.py");
     let dir = std::env::temp_dir().join(format!("mfh-external-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mut failures = Vec::new();
-    for case in cases {
-        let pid_file = dir.join(case.mode);
-        let cmd = format!(
-            "python3 {} {} {}",
-            script.display(),
-            case.mode,
-            pid_file.display()
-        );
+    for (mode, at_start, expect) in cases {
+        let pid_file = dir.join(mode);
+        let cmd = format!("python3 {} {mode} {}", script.display(), pid_file.display());
         let t = Instant::now();
         let error = match start(&cmd, TIMEOUT) {
             Err(e) => {
-                assert!(case.at_start, "{}: start failed: {e}", case.mode);
+                assert!(at_start, "{mode}: start failed: {e}");
                 e
             }
             Ok(model) => {
-                assert!(!case.at_start, "{}: started", case.mode);
+                assert!(!at_start, "{mode}: started");
                 let d = model.d_batch(&directions(100));
-                let e = d.expect_err(case.mode);
+                let e = d.expect_err(mode);
                 // The trait methods answer NaN from now on, at once, and the first error stays.
                 assert!(model.d([0.0, 0.0, 1.0]).is_nan());
-                assert_eq!(model.first_error().as_ref(), Some(&e), "{}", case.mode);
+                assert_eq!(model.first_error().as_ref(), Some(&e), "{mode}");
                 drop(model);
                 e
             }
         };
         let seconds = t.elapsed().as_secs_f64();
-        eprintln!("{}: {seconds:.2} s: {error}", case.mode);
-        if !(case.expect)(&error) {
-            failures.push(format!("{}: unexpected error {error:?}", case.mode));
+        let shown = e_excerpt(&error.to_string());
+        eprintln!("{mode}: {seconds:.2} s: {shown}");
+        if !expect(&error) {
+            failures.push(format!("{mode}: unexpected error {shown}"));
         }
         if seconds > TIMEOUT + 5.0 {
-            failures.push(format!("{}: took {seconds} s", case.mode));
+            failures.push(format!("{mode}: took {seconds} s"));
         }
         if let Ok(pid) = std::fs::read_to_string(&pid_file) {
             let pid: u32 = pid.trim().parse().unwrap();
             std::thread::sleep(Duration::from_millis(100));
             if alive(pid) {
-                failures.push(format!("{}: child {pid} still running", case.mode));
+                failures.push(format!("{mode}: child {pid} still running"));
             }
         }
     }
@@ -279,47 +295,16 @@ fn each_misbehaviour_is_a_clear_error_in_bounded_time() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// The numpy example agrees with the reference like the pure-Python one, and its batch
-/// throughput is printed. Skipped with a message when numpy is absent and CI is unset (.ci/run
-/// installs numpy, so under CI it always runs).
+/// The numpy example agrees with the reference like the pure-Python one, in versions 1 and 2,
+/// and its batch throughput is printed. Skipped with a message when numpy is absent and CI is
+/// unset (.ci/run installs numpy, so under CI it always runs).
 #[test]
 fn numpy_example_agrees_and_its_throughput_is_printed() {
-    let has_numpy = std::process::Command::new("python3")
-        .args(["-c", "import numpy"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has_numpy {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI is set but numpy is missing: .ci/run installs it"
-        );
-        eprintln!("SKIPPED: numpy is not installed (python3 -m pip install numpy)");
+    if !has_numpy() {
         return;
     }
-    let cmd = format!(
-        "python3 {}/examples/external/ggx_numpy.py --alpha-x 0.1 --alpha-y 0.4",
-        root().display()
-    );
-    let model = start(&cmd, 30.0).unwrap();
     let reference = Ggx::new(0.1, 0.4).unwrap();
     let dirs = directions(20_000);
-    let d = model.d_batch(&dirs).unwrap();
-    let lambda = model.lambda_batch(&dirs).unwrap();
-    for (i, &w) in dirs.iter().enumerate() {
-        let r = reference.d(w);
-        assert!(
-            (d[i] - r).abs() <= 1e-12 * r.abs(),
-            "D at {w:?}: {} vs {r}",
-            d[i]
-        );
-        if w[2] > 0.0 {
-            let l = reference.lambda(w);
-            assert!(
-                (lambda[i] - l).abs() <= 1e-12 * l.abs().max(1e-300),
-                "Λ at {w:?}"
-            );
-        }
-    }
     let n = 500_000usize;
     let u: Vec<[f64; 2]> = (0..n)
         .map(|i| {
@@ -329,11 +314,6 @@ fn numpy_example_agrees_and_its_throughput_is_printed() {
             ]
         })
         .collect();
-    let mut out = vec![[0.0; 3]; n];
-    let t = Instant::now();
-    model.sample_wm_batch(&u, &mut out);
-    let seconds = t.elapsed().as_secs_f64();
-    assert_eq!(model.first_error(), None);
     // The example's own map (slope (α_x ρ cos φ, α_y ρ sin φ), m ∝ (−p, −q, 1)), which is
     // the reference's up to the sign of the slope; the distribution is checked by the audit.
     let map = |u: [f64; 2]| {
@@ -343,38 +323,55 @@ fn numpy_example_agrees_and_its_throughput_is_printed() {
         let n = (1.0 + px * px + py * py).sqrt();
         [-px / n, -py / n, 1.0 / n]
     };
-    for (ui, m) in u.iter().zip(&out).step_by(997) {
-        let r = map(*ui);
-        assert!(
-            (0..3).all(|k| (m[k] - r[k]).abs() < 1e-12),
-            "{ui:?}: {m:?} vs {r:?}"
+    for protocol in [1, 2] {
+        let args = format!("--alpha-x 0.1 --alpha-y 0.4 --protocol {protocol}");
+        let model = start(&example("ggx_numpy.py", &args), 30.0).unwrap();
+        assert_eq!(model.version(), protocol);
+        let d = model.d_batch(&dirs).unwrap();
+        let lambda = model.lambda_batch(&dirs).unwrap();
+        for (i, &w) in dirs.iter().enumerate() {
+            let r = reference.d(w);
+            assert!(
+                (d[i] - r).abs() <= 1e-12 * r.abs(),
+                "D at {w:?}: {} vs {r}",
+                d[i]
+            );
+            if w[2] > 0.0 {
+                let l = reference.lambda(w);
+                assert!(
+                    (lambda[i] - l).abs() <= 1e-12 * l.abs().max(1e-300),
+                    "Λ at {w:?}"
+                );
+            }
+        }
+        let mut out = vec![[0.0; 3]; n];
+        let t = Instant::now();
+        model.sample_wm_batch(&u, &mut out);
+        let seconds = t.elapsed().as_secs_f64();
+        assert_eq!(model.first_error(), None);
+        for (ui, m) in u.iter().zip(&out).step_by(997) {
+            let r = map(*ui);
+            assert!(
+                (0..3).all(|k| (m[k] - r[k]).abs() < 1e-12),
+                "{ui:?}: {m:?} vs {r:?}"
+            );
+        }
+        eprintln!(
+            "numpy ggx_numpy.py, protocol {protocol}: {n} samples in {seconds:.3} s = {:.3e} \
+             samples/s through the protocol (shared machine: noisy)",
+            n as f64 / seconds
         );
+        model.shutdown();
     }
-    eprintln!(
-        "numpy ggx_numpy.py: {n} samples in {seconds:.3} s = {:.3e} samples/s through the \
-         protocol (shared machine: noisy)",
-        n as f64 / seconds
-    );
-    model.shutdown();
 }
 
 /// `mfh audit-external`: a child that cannot describe itself, or a bad --timeout, is bad input
 /// (exit 2) with a message naming the request or the flag.
 #[test]
 fn audit_external_cli_bad_input_exits_2() {
-    let run = |args: &[&str]| {
-        let (mut out, mut err) = (Vec::new(), Vec::new());
-        let code = mfh_harness::cli::run(
-            std::iter::once("mfh").chain(args.iter().copied()),
-            &mut std::io::empty(),
-            &mut out,
-            &mut err,
-        );
-        (code, String::from_utf8(err).unwrap())
-    };
     let out = std::env::temp_dir().join(format!("mfh-external-cli-{}", std::process::id()));
     let out = out.to_str().unwrap();
-    let (code, err) = run(&[
+    let (code, _, err) = run(&[
         "audit-external",
         "--cmd",
         "/nonexistent/mfh-no-such-program",
@@ -383,7 +380,7 @@ fn audit_external_cli_bad_input_exits_2() {
     ]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("describe") && err.contains("127"), "{err}");
-    let (code, err) = run(&["audit-external", "--cmd", "true", "--timeout", "0"]);
+    let (code, _, err) = run(&["audit-external", "--cmd", "true", "--timeout", "0"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("--timeout"), "{err}");
     let _ = std::fs::remove_dir_all(out);

@@ -3,32 +3,17 @@
 //! the deliberately wrong sampler fails `sampling.chi2` (and nothing that does not depend on its
 //! samples), and `mfh chi2 --cmd` tests an external sampler as `--model` tests a reference one.
 
+#[path = "external/common.rs"]
+mod common;
+
+use common::{example, extensive, has_numpy, run};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn example(file: &str) -> String {
-    format!("python3 {}/examples/external/{file}", root().display())
-}
-
-fn run(args: &[&str]) -> (i32, String, String) {
-    let (mut out, mut err) = (Vec::new(), Vec::new());
-    let code = mfh_harness::cli::run(
-        std::iter::once("mfh").chain(args.iter().copied()),
-        &mut std::io::empty(),
-        &mut out,
-        &mut err,
-    );
-    (
-        code,
-        String::from_utf8(out).unwrap(),
-        String::from_utf8(err).unwrap(),
-    )
-}
+/// Why the pure-Python GGX audits are extensive tier.
+const SLOW_PURE_PYTHON: &str = "the pure-Python child answers ~46 000 small KS-table requests; \
+                                minutes on 2 cores";
 
 fn temp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("mfh-{name}-{}", std::process::id()))
@@ -38,7 +23,7 @@ fn temp(name: &str) -> PathBuf {
 /// checks whose records failed (or erred), printing the time it took.
 fn audit(file: &str, against: Option<&str>) -> (i32, Vec<String>, Value) {
     let out = temp(&format!("audit-{file}"));
-    let cmd = example(file);
+    let cmd = example(file, "");
     let mut args = vec![
         "audit-external",
         "--cmd",
@@ -74,11 +59,7 @@ fn audit(file: &str, against: Option<&str>) -> (i32, Vec<String>, Value) {
 
 #[test]
 fn the_pure_python_ggx_passes_the_ci_audit() {
-    if std::env::var_os("MFH_EXTENSIVE").is_none() {
-        eprintln!(
-            "skipped: extensive tier (the pure-Python child answers ~46 000 small KS-table \
-             requests; minutes on 2 cores), run with MFH_EXTENSIVE=1"
-        );
+    if !extensive(SLOW_PURE_PYTHON) {
         return;
     }
     let (code, failing, report) = audit("ggx.py", Some(r#"{"family":"ggx","alpha":0.3}"#));
@@ -111,16 +92,7 @@ fn the_pure_python_beckmann_passes_the_ci_audit() {
 
 #[test]
 fn the_numpy_ggx_passes_the_ci_audit() {
-    let has_numpy = std::process::Command::new("python3")
-        .args(["-c", "import numpy"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has_numpy {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI is set but numpy is missing: .ci/run installs it"
-        );
-        eprintln!("SKIPPED: numpy is not installed (python3 -m pip install numpy)");
+    if !has_numpy() {
         return;
     }
     let (code, failing, _) = audit("ggx_numpy.py", Some(r#"{"family":"ggx","alpha":0.3}"#));
@@ -131,11 +103,7 @@ fn the_numpy_ggx_passes_the_ci_audit() {
 /// look at its samples (D, Λ, the value comparison) passes.
 #[test]
 fn the_wrong_sampler_fails_the_chi_square_check() {
-    if std::env::var_os("MFH_EXTENSIVE").is_none() {
-        eprintln!(
-            "skipped: extensive tier (the pure-Python child answers ~46 000 small KS-table \
-             requests; minutes on 2 cores), run with MFH_EXTENSIVE=1"
-        );
+    if !extensive(SLOW_PURE_PYTHON) {
         return;
     }
     let (code, failing, _) = audit("ggx_wrong_sampler.py", None);
@@ -161,7 +129,7 @@ fn chi2_cmd_tests_an_external_sampler() {
     let out = temp("chi2-cmd");
     let dir = out.to_str().unwrap();
     let common = ["--samples", "200000", "--resolution", "8", "--seed", "3"];
-    let cmd = example("ggx.py");
+    let cmd = example("ggx.py", "");
     let mut args = vec!["chi2", "--cmd", &cmd, "--json", "--out", dir];
     args.extend(common);
     let (code, stdout, stderr) = run(&args);
@@ -232,22 +200,18 @@ fn chi2_cmd_tests_an_external_sampler() {
     let (code, stdout, stderr) = run(&args);
     assert_eq!(code, 0, "{stdout}{stderr}");
     // The wrong sampler fails.
-    let wrong = example("ggx_wrong_sampler.py");
+    let wrong = example("ggx_wrong_sampler.py", "");
     let mut args = vec!["chi2", "--cmd", &wrong, "--json"];
     args.extend(common);
     let (code, stdout, _) = run(&args);
     assert_eq!(code, 1, "{stdout}");
     // No visible sampler declared (the numpy example): bad input naming the capability; and
     // --cmd with --model is bad input.
-    let numpy = example("ggx_numpy.py");
+    let numpy = example("ggx_numpy.py", "");
     let mut args = vec!["chi2", "--cmd", &numpy, "--sampling", "visible"];
     args.extend(common);
     let (code, _, stderr) = run(&args);
-    if std::process::Command::new("python3")
-        .args(["-c", "import numpy"])
-        .status()
-        .is_ok_and(|s| s.success())
-    {
+    if has_numpy() {
         assert_eq!(code, 2, "{stderr}");
         assert!(stderr.contains("sample_wm_visible"), "{stderr}");
     }

@@ -8,7 +8,7 @@
 //! runner appends an `external.protocol` error record with the message.
 
 use super::process::{ExternalError, Session};
-use super::protocol::{Answer, Description, Number, Request};
+use super::protocol::{Answer, Description, Item, Request, Wire};
 use mfh_reference::model::{visible_domain, NormalSampler, Smith, VisibleNormalSampler};
 use mfh_reference::{Masking, Ndf, Vec3};
 use std::sync::Mutex;
@@ -23,6 +23,7 @@ const NAN3: Vec3 = [f64::NAN; 3];
 pub struct ExternalModel {
     session: Mutex<Session>,
     description: Description,
+    version: u32,
     first_error: Mutex<Option<ExternalError>>,
 }
 
@@ -36,10 +37,16 @@ impl ExternalModel {
             return Err(ExternalError::Describe(e));
         }
         Ok(Self {
+            version: session.version(),
             session: Mutex::new(session),
             description,
             first_error: Mutex::new(None),
         })
+    }
+
+    /// The protocol version spoken (the child's choice at `describe`).
+    pub fn version(&self) -> u32 {
+        self.version
     }
 
     /// What the child said of itself.
@@ -81,30 +88,7 @@ impl ExternalModel {
         inputs: &dyn Fn(usize) -> String,
     ) -> Result<Vec<f64>, ExternalError> {
         let answer = self.call(request)?;
-        let label = || format!("{} ({} items)", request.op(), request.len());
-        let values = answer.values.ok_or_else(|| {
-            self.record(ExternalError::Malformed {
-                request: label(),
-                reason: "the answer has no \"values\" array".into(),
-                got: String::new(),
-            })
-        })?;
-        if values.len() != request.len() {
-            return Err(self.record(ExternalError::WrongLength {
-                request: label(),
-                asked: request.len(),
-                got: values.len(),
-            }));
-        }
-        let values: Vec<f64> = values.into_iter().map(Number::value).collect();
-        if let Some(index) = values.iter().position(|v| v.is_nan()) {
-            return Err(self.record(ExternalError::NotANumber {
-                request: label(),
-                index,
-                input: inputs(index),
-            }));
-        }
-        Ok(values)
+        self.items(request, inputs, "values", answer.values)
     }
 
     /// Sends one sampling request and checks the answer: one direction per item, no NaN.
@@ -114,33 +98,49 @@ impl ExternalModel {
         inputs: &dyn Fn(usize) -> String,
     ) -> Result<Vec<Vec3>, ExternalError> {
         let answer = self.call(request)?;
+        let numbers = self.items(request, inputs, "m", answer.m)?;
+        Ok(numbers
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect())
+    }
+
+    /// Checks an answer's array `field` against `request`: present, decodable in the session's
+    /// protocol version, one item per item asked, no NaN. Its numbers, row-major.
+    fn items<T: Item>(
+        &self,
+        request: &Request<'_>,
+        inputs: &dyn Fn(usize) -> String,
+        field: &str,
+        wire: Option<Wire<T>>,
+    ) -> Result<Vec<f64>, ExternalError> {
         let label = || format!("{} ({} items)", request.op(), request.len());
-        let m = answer.m.ok_or_else(|| {
-            self.record(ExternalError::Malformed {
-                request: label(),
-                reason: "the answer has no \"m\" array".into(),
-                got: String::new(),
-            })
-        })?;
-        if m.len() != request.len() {
+        let malformed = |reason: String| ExternalError::Malformed {
+            request: label(),
+            reason,
+            got: String::new(),
+        };
+        let wire = wire
+            .ok_or_else(|| self.record(malformed(format!("the answer has no {field:?} array"))))?;
+        let numbers = wire
+            .numbers(self.version)
+            .map_err(|e| self.record(malformed(format!("{field:?}: {e}"))))?;
+        let got = numbers.len() / T::WIDTH;
+        if got != request.len() {
             return Err(self.record(ExternalError::WrongLength {
                 request: label(),
                 asked: request.len(),
-                got: m.len(),
+                got,
             }));
         }
-        let m: Vec<Vec3> = m
-            .into_iter()
-            .map(|[x, y, z]| [x.value(), y.value(), z.value()])
-            .collect();
-        if let Some(index) = m.iter().position(|v| v.iter().any(|c| c.is_nan())) {
+        if let Some(index) = numbers.iter().position(|v| v.is_nan()) {
             return Err(self.record(ExternalError::NotANumber {
                 request: label(),
-                index,
-                input: inputs(index),
+                index: index / T::WIDTH,
+                input: inputs(index / T::WIDTH),
             }));
         }
-        Ok(m)
+        Ok(numbers)
     }
 
     /// Records an error found in an answer (the session itself is still alive: stop it).
@@ -182,11 +182,7 @@ impl ExternalModel {
     /// `sample_wm` for a batch of uniform pairs, written into `out` (same length as `u`). On a
     /// protocol error `out` is filled with NaN directions and the error is recorded.
     pub fn sample_wm_batch(&self, u: &[[f64; 2]], out: &mut [Vec3]) {
-        assert_eq!(
-            u.len(),
-            out.len(),
-            "sample_wm_batch: u and out differ in length"
-        );
+        same_length("sample_wm_batch", "u", u.len(), out.len());
         for (start, chunk) in (0..u.len())
             .step_by(MAX_BATCH)
             .zip(out.chunks_mut(MAX_BATCH))
@@ -223,6 +219,12 @@ fn chunked(
     Ok(out)
 }
 
+/// The batch methods' contract: as many outputs as inputs (a caller's bug otherwise: panics).
+#[track_caller]
+fn same_length(method: &str, input: &str, n_in: usize, n_out: usize) {
+    assert_eq!(n_in, n_out, "{method}: {input} and out differ in length");
+}
+
 fn show(v: Vec3) -> String {
     format!("[{}, {}, {}]", v[0], v[1], v[2])
 }
@@ -245,7 +247,7 @@ impl Ndf for ExternalModel {
     }
     /// D through the protocol: up to 65 536 directions per request.
     fn d_batch(&self, m: &[Vec3], out: &mut [f64]) {
-        assert_eq!(m.len(), out.len(), "d_batch: m and out differ in length");
+        same_length("d_batch", "m", m.len(), out.len());
         fill(out, ExternalModel::d_batch(self, m));
     }
     fn as_smith(&self) -> Option<&dyn Smith> {
@@ -269,11 +271,7 @@ impl Smith for ExternalModel {
     }
     /// Λ through the protocol: up to 65 536 directions per request.
     fn lambda_batch(&self, w: &[Vec3], out: &mut [f64]) {
-        assert_eq!(
-            w.len(),
-            out.len(),
-            "lambda_batch: w and out differ in length"
-        );
+        same_length("lambda_batch", "w", w.len(), out.len());
         fill(out, ExternalModel::lambda_batch(self, w));
     }
     fn g1(&self, w: Vec3, m: Vec3) -> f64 {
@@ -342,11 +340,7 @@ impl NormalSampler for ExternalModel {
     }
     /// pdf_wm through the protocol (D(m) m_z from a `d` batch when not declared).
     fn pdf_wm_batch(&self, m: &[Vec3], out: &mut [f64]) {
-        assert_eq!(
-            m.len(),
-            out.len(),
-            "pdf_wm_batch: m and out differ in length"
-        );
+        same_length("pdf_wm_batch", "m", m.len(), out.len());
         if self.description.has("pdf_wm") {
             return fill(out, ExternalModel::pdf_wm_batch(self, m));
         }
@@ -394,11 +388,7 @@ impl VisibleNormalSampler for ExternalModel {
     /// sample_wm_visible through the protocol: up to 65 536 pairs per request (NaN directions
     /// outside the domain, and after a protocol error).
     fn sample_wm_visible_batch(&self, wi: Vec3, u: &[[f64; 2]], out: &mut [Vec3]) {
-        assert_eq!(
-            u.len(),
-            out.len(),
-            "sample_wm_visible_batch: u and out differ in length"
-        );
+        same_length("sample_wm_visible_batch", "u", u.len(), out.len());
         if !visible_domain(wi) {
             return out.fill(NAN3);
         }
@@ -425,11 +415,7 @@ impl VisibleNormalSampler for ExternalModel {
     }
     /// pdf_wm_visible through the protocol (from `d` and Λ batches when not declared).
     fn pdf_wm_visible_batch(&self, wi: Vec3, m: &[Vec3], out: &mut [f64]) {
-        assert_eq!(
-            m.len(),
-            out.len(),
-            "pdf_wm_visible_batch: m and out differ in length"
-        );
+        same_length("pdf_wm_visible_batch", "m", m.len(), out.len());
         if !visible_domain(wi) {
             return out.fill(0.0);
         }

@@ -1,12 +1,12 @@
-//! The child process: started with `sh -c`, spoken to by JSON lines, read with a timeout,
-//! killed and reaped on drop.
+//! The child process: started with `sh -c`, spoken to by JSON lines (in the protocol version
+//! it chose at `describe`), read with a timeout, killed and reaped on drop.
 //!
 //! Reading stdout with a timeout needs a reader thread and a channel (std has no timed read on
 //! a pipe); writing goes through a writer thread too, so that a child that stops reading its
 //! stdin cannot block mfh on a full pipe. Both threads end when the child's pipes close, which
 //! killing the child guarantees.
 
-use super::protocol::{quote_non_finite, Answer, Description, Request};
+use super::protocol::{quote_non_finite, Answer, Description, Request, VERSIONS};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
@@ -18,7 +18,9 @@ use std::time::Duration;
 /// (≈ 0.3 s measured), short enough that a hung child is reported within a CI step.
 pub const DEFAULT_TIMEOUT_SECONDS: f64 = 10.0;
 
-/// The longest answer line accepted (bytes): a batch of 65 536 directions is ≈ 4 MB.
+/// The longest answer line accepted (bytes, 64 MiB): the bound on an answer's size, and so on
+/// the memory one answer takes (the line, then its decoded numbers, ≤ 3/4 of it in version 2).
+/// A batch of 65 536 directions is ≈ 4 MB as version-1 text, 2.1 MB as version-2 base64.
 pub const MAX_LINE_BYTES: u64 = 64 << 20;
 
 /// How much of the child's stderr is kept for error messages (bytes, the last ones).
@@ -56,13 +58,13 @@ pub enum ExternalError {
         stderr: String,
     },
     /// The answer is not the JSON object the protocol asks for.
-    #[error("request {request}: malformed answer ({reason}); got: {got}")]
+    #[error("request {request}: malformed answer ({reason}){}", got_suffix(.got))]
     Malformed {
         /// The request.
         request: String,
         /// What is wrong.
         reason: String,
-        /// The start of what came back.
+        /// The start of what came back (empty when the reason quotes it, or nothing came).
         got: String,
     },
     /// The child answered with its own error.
@@ -121,6 +123,7 @@ pub struct Session {
     timeout: Duration,
     next_id: u64,
     failed: bool,
+    version: u32,
 }
 
 impl Session {
@@ -160,7 +163,14 @@ impl Session {
             timeout,
             next_id: 0,
             failed: false,
+            version: 1,
         })
+    }
+
+    /// The protocol version spoken: 1 until `describe` has been answered, then the child's
+    /// choice (when mfh speaks it).
+    pub fn version(&self) -> u32 {
+        self.version
     }
 
     /// The command the child was started with.
@@ -174,17 +184,23 @@ impl Session {
         self.call_line(request).map(|(answer, _)| answer)
     }
 
-    /// The `describe` exchange: the child's description, parsed from its answer line.
+    /// The `describe` exchange: the child's description, parsed from its answer line. Later
+    /// requests use the version it chose, if mfh speaks it ([`VERSIONS`]; otherwise
+    /// [`Description::validate`] refuses it).
     pub fn describe(&mut self) -> Result<Description, ExternalError> {
         let (_, line) = self.call_line(&Request::Describe)?;
         let parsed = serde_json::from_str::<Description>(&quote_non_finite(line.trim()));
-        parsed.map_err(|e| {
+        let description = parsed.map_err(|e| {
             self.fail();
             ExternalError::Describe(format!(
                 "the answer is not a description ({e}); got: {}",
                 excerpt(&line)
             ))
-        })
+        })?;
+        if VERSIONS.contains(&description.protocol) {
+            self.version = description.protocol;
+        }
+        Ok(description)
     }
 
     /// Marks the session failed (an answer was unusable) and kills the child.
@@ -214,7 +230,7 @@ impl Session {
         id: u64,
         label: &str,
     ) -> Result<(Answer, String), ExternalError> {
-        let mut bytes = request.to_line(id).into_bytes();
+        let mut bytes = request.to_line(id, self.version).into_bytes();
         bytes.push(b'\n');
         let sent = self
             .to_child
@@ -254,8 +270,17 @@ impl Session {
             reason,
             got: excerpt(&line),
         };
-        let answer: Answer = serde_json::from_str(&quote_non_finite(line.trim()))
-            .map_err(|e| malformed(format!("not a JSON answer object: {e}")))?;
+        // Version 1 may write Python's bare NaN / Infinity tokens; version 2's arrays are
+        // base64 (in which "NaN" occurs by chance), so its lines are quoted only if they fail
+        // to parse as they are (a version-2 answer may carry small JSON arrays).
+        let parsed = if self.version < 2 {
+            serde_json::from_str(&quote_non_finite(line.trim()))
+        } else {
+            serde_json::from_str(line.trim())
+                .or_else(|_| serde_json::from_str(&quote_non_finite(line.trim())))
+        };
+        let answer: Answer =
+            parsed.map_err(|e| malformed(format!("not a JSON answer object: {e}")))?;
         if answer.id != Some(id) {
             return Err(malformed(format!(
                 "the answer's id is {:?}, expected {id}",
@@ -321,7 +346,9 @@ impl Session {
     pub fn shutdown(&mut self) {
         if !self.failed {
             if let Some(tx) = &self.to_child {
-                let mut line = Request::Shutdown.to_line(self.next_id).into_bytes();
+                let mut line = Request::Shutdown
+                    .to_line(self.next_id, self.version)
+                    .into_bytes();
                 line.push(b'\n');
                 let _ = tx.send(line);
             }
@@ -357,7 +384,11 @@ fn read_lines(stdout: impl Read, tx: Sender<Line>) {
             Ok(_) if buf.last() != Some(&b'\n') && buf.len() as u64 >= MAX_LINE_BYTES => {
                 Line::TooLong
             }
-            Ok(_) => Line::Text(String::from_utf8_lossy(&buf).into_owned()),
+            // Valid UTF-8 (every well-formed answer) is taken without a copy.
+            Ok(_) => Line::Text(
+                String::from_utf8(buf)
+                    .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()),
+            ),
             Err(e) => Line::Failed(e.to_string()),
         };
         let stop = !matches!(line, Line::Text(_));
@@ -386,6 +417,15 @@ fn keep_tail(mut pipe: impl Read, tail: Arc<Mutex<Vec<u8>>>) {
             let excess = t.len().saturating_sub(STDERR_TAIL_BYTES);
             t.drain(..excess);
         }
+    }
+}
+
+/// "; got: …" after a malformed-answer message, unless there is nothing to show.
+fn got_suffix(got: &str) -> String {
+    if got.is_empty() {
+        String::new()
+    } else {
+        format!("; got: {got}")
     }
 }
 
