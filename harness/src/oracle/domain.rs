@@ -239,35 +239,44 @@ impl CellFinder {
         }
         let (last_row, last_column) = (self.grid.rows() as i32 - 1, columns as i32 - 1);
         let per_radian = self.columns_per_radian;
-        let mut row = [0i32; FIND_BLOCK];
-        let mut column = [0i32; FIND_BLOCK];
-        let mut clear = [false; FIND_BLOCK];
+        let (mut x, mut y, mut z) = ([0.0; FIND_BLOCK], [0.0; FIND_BLOCK], [0.0; FIND_BLOCK]);
+        let mut t = [0.0; FIND_BLOCK];
+        let mut estimate = [0.0; FIND_BLOCK];
+        let mut valid = [false; FIND_BLOCK];
         let mut inside = true;
         for (m, cells) in m.chunks(FIND_BLOCK).zip(cells.chunks_mut(FIND_BLOCK)) {
-            for (((&[x, y, z], row), column), clear) in m
+            let n = m.len();
+            // Components apart (three arrays), so the arithmetic pass loads whole vectors.
+            for (i, m) in m.iter().enumerate() {
+                (x[i], y[i], z[i]) = (m[0], m[1], m[2]);
+            }
+            // Zipped slices of one length: no bounds checks, so the loop vectorizes.
+            for (((((&x, &y), &z), valid), t), estimate) in x[..n]
                 .iter()
-                .zip(row.iter_mut())
-                .zip(column.iter_mut())
-                .zip(clear.iter_mut())
+                .zip(&y[..n])
+                .zip(&z[..n])
+                .zip(&mut valid[..n])
+                .zip(&mut t[..n])
+                .zip(&mut estimate[..n])
             {
                 let squared = x * x + y * y + z * z;
-                let valid = (squared >= low) & (squared <= high) & (z >= 0.0);
-                let t = z * rows;
-                // `as i32` saturates (NaN → 0): defined for every input, and for a valid
-                // direction (0 ≤ t ≤ R(1 + 1e-6)) it is `cell_of`'s ⌊t⌋ through i64.
-                let floor = t as i32;
-                let fraction = t - floor as f64;
-                *clear = valid & (fraction > margin) & (fraction < 1.0 - margin);
-                *row = floor.min(last_row);
-                *column = ((approximate_azimuth(x, y) * per_radian) as i32).clamp(0, last_column);
+                *valid = (squared >= low) & (squared <= high) & (z >= 0.0);
+                *t = z * rows;
+                *estimate = approximate_azimuth(x, y) * per_radian;
             }
             for (i, (cell, &m)) in cells.iter_mut().zip(m).enumerate() {
-                let j = column[i] as usize;
-                let (x, y) = (m[0], m[1]);
+                // `as i32` saturates (NaN → 0): defined for every input, and for a valid
+                // direction (0 ≤ t ≤ R(1 + 1e-6)) it is `cell_of`'s ⌊t⌋ through i64.
+                let floor = t[i] as i32;
+                let fraction = t[i] - floor as f64;
+                let clear = valid[i] & (fraction > margin) & (fraction < 1.0 - margin);
+                let row = floor.min(last_row) as usize;
+                let j = (estimate[i] as i32).clamp(0, last_column) as usize;
+                let (x, y) = (x[i], y[i]);
                 let at = (j == 0) | self.past(j, x, y);
                 let beyond = (j + 1 < columns) & self.past(j + 1, x, y);
-                *cell = if clear[i] & at & !beyond {
-                    row[i] as usize * columns + j
+                *cell = if clear & at & !beyond {
+                    row * columns + j
                 } else {
                     match self.cell_of(m) {
                         Ok(c) => c,
@@ -392,7 +401,9 @@ fn approximate_azimuth(x: f64, y: f64) -> f64 {
     const A: [f64; 5] = [0.999_866, -0.330_299_5, 0.180_141, -0.085_133, 0.020_835_1];
     let (ax, ay) = (x.abs(), y.abs());
     let steep = ay > ax;
-    let q = if steep { ax / ay } else { ay / ax };
+    // min / max, not a select between two quotients (which the compiler turns into a branch
+    // to spare a division).
+    let q = ax.min(ay) / ax.max(ay);
     let q2 = q * q;
     let mut a = q * (A[0] + q2 * (A[1] + q2 * (A[2] + q2 * (A[3] + q2 * A[4]))));
     a = if steep { FRAC_PI_2 - a } else { a };
