@@ -214,12 +214,13 @@ impl CellFinder {
     /// Two passes per sub-block of [`FIND_BLOCK`] directions. The first is straight-line
     /// arithmetic the compiler vectorizes (no branch, no table): the domain test on |m|², the
     /// row ⌊z·R⌋ and whether z·R is clear of the row edges by `row_margin`, and the column
-    /// estimate of [`approximate_azimuth`]. The second reads the two column boundaries b_j,
-    /// b_{j+1} of each estimate j and accepts it if the direction is at or past b_j and not
-    /// past b_{j+1} — the point where both searches of [`CellFinder::cell_of`] (which starts
-    /// from the same estimate) stop at once, so the answer is its answer. Anything else (a
-    /// direction outside the domain, near a row edge, or an estimate off by a column: at
-    /// R = 64, a fraction ~4e-4 of directions) goes through [`CellFinder::cell_of`].
+    /// estimate j of [`approximate_azimuth`]. The second reads the two column boundaries b_j,
+    /// b_{j+1} of each estimate and accepts j if the direction is strictly past b_j (or j = 0)
+    /// and strictly before b_{j+1} (or j = 2R − 1) — where both searches of
+    /// [`CellFinder::cell_of`] (which starts from the same estimate) stop at once, so the
+    /// answer is its answer. Anything else (a direction outside the domain, near a row edge,
+    /// on a column edge, or an estimate off by a column: at R = 64, a fraction ~4e-4 of
+    /// directions) goes through [`CellFinder::cell_of`].
     ///
     /// # Panics
     /// If `m` and `cells` differ in length.
@@ -240,43 +241,57 @@ impl CellFinder {
         let (last_row, last_column) = (self.grid.rows() as i32 - 1, columns as i32 - 1);
         let per_radian = self.columns_per_radian;
         let (mut x, mut y, mut z) = ([0.0; FIND_BLOCK], [0.0; FIND_BLOCK], [0.0; FIND_BLOCK]);
-        let mut t = [0.0; FIND_BLOCK];
-        let mut estimate = [0.0; FIND_BLOCK];
-        let mut valid = [false; FIND_BLOCK];
+        let mut row = [0i32; FIND_BLOCK];
+        let mut column = [0i32; FIND_BLOCK];
+        let mut clear = [false; FIND_BLOCK];
         let mut inside = true;
         for (m, cells) in m.chunks(FIND_BLOCK).zip(cells.chunks_mut(FIND_BLOCK)) {
             let n = m.len();
             // Components apart (three arrays), so the arithmetic pass loads whole vectors.
-            for (i, m) in m.iter().enumerate() {
-                (x[i], y[i], z[i]) = (m[0], m[1], m[2]);
+            for (((m, x), y), z) in m.iter().zip(&mut x).zip(&mut y).zip(&mut z) {
+                (*x, *y, *z) = (m[0], m[1], m[2]);
             }
             // Zipped slices of one length: no bounds checks, so the loop vectorizes.
-            for (((((&x, &y), &z), valid), t), estimate) in x[..n]
+            for (((((&x, &y), &z), clear), row), column) in x[..n]
                 .iter()
                 .zip(&y[..n])
                 .zip(&z[..n])
-                .zip(&mut valid[..n])
-                .zip(&mut t[..n])
-                .zip(&mut estimate[..n])
+                .zip(&mut clear[..n])
+                .zip(&mut row[..n])
+                .zip(&mut column[..n])
             {
                 let squared = x * x + y * y + z * z;
-                *valid = (squared >= low) & (squared <= high) & (z >= 0.0);
-                *t = z * rows;
-                *estimate = approximate_azimuth(x, y) * per_radian;
-            }
-            for (i, (cell, &m)) in cells.iter_mut().zip(m).enumerate() {
+                let valid = (squared >= low) & (squared <= high) & (z >= 0.0);
+                let t = z * rows;
                 // `as i32` saturates (NaN → 0): defined for every input, and for a valid
                 // direction (0 ≤ t ≤ R(1 + 1e-6)) it is `cell_of`'s ⌊t⌋ through i64.
-                let floor = t[i] as i32;
-                let fraction = t[i] - floor as f64;
-                let clear = valid[i] & (fraction > margin) & (fraction < 1.0 - margin);
-                let row = floor.min(last_row) as usize;
-                let j = (estimate[i] as i32).clamp(0, last_column) as usize;
-                let (x, y) = (x[i], y[i]);
-                let at = (j == 0) | self.past(j, x, y);
-                let beyond = (j + 1 < columns) & self.past(j + 1, x, y);
-                *cell = if clear & at & !beyond {
-                    row * columns + j
+                let floor = t as i32;
+                let fraction = t - floor as f64;
+                *clear = valid & (fraction > margin) & (fraction < 1.0 - margin);
+                *row = floor.min(last_row);
+                *column = ((approximate_azimuth(x, y) * per_radian) as i32).clamp(0, last_column);
+            }
+            for ((((((cell, &m), &clear), &row), &column), &x), &y) in cells
+                .iter_mut()
+                .zip(m)
+                .zip(&clear[..n])
+                .zip(&row[..n])
+                .zip(&column[..n])
+                .zip(&x[..n])
+                .zip(&y[..n])
+            {
+                // Strict side tests (a direction exactly on b_j or b_{j+1} goes through
+                // `cell_of`, which breaks the tie): past b_j if b_j × (x, y) > 0, not past
+                // b_{j+1} if b_{j+1} × (x, y) < 0 (`boundaries` has 2R + 1 entries).
+                let j = column as usize;
+                let cross = |j: usize| {
+                    let [c, s] = self.boundaries[j];
+                    c * y - s * x
+                };
+                let at = (j == 0) | (cross(j) > 0.0);
+                let before_next = (j + 1 == columns) | (cross(j + 1) < 0.0);
+                *cell = if clear & at & before_next {
+                    row as usize * columns + j
                 } else {
                     match self.cell_of(m) {
                         Ok(c) => c,
@@ -305,8 +320,7 @@ impl CellFinder {
     }
 
     /// Whether (x, y) is at or past column boundary j (0 ≤ j ≤ 2R): φ − φ_j ∈ [0, π), on the
-    /// boundary counting as past (b_j × (x, y) > 0, or = 0 with b_j · (x, y) > 0). `&` and `|`,
-    /// not `&&` and `||`: no branch.
+    /// boundary counting as past (b_j × (x, y) > 0, or = 0 with b_j · (x, y) > 0).
     #[inline(always)]
     fn past(&self, j: usize, x: f64, y: f64) -> bool {
         let [c, s] = self.boundaries[j];
