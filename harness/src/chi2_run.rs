@@ -4,10 +4,10 @@
 //! CLI (`cli/chi2.rs`) maps errors to exit codes and writes tables and heat maps.
 
 use crate::oracle::chi2::{
-    chi2_test_in, Chi2Config, Chi2Result, CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE,
-    MIN_EXPECTED,
+    chi2_test_batch_in, Chi2Config, Chi2Result, CELL_RELATIVE_TOLERANCE,
+    KINKED_CELL_RELATIVE_TOLERANCE, MIN_EXPECTED,
 };
-use mfh_reference::{Model, ModelSpec};
+use mfh_reference::{Model, ModelSpec, Vec3};
 use serde_json::{json, Value};
 use std::f64::consts::FRAC_PI_2;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -238,7 +238,7 @@ pub fn validate(request: &Chi2Request) -> Result<Chi2Plan, Chi2InputError> {
 /// Progress of a run: samples drawn so far of those planned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SampleProgress {
-    /// Samples drawn so far (counted in batches, so it lags by at most a batch per thread).
+    /// Samples drawn so far (counted in batches, so it lags by less than a batch per thread).
     pub done: u64,
     /// Samples planned.
     pub planned: u64,
@@ -253,13 +253,17 @@ thread_local! {
 }
 
 /// Runs a validated request. `progress`, if given, shares the count of samples drawn (updated
-/// every [`PROGRESS_BATCH`] samples per thread); reading it never changes the result.
+/// every [`PROGRESS_BATCH`] samples per thread); reading it never changes the result. The
+/// model's batch samplers draw the samples (`sample_wm_batch`, `sample_wm_visible_batch`):
+/// the same normals as the scalar methods.
 pub fn run(plan: &Chi2Plan, progress: Option<Arc<AtomicU64>>) -> Chi2Result {
-    let count = |progress: &Option<Arc<AtomicU64>>| {
+    // Counted per block of samples (the batch samplers' unit), flushed to the shared counter
+    // once a thread holds PROGRESS_BATCH or more.
+    let count = |progress: &Option<Arc<AtomicU64>>, n: usize| {
         if let Some(p) = progress {
             LOCAL_COUNT.with(|c| {
-                let n = c.get() + 1;
-                if n == PROGRESS_BATCH {
+                let n = c.get() + n as u64;
+                if n >= PROGRESS_BATCH {
                     p.fetch_add(n, Ordering::Relaxed);
                     c.set(0);
                 } else {
@@ -277,10 +281,10 @@ pub fn run(plan: &Chi2Plan, progress: Option<Arc<AtomicU64>>) -> Chi2Result {
             let wi = mfh_reference::geometry::from_spherical(theta, phi);
             // The visible density has a kink along the terminator of wi: cells that straddle
             // it converge slowly, so they are integrated to 1e-6 (still ≪ √count).
-            chi2_test_in(
-                &|u| {
-                    count(&progress);
-                    v.sample_wm_visible(wi, u)
+            chi2_test_batch_in(
+                &|u: &[[f64; 2]], m: &mut [Vec3]| {
+                    count(&progress, u.len());
+                    v.sample_wm_visible_batch(wi, u, m)
                 },
                 &|m| v.pdf_wm_visible(wi, m),
                 &plan.config,
@@ -293,10 +297,10 @@ pub fn run(plan: &Chi2Plan, progress: Option<Arc<AtomicU64>>) -> Chi2Result {
                 .model
                 .as_sampler()
                 .expect("validate checked the normal sampler");
-            chi2_test_in(
-                &|u| {
-                    count(&progress);
-                    s.sample_wm(u)
+            chi2_test_batch_in(
+                &|u: &[[f64; 2]], m: &mut [Vec3]| {
+                    count(&progress, u.len());
+                    s.sample_wm_batch(u, m)
                 },
                 &|m| s.pdf_wm(m),
                 &plan.config,

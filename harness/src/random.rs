@@ -30,9 +30,6 @@ use rand_core::{RngCore, SeedableRng};
 #[derive(Debug, Clone)]
 pub struct Stream(ChaCha8Rng);
 
-/// The pairs drawn per keystream read in [`Stream::fill_pairs`] (16 bytes each; 4 KiB).
-const FILL_PAIRS: usize = 256;
-
 impl Stream {
     /// Stream `id` under `seed`, at its start.
     pub fn new(seed: u64, id: u64) -> Self {
@@ -55,17 +52,18 @@ impl Stream {
     }
 
     /// Fills `out` with the next `out.len()` pairs of uniforms: the same numbers as that many
-    /// calls of [`Stream::pair`], read from the keystream in blocks of 4 KiB and converted in
-    /// a loop the compiler vectorizes.
+    /// calls of [`Stream::pair`]. The keystream is written straight into `out` (16 bytes per
+    /// pair, through `bytemuck`'s safe cast of `[f64; 2]` to bytes) and each 8-byte word
+    /// (little-endian, as [`Stream::pair`] reads it) is converted in place: no buffer to
+    /// clear or copy, a conversion loop the compiler vectorizes.
     pub fn fill_pairs(&mut self, out: &mut [[f64; 2]]) {
-        let mut bytes = [0u8; 16 * FILL_PAIRS];
-        for block in out.chunks_mut(FILL_PAIRS) {
-            let bytes = &mut bytes[..16 * block.len()];
-            self.0.fill_bytes(bytes);
-            for (u, b) in block.iter_mut().zip(bytes.chunks_exact(16)) {
-                let (lo, hi) = b.split_at(8);
-                *u = [to_unit(le_u64(lo)), to_unit(le_u64(hi))];
-            }
+        self.0.fill_bytes(bytemuck::cast_slice_mut(out));
+        for u in out.iter_mut() {
+            // to_bits returns the stored bytes as written (bit copies preserve every pattern).
+            *u = [
+                to_unit(u64::from_le(u[0].to_bits())),
+                to_unit(u64::from_le(u[1].to_bits())),
+            ];
         }
     }
 
@@ -75,14 +73,6 @@ impl Stream {
         // 4 ChaCha words (u32) per pair.
         self.0.set_word_pos(u128::from(index) * 4);
     }
-}
-
-/// The u64 of 8 little-endian bytes.
-#[inline(always)]
-fn le_u64(b: &[u8]) -> u64 {
-    let mut a = [0u8; 8];
-    a.copy_from_slice(b);
-    u64::from_le_bytes(a)
 }
 
 impl RngCore for Stream {
@@ -155,7 +145,7 @@ mod tests {
     fn block_and_scalar_draws_agree_and_seek_reaches_any_pair() {
         let mut scalar = stream(42, 3);
         let expected: Vec<[f64; 2]> = (0..1000).map(|_| scalar.pair()).collect();
-        // Blocks of awkward sizes, across the 256-pair fill blocks.
+        // Blocks of awkward sizes, across ChaCha8's 4-block (256-byte) refills.
         let mut block = stream(42, 3);
         let mut got = vec![[0.0; 2]; 1000];
         let (a, rest) = got.split_at_mut(7);
