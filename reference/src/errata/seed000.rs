@@ -95,6 +95,28 @@ pub fn segment_sin2_doc(a: f64, b: f64, t0: f64, t1: f64) -> f64 {
         / 8.0
 }
 
+/// Eq 23's partial segment ∫_{θ_k}^{E} (aθ + b) sin²θ dθ (E = π/2 − θ_o) written with
+/// `cos2` where −cos 2E belongs (eq 15 at t1 = E).
+fn eq23_partial_segment(a: f64, b: f64, theta_k: f64, theta_o: f64, cos2: f64) -> f64 {
+    let e = FRAC_PI_2 - theta_o;
+    (a * ((2.0 * theta_k).cos() + cos2)
+        + 2.0 * (e - theta_k) * (a * (theta_k + e) + 2.0 * b)
+        + 2.0 * (a * theta_k + b) * (2.0 * theta_k).sin()
+        - 2.0 * (a * e + b) * (2.0 * theta_o).sin())
+        / 8.0
+}
+
+/// Eq 23's y line as printed: the partial segment with cos 2φ_o where cos 2θ_o belongs
+/// (ERRATA 000-E5; wrong whenever φ_o ≠ θ_o).
+pub fn eq23_partial_segment_printed(a: f64, b: f64, theta_k: f64, theta_o: f64, phi_o: f64) -> f64 {
+    eq23_partial_segment(a, b, theta_k, theta_o, (2.0 * phi_o).cos())
+}
+
+/// Eq 23's partial segment corrected: cos 2θ_o (= −cos 2E).
+pub fn eq23_partial_segment_corrected(a: f64, b: f64, theta_k: f64, theta_o: f64) -> f64 {
+    eq23_partial_segment(a, b, theta_k, theta_o, (2.0 * theta_o).cos())
+}
+
 /// The line (a, b) of a profile on [t0, t1] (eq 4).
 fn line(d: &dyn Fn(f64) -> f64, t0: f64, t1: f64) -> (f64, f64) {
     let a = (d(t1) - d(t0)) / (t1 - t0);

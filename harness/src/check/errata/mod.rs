@@ -292,7 +292,9 @@ fn build(spec: Value) -> Result<Box<dyn Model>, String> {
 }
 
 /// The verdict of a demonstration: expected failure when the printed form fails and the
-/// corrected one holds; fail otherwise (so the check can fail).
+/// corrected one holds; `unexpected_pass` (which fails the audit) when both hold, for then the
+/// erratum is no longer shown and ERRATA.md or the demonstration is wrong; fail otherwise (the
+/// corrected form misses the oracle).
 fn decide(record: &mut CheckRecord, id: &str, description: &str, shown: &Shown) {
     let o = shown.oracle;
     let allowed = shown.tolerance.value + relative_error(o.value + o.error_bound, o.value).min(1.0);
@@ -324,6 +326,14 @@ fn decide(record: &mut CheckRecord, id: &str, description: &str, shown: &Shown) 
                  corrected {:.6e} within {corrected_error:.1e} (allowed {allowed:.1e}); \
                  ERRATA.md {id}",
                 shown.printed, o.value, shown.corrected
+            ),
+        }
+    } else if corrected_holds {
+        Verdict::UnexpectedPass {
+            reason: format!(
+                "[{id}] {description}: printed {:.6e} meets the oracle {:.6e} \
+                 ({printed_error:.1e} ≤ {allowed:.1e}): the erratum is not shown; ERRATA.md {id}",
+                shown.printed, o.value
             ),
         }
     } else {
@@ -457,6 +467,51 @@ mod tests {
                 .map(|r| (r.verdict.clone(), r.value, r.oracle))
                 .collect();
             assert!(found, "{id}: {mine:?}");
+        }
+    }
+
+    /// A demonstration whose printed form stops failing (here: replaced by the corrected one)
+    /// is an `unexpected_pass`, which fails the audit; one whose corrected form misses the
+    /// oracle fails.
+    #[test]
+    fn a_demonstration_whose_printed_form_holds_is_an_unexpected_pass() {
+        let cheap = ["001-5", "000-U2", "003-E1", "003-E8", "002-3", "000-E5"];
+        let demos: Vec<Demo> = demos()
+            .into_iter()
+            .filter(|d| cheap.contains(&d.id))
+            .collect();
+        assert_eq!(demos.len(), cheap.len());
+        for d in demos {
+            let record = || CheckRecord::new(CHECK, Value::Null, json!({}), d.source);
+            let shown = (d.run)().unwrap();
+            let mut r = record();
+            decide(&mut r, d.id, description(d.id), &shown);
+            assert!(
+                matches!(r.verdict, Verdict::ExpectedFailure { .. }),
+                "{}: {:?}",
+                d.id,
+                r.verdict
+            );
+            let fixed = Shown {
+                printed: shown.corrected,
+                ..(d.run)().unwrap()
+            };
+            let mut r = record();
+            decide(&mut r, d.id, description(d.id), &fixed);
+            assert!(
+                matches!(&r.verdict, Verdict::UnexpectedPass { reason } if reason.starts_with(&format!("[{}]", d.id))),
+                "{}: {:?}",
+                d.id,
+                r.verdict
+            );
+            assert!(r.verdict.is_failure() && r.verdict.name() == "unexpected_pass");
+            let broken = Shown {
+                corrected: shown.printed,
+                ..(d.run)().unwrap()
+            };
+            let mut r = record();
+            decide(&mut r, d.id, description(d.id), &broken);
+            assert_eq!(r.verdict, Verdict::Fail, "{}", d.id);
         }
     }
 

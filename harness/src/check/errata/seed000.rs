@@ -140,16 +140,9 @@ fn e000_4() -> Result<Shown, String> {
 fn e000_5() -> Result<Shown, String> {
     let (a, b, tk, theta_o, phi_o) = (0.7f64, 0.4f64, 0.2f64, 0.9f64, 0.3f64);
     let e = FRAC_PI_2 - theta_o;
-    let with = |c: f64| {
-        (a * ((2.0 * tk).cos() + c)
-            + 2.0 * (e - tk) * (a * (tk + e) + 2.0 * b)
-            + 2.0 * (a * tk + b) * (2.0 * tk).sin()
-            - 2.0 * (a * e + b) * (2.0 * theta_o).sin())
-            / 8.0
-    };
     Ok(Shown::new(
-        with((2.0 * phi_o).cos()),
-        with((2.0 * theta_o).cos()),
+        seed000::eq23_partial_segment_printed(a, b, tk, theta_o, phi_o),
+        seed000::eq23_partial_segment_corrected(a, b, tk, theta_o),
         integrate(&|t: f64| (a * t + b) * t.sin().powi(2), tk, e, acc()),
         &ERRATUM,
     ))

@@ -2,24 +2,20 @@
 //! harness oracle (reference/ERRATA.md, section "Seed 003").
 
 use super::*;
+use mfh_reference::errata::seed003;
 
 /// 003-E1: seed 003 §2.1 Cook–Torrance Fresnel factor with g = √(η² − c² − 1) (printed) and
 /// √(η² + c² − 1), against the mean of the s and p reflectances from Snell's law (η = 1.5,
 /// c = 0.6).
 fn e003_1() -> Result<Shown, String> {
     let (eta, c) = (1.5f64, 0.6f64);
-    let fresnel = |g: f64| {
-        let a = (g - c) / (g + c);
-        let b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
-        0.5 * a * a * (1.0 + b * b)
-    };
     let sin_t = (1.0 - c * c).sqrt() / eta;
     let cos_t = (1.0 - sin_t * sin_t).sqrt();
     let rs = ((c - eta * cos_t) / (c + eta * cos_t)).powi(2);
     let rp = ((eta * c - cos_t) / (eta * c + cos_t)).powi(2);
     Ok(Shown::new(
-        fresnel((eta * eta - c * c - 1.0).sqrt()),
-        fresnel((eta * eta + c * c - 1.0).sqrt()),
+        seed003::fresnel_printed(eta, c),
+        seed003::fresnel_corrected(eta, c),
         exact(0.5 * (rs + rp)),
         &ERRATUM,
     ))
@@ -162,10 +158,9 @@ fn e003_8() -> Result<Shown, String> {
     let xi = fiber_direction(t1, p1);
     let sg = Sg::new(xi, 4.0, 1.0).map_err(|e| e.to_string())?;
     let omega = fiber_direction(t, p);
-    let line = t.sin() * t1.sin() + t.cos() * t1.cos() * (p.cos() * p1.cos() + p.sin() * p1.sin());
     Ok(Shown::new(
-        line,
-        line - 1.0,
+        seed003::eq_sec41_line3_printed(t, p, t1, p1),
+        seed003::eq_sec41_line3_corrected(t, p, t1, p1),
         exact(sg.eval(omega).ln() / 4.0),
         &ERRATUM,
     ))
