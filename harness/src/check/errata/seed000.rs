@@ -94,21 +94,11 @@ fn e000_1() -> Result<Shown, String> {
 /// against the mass of D on the segment by quadrature.
 fn e000_2() -> Result<Shown, String> {
     let m = pl()?;
-    let (phi, t0, t1) = (0.9f64, m.breakpoints()[1], m.breakpoints()[2]);
-    let (kx, ky) = m.weights();
-    let (wx, wy) = (kx * phi.cos().powi(2), ky * phi.sin().powi(2));
-    let line = |d: &dyn Fn(f64) -> f64| {
-        let a = (d(t1) - d(t0)) / (t1 - t0);
-        (a, d(t0) - a * t0)
-    };
-    let (ax, bx) = line(&|t| m.d_x(t));
-    let (ay, by) = line(&|t| m.d_y(t));
-    let seg =
-        |a: f64, b: f64| integrate(&|t: f64| (a * t + b) * t.cos() * t.sin(), t0, t1, acc()).value;
-    let a = wx * ax + wy * ay;
+    let (phi, k) = (0.9f64, 1);
+    let (t0, t1) = (m.breakpoints()[k], m.breakpoints()[k + 1]);
     Ok(Shown::new(
-        seg(a, wx * bx + wy * bx),
-        seg(a, wx * bx + wy * by),
+        seed000::b_aniso_segment_printed(&m, phi, k),
+        seed000::b_aniso_segment_corrected(&m, phi, k),
         theta_mass(&m, phi, t0, t1),
         &ERRATUM,
     ))
@@ -226,10 +216,9 @@ fn e000_11() -> Result<Shown, String> {
     let (theta, phi) = (0.3f64, 0.7f64);
     let (_, o) = pl_lambda_oracle(from_spherical(theta, phi))?;
     let ds = domain_split(&pl()?, theta, (2.0 * phi).cos(), Remaining::Adaptive);
-    let i1 = ds.i11 + 0.5 * theta.cos();
     Ok(Shown::new(
-        (i1 + ds.i2_1 + ds.i2_2) / theta.cos() - 0.5,
-        (ds.i11 + ds.i2_1 + ds.i2_2) / theta.cos() - 0.5,
+        seed000::eq34_lambda_printed(theta, ds.i11, ds.i2_1, ds.i2_2),
+        seed000::eq34_lambda_corrected(theta, ds.i11, ds.i2_1, ds.i2_2),
         o,
         &ERRATUM,
     ))

@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::oracle::gtr::{self, g1_gamma0};
+use mfh_reference::errata::seed004;
 
 /// 004-E1: seed 004 §3.5, P2⁴ with "4α²q2" read literally (8α²q) and as 4α²q², against
 /// ∫ P22⁴(p, q) dp by harness quadrature (α = 0.3, q = 0.5).
@@ -11,14 +12,9 @@ fn e004_1() -> Result<Shown, String> {
     let m = Gtr::new(4.0, alpha).map_err(|e| e.to_string())?;
     let slopes = m.as_slopes().ok_or("no slopes")?;
     let o = integrate_line(&|p| slopes.p22(p, q), 0.0, alpha, acc());
-    let a2 = alpha * alpha;
-    let p2 = |middle: f64| {
-        3.0 * a2.powi(3) * (8.0 * q.powi(4) + middle + 12.0 * q * q + a2 * a2 + 2.0 * a2 + 5.0)
-            / (16.0 * (a2 * a2 + a2 + 1.0) * (q * q + a2).powf(3.5))
-    };
     Ok(Shown::new(
-        p2(4.0 * a2 * q * 2.0),
-        p2(4.0 * a2 * q * q),
+        seed004::p2_gamma4_printed(alpha, q),
+        seed004::p2_gamma4_corrected(alpha, q),
         o,
         &ERRATUM,
     ))
