@@ -240,37 +240,23 @@ fn exact(value: f64) -> Estimate {
     }
 }
 
-/// One planned demonstration.
-struct Demo {
-    id: &'static str,
-    concern: Concern,
-    source: &'static str,
-    covers: Vec<String>,
-    model: Value,
-    case: Value,
-    run: fn() -> Result<Shown, String>,
-}
-
-/// A demonstration (the positional constructor the seed files use).
-fn demo(
-    id: &'static str,
-    concern: Concern,
-    source: &'static str,
-    covers: Vec<String>,
-    model: Value,
-    case: Value,
-    run: fn() -> Result<Shown, String>,
-) -> Demo {
-    Demo {
-        id,
-        concern,
-        source,
-        covers,
-        model,
-        case,
-        run,
-    }
-}
+/// One planned demonstration; the seed files build it positionally (`Demo(id, …)`).
+struct Demo(
+    /// The erratum id (ERRATA.md).
+    &'static str,
+    /// What a scene must use for the erratum to concern it.
+    Concern,
+    /// The document and equation.
+    &'static str,
+    /// The coverage keys of the record.
+    Vec<String>,
+    /// The model spec of the record (`Value::Null`: none).
+    Value,
+    /// The case of the record.
+    Value,
+    /// The demonstration itself.
+    fn() -> Result<Shown, String>,
+);
 
 /// Every demonstration, document by document.
 fn demos() -> Vec<Demo> {
@@ -355,18 +341,10 @@ pub fn description(id: &str) -> &'static str {
 pub fn plan(scope: &Scope, why: &str) -> Vec<Planned> {
     let mut out = Vec::new();
     for demo in demos() {
-        let Some(used) = scope.uses(&demo.concern) else {
+        let Some(used) = scope.uses(&demo.1) else {
             continue;
         };
-        let Demo {
-            id,
-            concern: _,
-            source,
-            covers,
-            model,
-            case,
-            run,
-        } = demo;
+        let Demo(id, _, source, covers, model, case, run) = demo;
         let mut case = case;
         if let Value::Object(map) = &mut case {
             map.insert("erratum".into(), json!(id));
@@ -478,40 +456,40 @@ mod tests {
         let cheap = ["001-5", "000-U2", "003-E1", "003-E8", "002-3", "000-E5"];
         let demos: Vec<Demo> = demos()
             .into_iter()
-            .filter(|d| cheap.contains(&d.id))
+            .filter(|d| cheap.contains(&d.0))
             .collect();
         assert_eq!(demos.len(), cheap.len());
-        for d in demos {
-            let record = || CheckRecord::new(CHECK, Value::Null, json!({}), d.source);
-            let shown = (d.run)().unwrap();
+        for Demo(id, _, source, _, _, _, run) in demos {
+            let record = || CheckRecord::new(CHECK, Value::Null, json!({}), source);
+            let shown = run().unwrap();
             let mut r = record();
-            decide(&mut r, d.id, description(d.id), &shown);
+            decide(&mut r, id, description(id), &shown);
             assert!(
                 matches!(r.verdict, Verdict::ExpectedFailure { .. }),
                 "{}: {:?}",
-                d.id,
+                id,
                 r.verdict
             );
             let fixed = Shown {
                 printed: shown.corrected,
-                ..(d.run)().unwrap()
+                ..run().unwrap()
             };
             let mut r = record();
-            decide(&mut r, d.id, description(d.id), &fixed);
+            decide(&mut r, id, description(id), &fixed);
             assert!(
-                matches!(&r.verdict, Verdict::UnexpectedPass { reason } if reason.starts_with(&format!("[{}]", d.id))),
+                matches!(&r.verdict, Verdict::UnexpectedPass { reason } if reason.starts_with(&format!("[{}]", id))),
                 "{}: {:?}",
-                d.id,
+                id,
                 r.verdict
             );
             assert!(r.verdict.is_failure() && r.verdict.name() == "unexpected_pass");
             let broken = Shown {
                 corrected: shown.printed,
-                ..(d.run)().unwrap()
+                ..run().unwrap()
             };
             let mut r = record();
-            decide(&mut r, d.id, description(d.id), &broken);
-            assert_eq!(r.verdict, Verdict::Fail, "{}", d.id);
+            decide(&mut r, id, description(id), &broken);
+            assert_eq!(r.verdict, Verdict::Fail, "{}", id);
         }
     }
 

@@ -459,7 +459,7 @@ fn e000_u2() -> Result<Shown, String> {
 
 /// The demonstrations of this document's errata.
 pub(super) fn demos() -> Vec<Demo> {
-    let d = demo;
+    let d = Demo;
     vec![
         d(
             "000-E1",

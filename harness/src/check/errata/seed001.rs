@@ -253,7 +253,7 @@ fn e001_10() -> Result<Shown, String> {
 /// The demonstrations of this document's errata.
 pub(super) fn demos() -> Vec<Demo> {
     let std_spec = |g: f64| json!({"family": "std", "gamma": g, "alpha": 0.3});
-    let d = demo;
+    let d = Demo;
     vec![
         d(
             "001-1",

@@ -204,7 +204,7 @@ fn e003_9() -> Result<Shown, String> {
 
 /// The demonstrations of this document's errata.
 pub(super) fn demos() -> Vec<Demo> {
-    let d = demo;
+    let d = Demo;
     vec![
         d(
             "003-E1",

@@ -38,7 +38,7 @@ fn e004_2() -> Result<Shown, String> {
 /// The demonstrations of this document's errata.
 pub(super) fn demos() -> Vec<Demo> {
     let gtr = |g: f64, a: f64| json!({"family": "gtr", "gamma": g, "alpha": a});
-    let d = demo;
+    let d = Demo;
     vec![
         d(
             "004-E1",
