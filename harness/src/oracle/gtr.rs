@@ -48,7 +48,13 @@ fn p2(gamma: f64, alpha: f64, c: f64, q: f64, accuracy: Accuracy) -> Estimate {
 pub fn lambda(gamma: f64, alpha: f64, mu: f64) -> Estimate {
     // 1e-10 inside, 1e-9 outside: the claims and errata this serves measure errors ≥ 1e-6
     // (GTR_LIMIT) and the nested quadrature costs ~10⁵ evaluations per Λ.
-    let inner = Accuracy::relative(1e-10);
+    lambda_to(gamma, alpha, mu, 1e-9)
+}
+
+/// [`lambda`] to the relative target `relative` (the inner P2 and c integrals to a tenth of it),
+/// for a caller that needs fewer digits (the nested quadrature's cost grows with them).
+pub fn lambda_to(gamma: f64, alpha: f64, mu: f64, relative: f64) -> Estimate {
+    let inner = Accuracy::relative(0.1 * relative);
     let c = normalization(gamma, alpha, inner);
     let worst_inner = std::cell::Cell::new(0.0f64);
     let evaluations = std::cell::Cell::new(c.evaluations);
@@ -63,7 +69,7 @@ pub fn lambda(gamma: f64, alpha: f64, mu: f64) -> Estimate {
         },
         mu,
         (mu * mu + alpha * alpha).sqrt(),
-        Accuracy::relative(1e-9),
+        Accuracy::relative(relative),
     );
     let value = outer.value / mu;
     Estimate {
@@ -76,7 +82,12 @@ pub fn lambda(gamma: f64, alpha: f64, mu: f64) -> Estimate {
 
 /// G1 = 1/(1 + Λ) of GTR(γ, α) at incidence θ (azimuth-free: GTR is isotropic).
 pub fn g1(gamma: f64, alpha: f64, theta: f64) -> Estimate {
-    let lam = lambda(gamma, alpha, 1.0 / theta.tan());
+    g1_to(gamma, alpha, theta, 1e-9)
+}
+
+/// [`g1`] with Λ to the relative target `relative` ([`lambda_to`]).
+pub fn g1_to(gamma: f64, alpha: f64, theta: f64, relative: f64) -> Estimate {
+    let lam = lambda_to(gamma, alpha, 1.0 / theta.tan(), relative);
     Estimate {
         value: 1.0 / (1.0 + lam.value),
         error_bound: lam.error_bound / (1.0 + lam.value).powi(2),

@@ -95,6 +95,65 @@ pub fn segment_sin2_doc(a: f64, b: f64, t0: f64, t1: f64) -> f64 {
         / 8.0
 }
 
+/// Eq 23's partial segment ∫_{θ_k}^{E} (aθ + b) sin²θ dθ (E = π/2 − θ_o) written with
+/// `cos2` where −cos 2E belongs (eq 15 at t1 = E).
+fn eq23_partial_segment(a: f64, b: f64, theta_k: f64, theta_o: f64, cos2: f64) -> f64 {
+    let e = FRAC_PI_2 - theta_o;
+    (a * ((2.0 * theta_k).cos() + cos2)
+        + 2.0 * (e - theta_k) * (a * (theta_k + e) + 2.0 * b)
+        + 2.0 * (a * theta_k + b) * (2.0 * theta_k).sin()
+        - 2.0 * (a * e + b) * (2.0 * theta_o).sin())
+        / 8.0
+}
+
+/// Eq 23's y line as printed: the partial segment with cos 2φ_o where cos 2θ_o belongs
+/// (ERRATA 000-E5; wrong whenever φ_o ≠ θ_o).
+pub fn eq23_partial_segment_printed(a: f64, b: f64, theta_k: f64, theta_o: f64, phi_o: f64) -> f64 {
+    eq23_partial_segment(a, b, theta_k, theta_o, (2.0 * phi_o).cos())
+}
+
+/// Eq 23's partial segment corrected: cos 2θ_o (= −cos 2E).
+pub fn eq23_partial_segment_corrected(a: f64, b: f64, theta_k: f64, theta_o: f64) -> f64 {
+    eq23_partial_segment(a, b, theta_k, theta_o, (2.0 * theta_o).cos())
+}
+
+/// Eq 34's Λ as printed when its display is read as eq 16's I₁ (= I₁₁ + cos θ_o/2, ERRATA
+/// 000-E11): (I₁ + I₂¹ + I₂²)/cos θ_o − ½, ½ too large. `i11`, `i2_1`, `i2_2` are eq 34's
+/// terms (`piecewise_lambda::domain_split`).
+pub fn eq34_lambda_printed(theta_o: f64, i11: f64, i2_1: f64, i2_2: f64) -> f64 {
+    let i1 = i11 + 0.5 * theta_o.cos();
+    (i1 + i2_1 + i2_2) / theta_o.cos() - 0.5
+}
+
+/// Eq 34's Λ corrected: the display is I₁₁, (I₁₁ + I₂¹ + I₂²)/cos θ_o − ½.
+pub fn eq34_lambda_corrected(theta_o: f64, i11: f64, i2_1: f64, i2_2: f64) -> f64 {
+    (i11 + i2_1 + i2_2) / theta_o.cos() - 0.5
+}
+
+/// The segment integral of the text after eq 9 on segment `k` ([θ_k, θ_{k+1}] of
+/// `breakpoints`) at azimuth φ, ∫ (A θ + B) cos θ sin θ dθ with A^aniso = w_x a^x + w_y a^y and
+/// B^aniso as printed: w_x b^x + w_y b^x (w_x = k_x cos²φ, w_y = k_y sin²φ; ERRATA 000-E2: the
+/// x profile's b twice).
+pub fn b_aniso_segment_printed(m: &PiecewiseLinear, phi: f64, k: usize) -> f64 {
+    b_aniso_segment(m, phi, k, true)
+}
+
+/// The segment integral with B^aniso corrected (Algorithm 2, line 2): w_x b^x + w_y b^y, the
+/// mass of D cos θ on the segment at φ.
+pub fn b_aniso_segment_corrected(m: &PiecewiseLinear, phi: f64, k: usize) -> f64 {
+    b_aniso_segment(m, phi, k, false)
+}
+
+fn b_aniso_segment(m: &PiecewiseLinear, phi: f64, k: usize, printed: bool) -> f64 {
+    let (t0, t1) = (m.breakpoints()[k], m.breakpoints()[k + 1]);
+    let (kx, ky) = m.weights();
+    let (wx, wy) = (kx * phi.cos().powi(2), ky * phi.sin().powi(2));
+    let (ax, bx) = line(&|t| m.d_x(t), t0, t1);
+    let (ay, by) = line(&|t| m.d_y(t), t0, t1);
+    let b = wx * bx + wy * if printed { bx } else { by };
+    segment_cos_sin_doc(wx * ax + wy * ay, b, t0, t1)
+}
+
 /// The line (a, b) of a profile on [t0, t1] (eq 4).
 fn line(d: &dyn Fn(f64) -> f64, t0: f64, t1: f64) -> (f64, f64) {
     let a = (d(t1) - d(t0)) / (t1 - t0);

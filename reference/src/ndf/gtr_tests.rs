@@ -40,16 +40,8 @@ fn p2_printed(k: u8, alpha: f64, q: f64, literal_q2: bool) -> f64 {
         }
         2 => a2 / (2.0 * (q2 + a2).powf(1.5)),
         3 => a2 * a2 * (a2 + 4.0 * q2 + 3.0) / (4.0 * (a2 + 1.0) * (q2 + a2).powf(2.5)),
-        4 => {
-            let a4 = a2 * a2;
-            let middle = if literal_q2 {
-                4.0 * a2 * q * 2.0
-            } else {
-                4.0 * a2 * q2
-            };
-            3.0 * a4 * a2 * (8.0 * q2 * q2 + middle + 12.0 * q2 + a4 + 2.0 * a2 + 5.0)
-                / (16.0 * (a4 + a2 + 1.0) * (q2 + a2).powf(3.5))
-        }
+        4 if literal_q2 => crate::errata::seed004::p2_gamma4_printed(alpha, q),
+        4 => crate::errata::seed004::p2_gamma4_corrected(alpha, q),
         _ => f64::NAN,
     }
 }

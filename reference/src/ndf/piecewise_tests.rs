@@ -632,21 +632,9 @@ fn printed_b_aniso_uses_the_x_profile_twice() {
     let y = Profile::uniform(vec![3.0, 0.1, 2.5, 0.3, 1.0]);
     let m = pl(x.clone(), Some(y.clone()));
     let (phi, k) = (0.9f64, 1usize);
-    let (t0, t1) = (m.grid[k], m.grid[k + 1]);
     let (wx, wy) = (m.kx * phi.cos().powi(2), m.ky * phi.sin().powi(2));
-    let line = |g: &[f64]| {
-        let a = (g[k + 1] - g[k]) / (t1 - t0);
-        (a, g[k] - a * t0)
-    };
-    let ((ax, bx), (ay, by)) = (line(&m.gx), line(&m.gy));
-    let seg = |a: f64, b: f64| {
-        (2.0 * (a * t0 + b) * (2.0 * t0).cos() - 2.0 * (a * t1 + b) * (2.0 * t1).cos()
-            + a * ((2.0 * t1).sin() - (2.0 * t0).sin()))
-            / 8.0
-    };
-    let a_aniso = wx * ax + wy * ay;
-    let right = seg(a_aniso, wx * bx + wy * by);
-    let printed = seg(a_aniso, wx * bx + wy * bx);
+    let right = crate::errata::seed000::b_aniso_segment_corrected(&m, phi, k);
+    let printed = crate::errata::seed000::b_aniso_segment_printed(&m, phi, k);
     let mass = (wx * (m.tx[k + 1] - m.tx[k])) + wy * (m.ty[k + 1] - m.ty[k]);
     assert!(rel_err(right, mass) < 1e-12, "{right} {mass}");
     assert!(rel_err(printed, mass) > 1e-2, "{printed} {mass}");
@@ -879,16 +867,11 @@ fn printed_eq23_partial_segment_and_its_extracted_y_line() {
     // extracted reads cos 2φ_o there (ERRATA-000 E5), which is wrong whenever φ_o ≠ θ_o.
     let (a, b, tk, theta_o, phi_o) = (0.7f64, 0.4f64, 0.2f64, 0.9f64, 0.3f64);
     let e = FRAC_PI_2 - theta_o;
-    let with = |c: f64| {
-        (a * ((2.0 * tk).cos() + c)
-            + 2.0 * (e - tk) * (a * (tk + e) + 2.0 * b)
-            + 2.0 * (a * tk + b) * (2.0 * tk).sin()
-            - 2.0 * (a * e + b) * (2.0 * theta_o).sin())
-            / 8.0
-    };
     let want = de(&|t: f64| (a * t + b) * t.sin().powi(2), tk, e, 1e-15);
-    assert!(rel_err(with((2.0 * theta_o).cos()), want) < 1e-13);
-    assert!(rel_err(with((2.0 * phi_o).cos()), want) > 1e-2);
+    let right = crate::errata::seed000::eq23_partial_segment_corrected(a, b, tk, theta_o);
+    let printed = crate::errata::seed000::eq23_partial_segment_printed(a, b, tk, theta_o, phi_o);
+    assert!(rel_err(right, want) < 1e-13);
+    assert!(rel_err(printed, want) > 1e-2);
 }
 
 #[test]
@@ -908,9 +891,10 @@ fn eq34_display_is_i11_not_i1() {
     assert!(rel_err(ds.i11, display) < 1e-15);
     let exact = m.lambda(from_spherical(t, phi));
     assert!((ds.lambda - exact).abs() < 1e-13);
-    let i1 = display + 0.5 * t.cos();
-    let misread = (i1 + ds.i2_1 + ds.i2_2) / t.cos() - 0.5;
+    let misread = crate::errata::seed000::eq34_lambda_printed(t, display, ds.i2_1, ds.i2_2);
     assert!((misread - exact - 0.5).abs() < 1e-13);
+    let right = crate::errata::seed000::eq34_lambda_corrected(t, display, ds.i2_1, ds.i2_2);
+    assert!((right - exact).abs() < 1e-13);
 }
 
 /// The accuracy table of seed 000 (issue 3): for each closed form and route, the max error

@@ -25,6 +25,19 @@ fn lambda_definition(g: f64, sigma: f64, mu: f64) -> f64 {
     integrate_tail(&f, mu, k.sqrt(), 1e-13) / mu
 }
 
+/// The demonstration every test here ends with: the corrected form meets `truth` to `tolerance`
+/// (relative) and the printed one misses it by more than 1e-2 (`what` names the case).
+fn shown(printed: f64, corrected: f64, truth: f64, tolerance: f64, what: &str) {
+    assert!(
+        rel_err(corrected, truth) < tolerance,
+        "{what}: corrected {corrected} vs {truth}"
+    );
+    assert!(
+        rel_err(printed, truth) > 1e-2,
+        "{what}: printed {printed} agreed with {truth}"
+    );
+}
+
 #[test]
 fn eq20_has_a_spurious_half_on_the_2f1_term() {
     // I2 = μ/((γ−1)σ²)^{γ−1} ∫_{t0}^∞ (1+t²)^{½−γ} dt, t0 = μ/√((γ−1)σ²). Eq 20 writes the
@@ -34,14 +47,7 @@ fn eq20_has_a_spurious_half_on_the_2f1_term() {
         let printed = seed001::eq20_tail_printed(g, sigma, mu);
         let corrected = seed001::eq20_tail_corrected(g, sigma, mu);
         let truth = tail_integral(g, t0);
-        assert!(
-            rel_err(corrected, truth) < 1e-11,
-            "γ={g}: {corrected} vs {truth}"
-        );
-        assert!(
-            rel_err(printed, truth) > 1e-2,
-            "γ={g}: printed eq 20 agreed"
-        );
+        shown(printed, corrected, truth, 1e-11, &format!("γ={g}, eq 20"));
     }
 }
 
@@ -54,14 +60,7 @@ fn eq28_last_line_misplaces_the_square_root() {
         let truth = tail_integral(g, t0);
         let printed = seed001::eq28_tail_printed(g as u64, sigma, mu);
         let corrected = seed001::eq28_tail_corrected(g as u64, sigma, mu);
-        assert!(
-            rel_err(corrected, truth) < 1e-11,
-            "γ={g}: {corrected} vs {truth}"
-        );
-        assert!(
-            rel_err(printed, truth) > 1e-2,
-            "γ={g}: printed eq 28 agreed"
-        );
+        shown(printed, corrected, truth, 1e-11, &format!("γ={g}, eq 28"));
     }
 }
 
@@ -78,14 +77,7 @@ fn eq33_prefactor_keeps_q_and_drops_one_over_mu_and_one_over_2k_plus_1() {
         let printed = eq33_prefactor(g, sigma, mu, true) * bracket;
         let corrected = eq33_prefactor(g, sigma, mu, false) * bracket;
         let truth = lambda_definition(g, sigma, mu);
-        assert!(
-            rel_err(corrected, truth) < 1e-10,
-            "γ={g}: {corrected} vs {truth}"
-        );
-        assert!(
-            rel_err(printed, truth) > 1e-2,
-            "γ={g}: printed eq 33 agreed"
-        );
+        shown(printed, corrected, truth, 1e-10, &format!("γ={g}, eq 33"));
     }
 }
 
@@ -168,8 +160,7 @@ fn sec71_visible_slope_cdf_has_the_wrong_sign_of_exponent() {
     let truth = g1 * integrate_tail(&|u: f64| density(p - u), 0.0, 1.0, 1e-13);
     let printed = seed001::sec71_cdf_printed(g, theta, p);
     let corrected = seed001::sec71_cdf_corrected(g, theta, p);
-    assert!(rel_err(corrected, truth) < 1e-10, "{corrected} vs {truth}");
-    assert!(rel_err(printed, truth) > 1e-2, "printed agreed");
+    shown(printed, corrected, truth, 1e-10, "§7.1 visible-slope cdf");
 }
 
 #[test]

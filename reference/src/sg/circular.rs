@@ -382,19 +382,6 @@ mod tests {
     }
 
     #[test]
-    fn printed_derivation_line_drops_the_minus_one() {
-        // Seed 003 §4.1, third line of the derivation of ω·ξ − 1: printed as
-        // sin θ sin θ' + cos θ cos θ' (cos φ cos φ' + sin φ sin φ'), which is ω·ξ, not ω·ξ − 1
-        // (ERRATA.md, E8). The line before and after carry the "− 1".
-        let (t, p, t2, p2) = (0.3f64, 1.1f64, -0.2f64, 0.4f64);
-        let lhs = dot(fiber_direction(t, p), fiber_direction(t2, p2)) - 1.0;
-        let printed = t.sin() * t2.sin() + t.cos() * t2.cos() * (p - p2).cos();
-        assert!((printed - lhs - 1.0).abs() < 1e-15);
-        let right = ((t - t2).cos() - 1.0) + t.cos() * t2.cos() * ((p - p2).cos() - 1.0);
-        assert!((right - lhs).abs() < 1e-15);
-    }
-
-    #[test]
     fn validation() {
         assert!(CircularGaussian::new(0.0, 0.0).is_err());
         assert!(CircularGaussian::new(0.0, f64::NAN).is_err());

@@ -801,36 +801,6 @@ mod tests {
     }
 
     #[test]
-    fn printed_fresnel_g_has_the_wrong_sign() {
-        // ERRATA.md, E1: seed 003 §2.1 prints g = √(η² − c² − 1); Cook–Torrance's is
-        // g = √(η² + c² − 1). At normal incidence (c = 1) the Fresnel factor must be
-        // ((η − 1)/(η + 1))², and for every c it must equal the mean of the s and p
-        // reflectances.
-        fn fresnel(c: f64, g: f64) -> f64 {
-            let a = (g - c) / (g + c);
-            let b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
-            0.5 * a * a * (1.0 + b * b)
-        }
-        fn fresnel_sp(eta: f64, c: f64) -> f64 {
-            let st = (1.0 - c * c).sqrt() / eta;
-            let ct = (1.0 - st * st).sqrt();
-            let rs = (c - eta * ct) / (c + eta * ct);
-            let rp = (eta * c - ct) / (eta * c + ct);
-            0.5 * (rs * rs + rp * rp)
-        }
-        let eta: f64 = 1.5;
-        for c in [1.0, 0.8, 0.5, 0.2] {
-            let right = fresnel(c, (eta * eta + c * c - 1.0).sqrt());
-            assert!(rel_err(right, fresnel_sp(eta, c)) < 1e-14, "c = {c}");
-        }
-        let printed = fresnel(1.0, (eta * eta - 1.0 - 1.0).sqrt());
-        assert!(
-            rel_err(printed, ((eta - 1.0) / (eta + 1.0)).powi(2)) > 1.0,
-            "{printed}"
-        );
-    }
-
-    #[test]
     fn printed_visibility_lookup_mixes_sharpness_conventions() {
         // ERRATA.md, E6: §3.3.3 writes ∫ G_iso(i; p, ν) V(i) di ≈ f_h(θd, ν), with
         // G_iso = e^{2ν(i·p − 1)}; but f_h(θd, λ) (§2.2) integrates e^{λ(cos θ − 1)}. For a cap

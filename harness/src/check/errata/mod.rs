@@ -240,37 +240,23 @@ fn exact(value: f64) -> Estimate {
     }
 }
 
-/// One planned demonstration.
-struct Demo {
-    id: &'static str,
-    concern: Concern,
-    source: &'static str,
-    covers: Vec<String>,
-    model: Value,
-    case: Value,
-    run: fn() -> Result<Shown, String>,
-}
-
-/// A demonstration (the positional constructor the seed files use).
-fn demo(
-    id: &'static str,
-    concern: Concern,
-    source: &'static str,
-    covers: Vec<String>,
-    model: Value,
-    case: Value,
-    run: fn() -> Result<Shown, String>,
-) -> Demo {
-    Demo {
-        id,
-        concern,
-        source,
-        covers,
-        model,
-        case,
-        run,
-    }
-}
+/// One planned demonstration; the seed files build it positionally (`Demo(id, …)`).
+struct Demo(
+    /// The erratum id (ERRATA.md).
+    &'static str,
+    /// What a scene must use for the erratum to concern it.
+    Concern,
+    /// The document and equation.
+    &'static str,
+    /// The coverage keys of the record.
+    Vec<String>,
+    /// The model spec of the record (`Value::Null`: none).
+    Value,
+    /// The case of the record.
+    Value,
+    /// The demonstration itself.
+    fn() -> Result<Shown, String>,
+);
 
 /// Every demonstration, document by document.
 fn demos() -> Vec<Demo> {
@@ -292,7 +278,9 @@ fn build(spec: Value) -> Result<Box<dyn Model>, String> {
 }
 
 /// The verdict of a demonstration: expected failure when the printed form fails and the
-/// corrected one holds; fail otherwise (so the check can fail).
+/// corrected one holds; `unexpected_pass` (which fails the audit) when both hold, for then the
+/// erratum is no longer shown and ERRATA.md or the demonstration is wrong; fail otherwise (the
+/// corrected form misses the oracle).
 fn decide(record: &mut CheckRecord, id: &str, description: &str, shown: &Shown) {
     let o = shown.oracle;
     let allowed = shown.tolerance.value + relative_error(o.value + o.error_bound, o.value).min(1.0);
@@ -326,6 +314,14 @@ fn decide(record: &mut CheckRecord, id: &str, description: &str, shown: &Shown) 
                 shown.printed, o.value, shown.corrected
             ),
         }
+    } else if corrected_holds {
+        Verdict::UnexpectedPass {
+            reason: format!(
+                "[{id}] {description}: printed {:.6e} meets the oracle {:.6e} \
+                 ({printed_error:.1e} ≤ {allowed:.1e}): the erratum is not shown; ERRATA.md {id}",
+                shown.printed, o.value
+            ),
+        }
     } else {
         Verdict::Fail
     };
@@ -345,18 +341,10 @@ pub fn description(id: &str) -> &'static str {
 pub fn plan(scope: &Scope, why: &str) -> Vec<Planned> {
     let mut out = Vec::new();
     for demo in demos() {
-        let Some(used) = scope.uses(&demo.concern) else {
+        let Some(used) = scope.uses(&demo.1) else {
             continue;
         };
-        let Demo {
-            id,
-            concern: _,
-            source,
-            covers,
-            model,
-            case,
-            run,
-        } = demo;
+        let Demo(id, _, source, covers, model, case, run) = demo;
         let mut case = case;
         if let Value::Object(map) = &mut case {
             map.insert("erratum".into(), json!(id));
@@ -457,6 +445,51 @@ mod tests {
                 .map(|r| (r.verdict.clone(), r.value, r.oracle))
                 .collect();
             assert!(found, "{id}: {mine:?}");
+        }
+    }
+
+    /// A demonstration whose printed form stops failing (here: replaced by the corrected one)
+    /// is an `unexpected_pass`, which fails the audit; one whose corrected form misses the
+    /// oracle fails.
+    #[test]
+    fn a_demonstration_whose_printed_form_holds_is_an_unexpected_pass() {
+        let cheap = ["001-5", "000-U2", "003-E1", "003-E8", "002-3", "000-E5"];
+        let demos: Vec<Demo> = demos()
+            .into_iter()
+            .filter(|d| cheap.contains(&d.0))
+            .collect();
+        assert_eq!(demos.len(), cheap.len());
+        for Demo(id, _, source, _, _, _, run) in demos {
+            let record = || CheckRecord::new(CHECK, Value::Null, json!({}), source);
+            let shown = run().unwrap();
+            let mut r = record();
+            decide(&mut r, id, description(id), &shown);
+            assert!(
+                matches!(r.verdict, Verdict::ExpectedFailure { .. }),
+                "{}: {:?}",
+                id,
+                r.verdict
+            );
+            let fixed = Shown {
+                printed: shown.corrected,
+                ..run().unwrap()
+            };
+            let mut r = record();
+            decide(&mut r, id, description(id), &fixed);
+            assert!(
+                matches!(&r.verdict, Verdict::UnexpectedPass { reason } if reason.starts_with(&format!("[{}]", id))),
+                "{}: {:?}",
+                id,
+                r.verdict
+            );
+            assert!(r.verdict.is_failure() && r.verdict.name() == "unexpected_pass");
+            let broken = Shown {
+                corrected: shown.printed,
+                ..run().unwrap()
+            };
+            let mut r = record();
+            decide(&mut r, id, description(id), &broken);
+            assert_eq!(r.verdict, Verdict::Fail, "{}", id);
         }
     }
 

@@ -94,7 +94,7 @@ fn e002_4() -> Result<Shown, String> {
 /// The demonstrations of this document's errata.
 pub(super) fn demos() -> Vec<Demo> {
     let gs = json!({"family": "gaussian_slopes", "mean": GS_MEAN, "cov": GS_COV});
-    let d = demo;
+    let d = Demo;
     vec![
         d(
             "002-1",
