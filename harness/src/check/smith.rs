@@ -391,7 +391,12 @@ pub fn plan<'a>(
         if to > theta_max || ti > theta_max {
             continue;
         }
+        // Λ's oracles at w_o and w_i, shared by the three quantities of the pair (computed by
+        // whichever check runs first, as the route checks' oracles).
+        let (memo_o, memo_i): (SharedOracle, SharedOracle) =
+            (Arc::new(OnceLock::new()), Arc::new(OnceLock::new()));
         for quantity in ["g1", "g2_uncorrelated", "g2_height_correlated"] {
+            let (memo_o, memo_i) = (memo_o.clone(), memo_i.clone());
             let case = json!({"quantity": quantity, "theta_o": to, "phi_o": po, "theta_i": ti, "phi_i": pi});
             let m = subject.clone();
             let covered = vec![match quantity {
@@ -413,7 +418,8 @@ pub fn plan<'a>(
                     let smith = need(m.model.as_smith(), "Smith masking")?;
                     let (wo, wi) = (from_spherical(to, po), from_spherical(ti, pi));
                     let n = [0.0, 0.0, 1.0];
-                    let (lo, li) = (lambda_oracle_for(&m, wo), lambda_oracle_for(&m, wi));
+                    let lo = *memo_o.get_or_init(|| lambda_oracle_for(&m, wo));
+                    let li = *memo_i.get_or_init(|| lambda_oracle_for(&m, wi));
                     let (go, gi) = (1.0 / (1.0 + lo.value), 1.0 / (1.0 + li.value));
                     let (value, want, bound) = match quantity {
                         "g1" => (smith.g1(wo, n), go, lo.error_bound * go * go),
