@@ -272,58 +272,89 @@ pub fn check_seed(seed: u64, planned: &PlannedCheck<'_>) -> u64 {
 /// Runs a plan: every check in parallel (with `MFH_TRACE` set, each start and end is printed
 /// to standard error with its time), records in plan order, statistical verdicts at the
 /// Šidák-corrected level.
+///
+/// Scheduling: the checks are started longest first by [`crate::shard::estimated_cost`]
+/// (ties in plan order), each thread taking the next from one queue, so that a long check does
+/// not start last and run alone while the other threads are idle (rayon's split of the plan
+/// into contiguous halves did that). Records do not depend on the order: each check has its
+/// own seed ([`check_seed`]).
 pub fn run_plan(
     plan: &[PlannedCheck<'_>],
     options: &AuditOptions,
 ) -> (Vec<CheckRecord>, usize, f64) {
     let trace = std::env::var_os("MFH_TRACE").is_some();
     let (done, failures) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    let mut records: Vec<CheckRecord> = plan
-        .par_iter()
-        .map(|p| {
-            if trace {
-                eprintln!("start {} {} {}", p.check, p.model, p.case);
-            }
-            let ctx = RunContext {
-                seed: check_seed(options.seed, p),
-            };
-            let mut r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| (p.run)(&ctx)))
-                .unwrap_or_else(|e| {
-                    let mut r = CheckRecord::new(&p.check, p.model.clone(), p.case.clone(), "");
-                    let message = e
-                        .downcast_ref::<String>()
-                        .cloned()
-                        .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
-                        .unwrap_or_default();
-                    r.verdict = Verdict::Error {
-                        message: format!(
-                            "a panic inside the check or the model's methods: {message}"
-                        ),
-                    };
-                    r
-                });
-            if r.covers.is_empty() {
-                r.covers = p.covers.clone();
-            }
-            if trace {
-                eprintln!(
-                    "done {:.3}s {} {} {} {}",
-                    r.cost.wall_seconds,
-                    r.verdict.name(),
-                    p.check,
-                    p.model,
-                    p.case
-                );
-            }
-            if let Some(f) = &options.progress {
-                let failed = failures.fetch_add(usize::from(r.verdict.is_failure()), Relaxed);
-                (f.0)(Progress {
-                    done: done.fetch_add(1, Relaxed) + 1,
-                    planned: plan.len(),
-                    failures: failed + usize::from(r.verdict.is_failure()),
-                });
-            }
-            r
+    let costs: Vec<f64> = plan
+        .iter()
+        .map(|p| crate::shard::estimated_cost(p, options.profile))
+        .collect();
+    let mut order: Vec<usize> = (0..plan.len()).collect();
+    order.sort_by(|&a, &b| costs[b].total_cmp(&costs[a]));
+    let next = AtomicUsize::new(0);
+    let slots: Vec<std::sync::OnceLock<CheckRecord>> =
+        plan.iter().map(|_| std::sync::OnceLock::new()).collect();
+    let run_one = |p: &PlannedCheck<'_>| {
+        if trace {
+            eprintln!("start {} {} {}", p.check, p.model, p.case);
+        }
+        let ctx = RunContext {
+            seed: check_seed(options.seed, p),
+        };
+        let mut r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| (p.run)(&ctx)))
+            .unwrap_or_else(|e| {
+                let mut r = CheckRecord::new(&p.check, p.model.clone(), p.case.clone(), "");
+                let message = e
+                    .downcast_ref::<String>()
+                    .cloned()
+                    .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
+                    .unwrap_or_default();
+                r.verdict = Verdict::Error {
+                    message: format!("a panic inside the check or the model's methods: {message}"),
+                };
+                r
+            });
+        if r.covers.is_empty() {
+            r.covers = p.covers.clone();
+        }
+        if trace {
+            eprintln!(
+                "done {:.3}s {} {} {} {}",
+                r.cost.wall_seconds,
+                r.verdict.name(),
+                p.check,
+                p.model,
+                p.case
+            );
+        }
+        if let Some(f) = &options.progress {
+            let failed = failures.fetch_add(usize::from(r.verdict.is_failure()), Relaxed);
+            (f.0)(Progress {
+                done: done.fetch_add(1, Relaxed) + 1,
+                planned: plan.len(),
+                failures: failed + usize::from(r.verdict.is_failure()),
+            });
+        }
+        r
+    };
+    (0..rayon::current_num_threads().max(1))
+        .into_par_iter()
+        .for_each(|_| loop {
+            let at = next.fetch_add(1, Relaxed);
+            let Some(&i) = order.get(at) else { break };
+            let _ = slots[i].set(run_one(&plan[i]));
+        });
+    let mut records: Vec<CheckRecord> = slots
+        .into_iter()
+        .zip(plan)
+        .map(|(s, p)| {
+            // Every index is taken from the queue once; an empty slot is not reached.
+            s.into_inner().unwrap_or_else(|| {
+                let mut r = CheckRecord::new(&p.check, p.model.clone(), p.case.clone(), "");
+                r.verdict = Verdict::Error {
+                    message: "the check was not run".into(),
+                };
+                r
+            })
         })
         .collect();
     let (k, alpha) = judge_statistical(&mut records);

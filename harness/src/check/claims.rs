@@ -26,6 +26,7 @@ use mfh_reference::ndf::gtr::Gtr;
 use mfh_reference::sg::asg::Asg;
 use mfh_reference::sg::circular::CircularGaussian;
 use mfh_reference::{Model, ModelSpec};
+use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::f64::consts::FRAC_PI_2;
 
@@ -187,18 +188,34 @@ fn spline_grid() -> Vec<(f64, f64, f64)> {
 /// both spline claims.
 fn spline_errors() -> Result<(f64, f64), String> {
     static CACHE: std::sync::OnceLock<Result<(f64, f64), String>> = std::sync::OnceLock::new();
-    CACHE.get_or_init(spline_errors_uncached).clone()
+    if let Some(v) = CACHE.get() {
+        return v.clone();
+    }
+    // Computed outside the cell's initialization: the computation is parallel, and a thread
+    // waiting inside `get_or_init` for it could steal a job that calls this again (a
+    // re-entrant initialization deadlocks). Two first callers at once compute it twice.
+    let v = spline_errors_uncached();
+    CACHE.get_or_init(|| v).clone()
 }
 
 fn spline_errors_uncached() -> Result<(f64, f64), String> {
+    // The 600 grid points are independent: computed in parallel (the longest single record
+    // of the quick audit when serial), collected in grid order and summed in that order, so
+    // the result does not depend on the thread count.
+    let errors: Vec<Result<f64, String>> = spline_grid()
+        .into_par_iter()
+        .map(|(g, a, mu)| {
+            let theta = (1.0 / mu).atan();
+            let m = Gtr::new(g, a).map_err(|e| e.to_string())?;
+            let s = m
+                .g1_route(from_spherical(theta, 0.0), "spline")
+                .map_err(|e| e.to_string())?;
+            Ok((s - gtr_g1(g, a, theta).value).abs())
+        })
+        .collect();
     let (mut max, mut sum, mut n) = (0.0f64, 0.0, 0.0);
-    for (g, a, mu) in spline_grid() {
-        let theta = (1.0 / mu).atan();
-        let m = Gtr::new(g, a).map_err(|e| e.to_string())?;
-        let s = m
-            .g1_route(from_spherical(theta, 0.0), "spline")
-            .map_err(|e| e.to_string())?;
-        let e = (s - gtr_g1(g, a, theta).value).abs();
+    for e in errors {
+        let e = e?;
         max = max.max(e);
         sum += e;
         n += 1.0;

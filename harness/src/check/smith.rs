@@ -34,6 +34,18 @@ fn projection(w: Vec3) -> impl Fn(f64) -> (f64, f64) {
     }
 }
 
+/// `from_spherical(θ, φ)` with φ's (sin, cos) given (hoisted out of a run of nodes at one
+/// azimuth): the same operations, so the same direction bit for bit.
+fn spherical(theta: f64, (sp, cp): (f64, f64)) -> Vec3 {
+    let (st, ct) = theta.sin_cos();
+    let ct = if (theta - FRAC_PI_2).abs() < 1e-15 {
+        0.0
+    } else {
+        ct
+    };
+    [st * cp, st * sp, ct]
+}
+
 /// The mean slope along azimuth φ: mean · (cos φ, sin φ) (non-zero for Gaussian slopes with
 /// a mean, seed 002).
 fn mean_slope(subject: &Subject, phi: f64) -> f64 {
@@ -312,12 +324,22 @@ pub fn plan<'a>(
                 // D in batches (one round trip per step for an external model).
                 let e = integrate_hemisphere_polar_batch(
                     &|tp: &[[f64; 2]], out: &mut [f64]| {
-                        // D only where the normal faces w (as the scalar form did).
+                        // D only where the normal faces w (as the scalar form did). The nodes
+                        // of one inner integral share φ_m and come together: the projection at
+                        // φ_m is computed once per run of equal φ_m (the same values).
                         let (mut dirs, mut at) = (Vec::new(), Vec::new());
+                        let mut memo = (f64::NAN, (0.0, 0.0), (0.0, 0.0));
+                        let mut at_phi = |phi_m: f64| {
+                            if phi_m.to_bits() != memo.0.to_bits() {
+                                memo = (phi_m, p(phi_m), phi_m.sin_cos());
+                            }
+                            (memo.1, memo.2)
+                        };
                         for (i, &[theta_m, phi_m]) in tp.iter().enumerate() {
                             out[i] = 0.0;
-                            if theta_m < p(phi_m).1 {
-                                dirs.push(from_spherical(theta_m, phi_m));
+                            let ((_, theta_t), sin_cos_phi) = at_phi(phi_m);
+                            if theta_m < theta_t {
+                                dirs.push(spherical(theta_m, sin_cos_phi));
                                 at.push(i);
                             }
                         }
@@ -325,7 +347,7 @@ pub fn plan<'a>(
                         m.model.d_batch(&dirs, &mut d);
                         for (d, i) in d.into_iter().zip(at) {
                             let [theta_m, phi_m] = tp[i];
-                            let (rr, theta_t) = p(phi_m);
+                            let ((rr, theta_t), _) = at_phi(phi_m);
                             out[i] = g1 * rr * (theta_t - theta_m).sin() * d;
                         }
                     },
@@ -369,7 +391,12 @@ pub fn plan<'a>(
         if to > theta_max || ti > theta_max {
             continue;
         }
+        // Λ's oracles at w_o and w_i, shared by the three quantities of the pair (computed by
+        // whichever check runs first, as the route checks' oracles).
+        let (memo_o, memo_i): (SharedOracle, SharedOracle) =
+            (Arc::new(OnceLock::new()), Arc::new(OnceLock::new()));
         for quantity in ["g1", "g2_uncorrelated", "g2_height_correlated"] {
+            let (memo_o, memo_i) = (memo_o.clone(), memo_i.clone());
             let case = json!({"quantity": quantity, "theta_o": to, "phi_o": po, "theta_i": ti, "phi_i": pi});
             let m = subject.clone();
             let covered = vec![match quantity {
@@ -391,7 +418,8 @@ pub fn plan<'a>(
                     let smith = need(m.model.as_smith(), "Smith masking")?;
                     let (wo, wi) = (from_spherical(to, po), from_spherical(ti, pi));
                     let n = [0.0, 0.0, 1.0];
-                    let (lo, li) = (lambda_oracle_for(&m, wo), lambda_oracle_for(&m, wi));
+                    let lo = *memo_o.get_or_init(|| lambda_oracle_for(&m, wo));
+                    let li = *memo_i.get_or_init(|| lambda_oracle_for(&m, wi));
                     let (go, gi) = (1.0 / (1.0 + lo.value), 1.0 / (1.0 + li.value));
                     let (value, want, bound) = match quantity {
                         "g1" => (smith.g1(wo, n), go, lo.error_bound * go * go),
@@ -506,4 +534,26 @@ pub fn plan<'a>(
         }),
     );
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The hoisted form of the white furnace's directions is `from_spherical` bit for bit,
+    /// the horizon snap included.
+    #[test]
+    fn hoisted_spherical_is_from_spherical() {
+        for theta in [0.0, 1e-9, 0.3, 1.0, FRAC_PI_2 - 1e-16, FRAC_PI_2, 1.7] {
+            for phi in [0.0f64, 0.4, 2.0, 3.9, 6.2] {
+                let got = spherical(theta, phi.sin_cos());
+                let want = from_spherical(theta, phi);
+                assert_eq!(
+                    got.map(f64::to_bits),
+                    want.map(f64::to_bits),
+                    "{theta} {phi}"
+                );
+            }
+        }
+    }
 }

@@ -5,6 +5,7 @@ use super::{around, axis, compare_claim, compare_worst, cover, error};
 use super::{planned, sphere, width, FAMILY};
 use crate::check::{applied, apply_expected, compare, Planned, Profile};
 use crate::oracle::quadrature::frame_about;
+use crate::oracle::Estimate;
 use crate::record::{Measured, OracleValue, Verdict};
 use crate::tolerance::{
     ASG_CONVOLUTION_CLAIM, ASG_CONVOLUTION_CLAIM_SHARP, ASG_LARGE_BANDWIDTH, ASG_PRODUCT_FIT,
@@ -14,6 +15,7 @@ use mfh_reference::geometry::dot;
 use mfh_reference::sg::{Asg, Sg};
 use serde_json::json;
 use std::f64::consts::{PI, TAU};
+use std::sync::{Arc, OnceLock};
 
 const SRC_ASG_EVAL: &str = "seed 003 §3.1: G(v) = c max(v·z, 0) e^{−λ(v·x)² − μ(v·y)²}";
 const SRC_ASG_INTEGRAL: &str =
@@ -154,8 +156,19 @@ pub(super) fn plan_asg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
             ));
         }
         // The ASG–SG convolution, SG of sharpness 2ν = 20 at the ASG's axis and 0.3 rad off.
+        // The oracle (a sphere quadrature) depends on the tilt only: computed once per tilt by
+        // whichever route's check runs first, shared with the other (as Smith's Λ oracles).
+        let oracles: Vec<(f64, Arc<OnceLock<Estimate>>)> = [0.0, 0.3]
+            .into_iter()
+            .map(|t| (t, Arc::new(OnceLock::new())))
+            .collect();
         for (tilt, route) in [(0.0, "default"), (0.3, "default"), (0.3, "exact")] {
             let claimed = bw[0] > 1.0 && bw[1] > 1.0;
+            let memo = oracles
+                .iter()
+                .find(|(t, _)| *t == tilt)
+                .map(|(_, m)| m.clone())
+                .unwrap_or_default();
             out.push(planned(
                 "sg.asg_convolution",
                 json!({"bandwidths": bw, "sg_sharpness": 20.0, "tilt": tilt, "route": route}),
@@ -175,7 +188,9 @@ pub(super) fn plan_asg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
                         Ok(v) => v,
                         Err(e) => return error(r, e),
                     };
-                    let o = sphere(&|v| g.eval(v) * s.eval(v), p, PI, width(20.0), Some(z));
+                    let o = *memo.get_or_init(|| {
+                        sphere(&|v| g.eval(v) * s.eval(v), p, PI, width(20.0), Some(z))
+                    });
                     if route == "exact" {
                         compare(r, value, o, &NUMERICAL_ROUTE);
                     } else {

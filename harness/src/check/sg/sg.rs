@@ -6,6 +6,7 @@ use super::{accuracy, around, axis, compare_claim, compare_worst, cover, error};
 use super::{compare_route, planned, sharpness_grid, sphere, unit, width};
 use crate::check::{compare, Planned, Profile};
 use crate::oracle::quadrature::integrate_pieces;
+use crate::oracle::Estimate;
 use crate::record::CheckRecord;
 use crate::tolerance::{
     Tolerance, CLAMPED_COSINE_FIT, CLOSED_FORM, NUMERICAL_ROUTE, SG_IDENTITY, SG_WARP_AREA,
@@ -14,6 +15,7 @@ use mfh_reference::geometry::dot;
 use mfh_reference::sg::Sg;
 use serde_json::json;
 use std::f64::consts::{LN_10, PI, TAU};
+use std::sync::{Arc, OnceLock};
 
 const SRC_EVAL: &str = "seed 003 §1: G(v; p, λ, μ) = μ e^{λ(v·p − 1)}";
 pub(super) const SRC_INTEGRAL: &str = "seed 003 §1: ∫G = 2πμ(1 − e^{−2λ})/λ (inner product with 1)";
@@ -192,7 +194,18 @@ pub(super) fn plan_sg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
         ));
         // The clamped-cosine fit in use: G · C*(·; n) against ∫ G max(v·n, 0), light at 0° and
         // 60° from n; and the reference's quadrature route.
+        // The oracle depends on the light angle only: computed once per angle by whichever
+        // route's check runs first, shared with the other.
+        let oracles: Vec<(f64, Arc<OnceLock<Estimate>>)> = [0.0, PI / 3.0]
+            .into_iter()
+            .map(|t| (t, Arc::new(OnceLock::new())))
+            .collect();
         for (angle, route) in [(0.0, "default"), (PI / 3.0, "default"), (PI / 3.0, "exact")] {
+            let memo = oracles
+                .iter()
+                .find(|(t, _)| *t == angle)
+                .map(|(_, m)| m.clone())
+                .unwrap_or_default();
             out.push(planned(
                 "sg.clamped_cosine",
                 json!({"sharpness": lambda, "light_angle": angle, "route": route}),
@@ -210,13 +223,15 @@ pub(super) fn plan_sg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
                         Ok(v) => v,
                         Err(e) => return error(r, e),
                     };
-                    let o = sphere(
-                        &|v| a.eval(v) * dot(v, n).max(0.0),
-                        p,
-                        PI,
-                        width(lambda),
-                        Some(n),
-                    );
+                    let o = *memo.get_or_init(|| {
+                        sphere(
+                            &|v| a.eval(v) * dot(v, n).max(0.0),
+                            p,
+                            PI,
+                            width(lambda),
+                            Some(n),
+                        )
+                    });
                     if route == "exact" {
                         compare(r, value, o, &NUMERICAL_ROUTE);
                     } else {

@@ -4,9 +4,9 @@
 use super::{LobeHints, Marginal, INITIAL_PER_PIECE, INNER_ACCURACY, INTERPOLATION_TOLERANCE};
 use super::{MAX_DEPTH, MAX_SPANS, QUADRATURE_TOLERANCE};
 use crate::oracle::lobe::{self, Lobe};
-use crate::oracle::quadrature::integrate_pieces_batch;
+use crate::oracle::quadrature::integrate_pieces_many;
 use crate::oracle::Estimate;
-use mfh_reference::geometry::{from_spherical, Vec3};
+use mfh_reference::geometry::Vec3;
 use rayon::prelude::*;
 use std::f64::consts::FRAC_PI_2;
 
@@ -57,6 +57,15 @@ impl CdfTable {
     /// its error bound) with adaptive Simpson, starting from [`INITIAL_PER_PIECE`] equal
     /// intervals per piece between consecutive `cuts` (sorted, end points included).
     pub fn build(density: &(dyn Fn(f64) -> Estimate + Sync), cuts: &[f64]) -> Self {
+        Self::build_batch(&|xs: &[f64]| xs.iter().map(|&x| density(x)).collect(), cuts)
+    }
+
+    /// [`CdfTable::build`] for a batch density (`density(xs)` returns the estimates at each of
+    /// `xs`, in order): the refinement of every interval advances in waves, and each wave's new
+    /// nodes are evaluated together, in chunks of [`NODES_PER_CALL`] spread over threads. The
+    /// accepted intervals are those of one interval at a time (same tests, same arithmetic);
+    /// only the cap [`MAX_SPANS`] counts the intervals of a wave instead of a depth-first stack.
+    pub fn build_batch(density: &DensityBatch<'_>, cuts: &[f64]) -> Self {
         let mut initial = Vec::new();
         for w in cuts.windows(2).filter(|w| w[1] > w[0]) {
             for k in 0..INITIAL_PER_PIECE {
@@ -75,19 +84,72 @@ impl CdfTable {
         // log-spaced about the lobe, so each carries a comparable part of the mass; a share
         // by length would ask 1e-13 relative of the intervals of a lobe 1e-4 wide).
         let budget = QUADRATURE_TOLERANCE / initial.len().max(1) as f64;
-        let evaluations = std::sync::atomic::AtomicU64::new(0);
-        let pieces: Vec<Vec<Piece>> = initial
-            .par_iter()
-            .map(|&[a, b]| {
-                let (pieces, spent) = refine(density, a, b, budget);
-                evaluations.fetch_add(spent, std::sync::atomic::Ordering::Relaxed);
-                pieces
+        let mut evaluations = 0u64;
+        // The initial nodes: end points (shared by neighbours) and midpoints, each once.
+        let mut xs: Vec<f64> = initial
+            .iter()
+            .flat_map(|&[a, b]| [a, 0.5 * (a + b), b])
+            .collect();
+        xs.sort_by(f64::total_cmp);
+        xs.dedup_by(|x, y| x.to_bits() == y.to_bits());
+        let nodes = evaluate(density, &xs, &mut evaluations);
+        let node = |x: f64| {
+            let i = xs.partition_point(|y| y.total_cmp(&x).is_lt());
+            nodes[i]
+        };
+        let mut active: Vec<Span> = initial
+            .iter()
+            .enumerate()
+            .map(|(interval, &[a, b])| Span {
+                interval,
+                a: node(a),
+                m: node(0.5 * (a + b)),
+                b: node(b),
+                depth: 0,
             })
             .collect();
-        Self::assemble(
-            pieces.into_iter().flatten().collect(),
-            evaluations.into_inner(),
-        )
+        let mut accepted: Vec<Vec<Piece>> = vec![Vec::new(); initial.len()];
+        // Per initial interval: spans examined, and spans queued (this wave's and the next's).
+        let mut examined = vec![0usize; initial.len()];
+        let mut queued = vec![0usize; initial.len()];
+        for s in &active {
+            queued[s.interval] += 1;
+        }
+        while !active.is_empty() {
+            let xs: Vec<f64> = active
+                .iter()
+                .flat_map(|s| [0.5 * (s.a.x + s.m.x), 0.5 * (s.m.x + s.b.x)])
+                .collect();
+            let quarters = evaluate(density, &xs, &mut evaluations);
+            let mut next = Vec::new();
+            for (s, q) in active.iter().zip(quarters.chunks(2)) {
+                let i = s.interval;
+                examined[i] += 1;
+                queued[i] -= 1;
+                let [a, b] = initial[i];
+                let capped = examined[i] + queued[i] >= MAX_SPANS;
+                match judge(
+                    s,
+                    q[0],
+                    q[1],
+                    budget * (s.b.x - s.a.x) / (b - a).max(f64::MIN_POSITIVE),
+                    capped,
+                ) {
+                    Judged::Accept(piece) => accepted[i].push(piece),
+                    Judged::Split([left, right]) => {
+                        queued[i] += 2;
+                        next.extend([left, right]);
+                    }
+                }
+            }
+            active = next;
+        }
+        let mut pieces = Vec::new();
+        for mut a in accepted {
+            a.sort_by(|p, q| p.a.x.total_cmp(&q.a.x));
+            pieces.extend(a);
+        }
+        Self::assemble(pieces, evaluations)
     }
 
     /// Knots, prefix sums and error totals from the accepted pieces (in order).
@@ -145,6 +207,36 @@ impl CdfTable {
         self.cdf.last().copied().unwrap_or(0.0)
     }
 
+    /// F at each of the ascending `xs` (as `f64::total_cmp` sorts), passed to `f(i, F(xs[i]))`
+    /// in order: the values of [`CdfTable::cdf`] bit for bit, the interval found by a walk
+    /// along the knots instead of a binary search per value (the KS statistic evaluates F at
+    /// every one of 2·10⁶ sorted samples).
+    pub fn cdf_ascending(&self, xs: &[f64], mut f: impl FnMut(usize, f64)) {
+        let n = self.knots.len();
+        let mut i = match xs.first() {
+            Some(&x) if n > 0 => self.knots.partition_point(|&k| k <= x).saturating_sub(1),
+            _ => 0,
+        };
+        for (j, &x) in xs.iter().enumerate() {
+            if n < 2 || !(x > self.knots[0]) || x >= self.knots[n - 1] {
+                f(j, self.cdf(x));
+                continue;
+            }
+            while self.knots[i + 1] <= x {
+                i += 1;
+            }
+            f(
+                j,
+                hermite(
+                    [self.knots[i], self.knots[i + 1]],
+                    [self.cdf[i], self.cdf[i + 1]],
+                    [self.density[i], self.density[i + 1]],
+                    x,
+                ),
+            );
+        }
+    }
+
     /// F(x), clamped to the table's range.
     pub fn cdf(&self, x: f64) -> f64 {
         let n = self.knots.len();
@@ -167,68 +259,93 @@ impl CdfTable {
     }
 }
 
-/// Adaptive Simpson over [a, b] (see the module documentation); returns the accepted pieces in
-/// order and the pdf evaluations spent.
-fn refine(
-    density: &(dyn Fn(f64) -> Estimate + Sync),
-    a: f64,
-    b: f64,
-    budget: f64,
-) -> (Vec<Piece>, u64) {
-    let spent = std::cell::Cell::new(0u64);
-    let eval = |x: f64| {
-        let e = density(x);
-        spent.set(spent.get() + e.evaluations);
-        Node {
+/// A batch density: the estimates at each of `xs`, in order.
+pub type DensityBatch<'a> = dyn Fn(&[f64]) -> Vec<Estimate> + Sync + 'a;
+
+/// The nodes of one call of a batch density: a fixed number (not one per thread), so that the
+/// calls' contents, and with them the table, do not depend on the thread count even for a
+/// density whose batches are not evaluated element by element; 64 nodes of ~10² inner
+/// evaluations each make requests of ~10⁴ directions for an external model.
+pub const NODES_PER_CALL: usize = 64;
+
+/// The density at each of `xs` as nodes, in chunks of [`NODES_PER_CALL`] over threads.
+fn evaluate(density: &DensityBatch<'_>, xs: &[f64], evaluations: &mut u64) -> Vec<Node> {
+    let chunks: Vec<Vec<Estimate>> = xs.par_chunks(NODES_PER_CALL).map(density).collect();
+    let mut out = Vec::with_capacity(xs.len());
+    for (e, &x) in chunks.into_iter().flatten().zip(xs) {
+        *evaluations += e.evaluations;
+        out.push(Node {
             x,
             f: e.value,
             error: e.error_bound,
-        }
-    };
-    let mut out = Vec::new();
-    let mut stack = vec![(eval(a), eval(0.5 * (a + b)), eval(b), 0u32)];
-    let mut spans = 0usize;
-    while let Some((na, nm, nb, depth)) = stack.pop() {
-        spans += 1;
-        let q1 = eval(0.5 * (na.x + nm.x));
-        let q3 = eval(0.5 * (nm.x + nb.x));
-        let h = nb.x - na.x;
-        let whole = h / 6.0 * (na.f + 4.0 * nm.f + nb.f);
-        let left = h / 12.0 * (na.f + 4.0 * q1.f + nm.f);
-        let right = h / 12.0 * (nm.f + 4.0 * q3.f + nb.f);
-        let quadrature_error = (left + right - whole).abs();
-        let interpolated = hermite([na.x, nb.x], [0.0, left + right], [na.f, nb.f], nm.x);
-        let interpolation_error = (interpolated - left).abs();
-        let share = budget * h / (b - a).max(f64::MIN_POSITIVE);
-        let good = quadrature_error <= share && interpolation_error <= INTERPOLATION_TOLERANCE;
-        // An invalid density fails the test anyway: no point refining it.
-        let invalid = [na, q1, nm, q3, nb]
-            .iter()
-            .find(|n| !(n.f.is_finite() && n.f >= 0.0))
-            .map(|n| (n.x, n.f));
-        let valid = invalid.is_none();
-        if good || !valid || depth >= MAX_DEPTH || spans + stack.len() >= MAX_SPANS {
-            let inner = [na, q1, nm, q3, nb]
-                .iter()
-                .map(|n| n.error)
-                .fold(0.0f64, f64::max);
-            out.push(Piece {
-                a: na,
-                m: nm,
-                b: nb,
-                left,
-                right,
-                quadrature_error,
-                interpolation_error,
-                inner_error: h * inner,
-                invalid,
-            });
-        } else {
-            stack.push((nm, q3, nb, depth + 1));
-            stack.push((na, q1, nm, depth + 1));
-        }
+        });
     }
-    (out, spent.get())
+    out
+}
+
+/// An interval [a, b] of the adaptive Simpson quadrature with its midpoint node, inside the
+/// initial interval `interval`, `depth` bisections below it.
+#[derive(Debug, Clone, Copy)]
+struct Span {
+    interval: usize,
+    a: Node,
+    m: Node,
+    b: Node,
+    depth: u32,
+}
+
+/// What [`judge`] decides for a span.
+enum Judged {
+    /// The span is accepted as this piece.
+    Accept(Piece),
+    /// The span's two halves, to refine.
+    Split([Span; 2]),
+}
+
+/// One step of adaptive Simpson over a span (see the module documentation), with the nodes
+/// q1, q3 at its quarter points and its `share` of the budget: the accepted piece, or the two
+/// halves to refine. `capped`: accept whatever the error (the span cap is reached).
+fn judge(s: &Span, q1: Node, q3: Node, share: f64, capped: bool) -> Judged {
+    let (na, nm, nb) = (s.a, s.m, s.b);
+    let h = nb.x - na.x;
+    let whole = h / 6.0 * (na.f + 4.0 * nm.f + nb.f);
+    let left = h / 12.0 * (na.f + 4.0 * q1.f + nm.f);
+    let right = h / 12.0 * (nm.f + 4.0 * q3.f + nb.f);
+    let quadrature_error = (left + right - whole).abs();
+    let interpolated = hermite([na.x, nb.x], [0.0, left + right], [na.f, nb.f], nm.x);
+    let interpolation_error = (interpolated - left).abs();
+    let good = quadrature_error <= share && interpolation_error <= INTERPOLATION_TOLERANCE;
+    // An invalid density fails the test anyway: no point refining it.
+    let invalid = [na, q1, nm, q3, nb]
+        .iter()
+        .find(|n| !(n.f.is_finite() && n.f >= 0.0))
+        .map(|n| (n.x, n.f));
+    if good || invalid.is_some() || s.depth >= MAX_DEPTH || capped {
+        let inner = [na, q1, nm, q3, nb]
+            .iter()
+            .map(|n| n.error)
+            .fold(0.0f64, f64::max);
+        Judged::Accept(Piece {
+            a: na,
+            m: nm,
+            b: nb,
+            left,
+            right,
+            quadrature_error,
+            interpolation_error,
+            inner_error: h * inner,
+            invalid,
+        })
+    } else {
+        let half = |a, m, b| Span {
+            interval: s.interval,
+            a,
+            m,
+            b,
+            depth: s.depth + 1,
+        };
+        Judged::Split([half(na, q1, nm), half(nm, q3, nb)])
+    }
 }
 
 /// The monotone cubic Hermite interpolant through (x₀, F₀), (x₁, F₁) with slopes f₀, f₁ ≥ 0,
@@ -255,6 +372,18 @@ fn hermite(x: [f64; 2], f: [f64; 2], slope: [f64; 2], at: f64) -> f64 {
     let h10 = t3 - 2.0 * t2 + t;
     let h11 = t3 - t2;
     (f[0] + h01 * rise + h * (h10 * d0 + h11 * d1)).clamp(f[0], f[1])
+}
+
+/// sin θ and cos θ as `from_spherical` computes them (cos θ snapped to 0 at the horizon), so
+/// that a direction assembled from them and φ's sine and cosine is `from_spherical(θ, φ)` bit
+/// for bit.
+pub(super) fn polar_sin_cos(theta: f64) -> (f64, f64) {
+    let (st, ct) = theta.sin_cos();
+    if (theta - FRAC_PI_2).abs() < 1e-15 {
+        (st, 0.0)
+    } else {
+        (st, ct)
+    }
 }
 
 /// Tabulates the CDF of a marginal of `pdf` (a density with respect to solid angle on the upper
@@ -327,48 +456,76 @@ pub fn marginal_cdf_lobe_batch(
     polar.sort_by(f64::total_cmp);
     polar.dedup();
     let azimuth = lobe.azimuth_cuts();
+    // The inner integrals of one wave of the table run in lockstep: one call of `pdf` per
+    // step of all of them (an external model pays a round trip per step, not per knot), each
+    // with the arithmetic of an integral alone.
     match marginal {
         Marginal::CosTheta => {
-            let density = |theta: f64| {
-                let s = theta.sin();
-                if s == 0.0 {
-                    return Estimate::default();
-                }
-                let e = integrate_pieces_batch(
-                    &|phis: &[f64], out: &mut [f64]| {
-                        let m: Vec<Vec3> =
-                            phis.iter().map(|&phi| from_spherical(theta, phi)).collect();
+            let density = |thetas: &[f64]| {
+                // θ with sin θ = 0 (the pole) has density 0 and no integral.
+                let at: Vec<f64> = thetas.iter().copied().filter(|t| t.sin() != 0.0).collect();
+                let problems: Vec<_> = at
+                    .iter()
+                    .map(|_| (azimuth.clone(), INNER_ACCURACY))
+                    .collect();
+                // θ's sine and (snapped) cosine once per integral, not per node.
+                let trig: Vec<(f64, f64)> = at.iter().map(|&t| polar_sin_cos(t)).collect();
+                let mut m = Vec::new();
+                let mut estimates = integrate_pieces_many(
+                    &mut |tx: &[(usize, f64)], out: &mut [f64]| {
+                        m.clear();
+                        m.extend(tx.iter().map(|&(k, phi)| {
+                            let ((st, ct), (sp, cp)) = (trig[k], phi.sin_cos());
+                            [st * cp, st * sp, ct]
+                        }));
                         pdf(&m, out)
                     },
-                    &azimuth,
-                    INNER_ACCURACY,
-                );
-                Estimate {
-                    value: s * e.value,
-                    error_bound: s * e.error_bound,
-                    evaluations: e.evaluations,
-                }
+                    &problems,
+                )
+                .into_iter();
+                thetas
+                    .iter()
+                    .map(|theta| {
+                        let s = theta.sin();
+                        if s == 0.0 {
+                            return Estimate::default();
+                        }
+                        let e = estimates.next().unwrap_or_default();
+                        Estimate {
+                            value: s * e.value,
+                            error_bound: s * e.error_bound,
+                            evaluations: e.evaluations,
+                        }
+                    })
+                    .collect()
             };
-            CdfTable::build(&density, &polar)
+            CdfTable::build_batch(&density, &polar)
         }
         Marginal::Phi => {
-            let density = |phi: f64| {
-                integrate_pieces_batch(
-                    &|thetas: &[f64], out: &mut [f64]| {
-                        let m: Vec<Vec3> = thetas
-                            .iter()
-                            .map(|&theta| from_spherical(theta, phi))
-                            .collect();
+            let density = |phis: &[f64]| {
+                let problems: Vec<_> = phis
+                    .iter()
+                    .map(|_| (polar.clone(), INNER_ACCURACY))
+                    .collect();
+                // φ's sine and cosine once per integral, not per node.
+                let azimuthal: Vec<(f64, f64)> = phis.iter().map(|p| p.sin_cos()).collect();
+                let mut m = Vec::new();
+                integrate_pieces_many(
+                    &mut |tx: &[(usize, f64)], out: &mut [f64]| {
+                        m.clear();
+                        m.extend(tx.iter().map(|&(k, theta)| {
+                            let ((st, ct), (sp, cp)) = (polar_sin_cos(theta), azimuthal[k]);
+                            [st * cp, st * sp, ct]
+                        }));
                         pdf(&m, out);
-                        for (v, &theta) in out.iter_mut().zip(thetas) {
+                        for (v, &(_, theta)) in out.iter_mut().zip(tx) {
                             *v = if *v == 0.0 { 0.0 } else { *v * theta.sin() };
                         }
                     },
-                    &polar,
-                    INNER_ACCURACY,
+                    &problems,
                 )
             };
-            CdfTable::build(&density, &azimuth)
+            CdfTable::build_batch(&density, &azimuth)
         }
     }
 }

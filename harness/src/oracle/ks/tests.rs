@@ -297,3 +297,53 @@ fn ks_p_values_of_a_correct_sampler_spread_over_seeds() {
         "{p:?}"
     );
 }
+
+/// The table walk and the chunked statistic give `CdfTable::cdf` and `ks_statistic` bit for
+/// bit (values below, inside and above the table, ties, chunk boundaries), and the batched
+/// table build is the same whatever the thread count.
+#[test]
+fn ks_walk_and_batched_table_match_the_scalar_forms() {
+    let g = Ggx::new(0.2, 0.5).unwrap();
+    let h = hints(0.2);
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| marginal_cdf(&|m| g.pdf_wm(m), Marginal::CosTheta, &h))
+    };
+    let table = run(1);
+    assert_eq!(table, run(2));
+    let mut d = draw_batch(
+        &|u: &[[f64; 2]], m: &mut [Vec3]| g.sample_wm_batch(u, m),
+        Marginal::CosTheta,
+        40_000,
+        3,
+    );
+    d.values.extend([-1.0, 0.0, 0.0, 1.0, 1.0, FRAC_PI_2, 2.0]);
+    d.values.sort_unstable_by(f64::total_cmp);
+    let mut walked = vec![f64::NAN; d.values.len()];
+    table.cdf_ascending(&d.values, |i, f| walked[i] = f);
+    for (x, w) in d.values.iter().zip(&walked) {
+        assert_eq!(table.cdf(*x).to_bits(), w.to_bits(), "{x}");
+    }
+    let want = ks_statistic(&d.values, &|x| table.cdf(x));
+    let got = ks_statistic_table(&d.values, &table);
+    assert_eq!(want.0.to_bits(), got.0.to_bits());
+    assert_eq!(want.1.to_bits(), got.1.to_bits());
+}
+
+/// The table's hoisted directions are `from_spherical`'s bit for bit (the horizon included).
+#[test]
+fn ks_table_directions_are_from_spherical() {
+    for theta in [0.0, 1e-9, 0.3, 1.0, FRAC_PI_2 - 1e-16, FRAC_PI_2] {
+        for phi in [0.0f64, 0.4, 2.0, 3.9, 6.2] {
+            let ((st, ct), (sp, cp)) = (table::polar_sin_cos(theta), phi.sin_cos());
+            let want = mfh_reference::geometry::from_spherical(theta, phi);
+            assert_eq!(
+                [st * cp, st * sp, ct].map(f64::to_bits),
+                want.map(f64::to_bits)
+            );
+        }
+    }
+}
