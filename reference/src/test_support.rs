@@ -103,3 +103,68 @@ pub fn golden_beckmann() -> Vec<serde_json::Value> {
         serde_json::from_str(include_str!("../golden/beckmann.json")).expect("golden JSON");
     all["lambda"].as_array().expect("golden table").clone()
 }
+
+/// A table of `reports/accuracy-other-seeds.md` built by an accuracy test: printed as it is
+/// built, then compared with the file's section between `<!-- generated: NAME -->` and
+/// `<!-- end: NAME -->` — or, with `MFH_WRITE_REPORTS=1`, written into it. So the tracked
+/// tables are this test's output, and the test fails when they are stale.
+pub struct ReportTable {
+    name: &'static str,
+    text: String,
+}
+
+impl ReportTable {
+    /// An empty table for the section `name`.
+    pub fn new(name: &'static str) -> Self {
+        Self {
+            name,
+            text: String::new(),
+        }
+    }
+
+    /// Prints a line and appends it to the table.
+    pub fn line(&mut self, line: String) {
+        println!("{line}");
+        self.text.push_str(&line);
+        self.text.push('\n');
+    }
+
+    /// Compares the table with its section of the report (or writes it there).
+    ///
+    /// # Panics
+    /// If the report or its markers are missing, or the section differs from the table.
+    pub fn check_report(&self) {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../reports/accuracy-other-seeds.md");
+        let report = std::fs::read_to_string(&path).expect("reports/accuracy-other-seeds.md");
+        let begin = format!("<!-- generated: {} -->\n", self.name);
+        let end = format!("<!-- end: {} -->", self.name);
+        let start = report.find(&begin).expect("the section's begin marker") + begin.len();
+        let stop = start
+            + report[start..]
+                .find(&end)
+                .expect("the section's end marker");
+        if std::env::var_os("MFH_WRITE_REPORTS").is_some() {
+            let updated = format!("{}{}{}", &report[..start], self.text, &report[stop..]);
+            std::fs::write(&path, updated).expect("write reports/accuracy-other-seeds.md");
+            return;
+        }
+        assert!(
+            report[start..stop] == self.text,
+            "reports/accuracy-other-seeds.md, section {}, is stale: regenerate it with \
+             `MFH_EXTENSIVE=1 MFH_WRITE_REPORTS=1 cargo test -p mfh-reference --release \
+             accuracy_table_`\n--- now ---\n{}--- in the file ---\n{}",
+            self.name,
+            self.text,
+            &report[start..stop]
+        );
+    }
+}
+
+/// `tline!(table, "…", args)`: a formatted line of a [`ReportTable`].
+macro_rules! tline {
+    ($table:expr, $($arg:tt)*) => {
+        $table.line(format!($($arg)*))
+    };
+}
+pub(crate) use tline;

@@ -743,7 +743,7 @@ fn stable_at_the_edges_of_the_domain() {
 /// Run: `MFH_EXTENSIVE=1 cargo test -p mfh-reference --release accuracy_table_gtr -- --nocapture`.
 mod accuracy_table {
     use super::*;
-    use crate::test_support::integrate;
+    use crate::test_support::{integrate, tline, ReportTable};
     use std::f64::consts::TAU;
 
     const TABLE_GAMMAS: [f64; 13] = [
@@ -802,6 +802,7 @@ mod accuracy_table {
             eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")");
             return;
         }
+        let mut out = ReportTable::new("seed004");
         // route label, quantity compared ("Λ" or "G1").
         let rows = [
             ("exact", "Λ"),
@@ -846,19 +847,22 @@ mod accuracy_table {
                 }
             }
         }
-        println!(
+        tline!(
+            out,
             "| quantity | route | {} |",
             TABLE_GAMMAS.map(|g| format!("γ={g}")).join(" | ")
         );
-        println!("|---|---|{}", "---|".repeat(TABLE_GAMMAS.len()));
-        println!(
+        tline!(out, "|---|---|{}", "---|".repeat(TABLE_GAMMAS.len()));
+        tline!(
+            out,
             "| ∫D cos θ dω − 1 (abs) | eq 1**, 4** | {} |",
             norm.iter()
                 .map(|&e| cell(Some(e)))
                 .collect::<Vec<_>>()
                 .join(" | ")
         );
-        println!(
+        tline!(
+            out,
             "| sample_wm: \\|F(θ(u)) − u\\| (abs) | Burley inversion | {} |",
             sampler
                 .iter()
@@ -867,7 +871,8 @@ mod accuracy_table {
                 .join(" | ")
         );
         for (i, (route, quantity)) in rows.iter().enumerate() {
-            println!(
+            tline!(
+                out,
                 "| {quantity} (rel) | `{route}` | {} |",
                 table[i]
                     .iter()
@@ -876,7 +881,8 @@ mod accuracy_table {
                     .join(" | ")
             );
         }
-        println!(
+        tline!(
+            out,
             "| G1 (abs) | `spline` | {} |",
             spline_abs
                 .iter()
@@ -884,6 +890,7 @@ mod accuracy_table {
                 .collect::<Vec<_>>()
                 .join(" | ")
         );
+        out.check_report();
         // What the table must show: the default route and the rearranged closed forms at
         // 1e-10 everywhere; the printed forms fail where they cancel (γ = 3, 4); the
         // spline's claimed 0.1 % fails as a bound off the knots.

@@ -911,6 +911,7 @@ fn eq34_display_is_i11_not_i1() {
 mod accuracy_table {
     use super::*;
     use crate::ndf::Blend;
+    use crate::test_support::{tline, ReportTable};
     use crate::Smith;
 
     const THETAS: [f64; 9] = [1e-6, 1e-3, 0.05, 0.3, 0.8, 1.2, 1.5, 1.57, FRAC_PI_2 - 1e-6];
@@ -963,6 +964,7 @@ mod accuracy_table {
             eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")");
             return;
         }
+        let mut out = ReportTable::new("seed000");
         let models: Vec<(&str, PiecewiseLinear)> =
             small_models().into_iter().chain(big_models()).collect();
         let blend = Blend::new(
@@ -1066,10 +1068,11 @@ mod accuracy_table {
             .map(|(l, m)| format!("{l} ({} pts)", m.breakpoints().len()))
             .chain(["blend ggx 0.2 + beckmann 0.4".to_string()])
             .collect();
-        println!("| quantity | route | {} |", names.join(" | "));
-        println!("|---|---|{}", "---|".repeat(ncol));
+        tline!(out, "| quantity | route | {} |", names.join(" | "));
+        tline!(out, "|---|---|{}", "---|".repeat(ncol));
         for (i, label) in labels.iter().enumerate() {
-            println!(
+            tline!(
+                out,
                 "| {label} | {} |",
                 t[i].iter()
                     .map(|&e| cell(e))
@@ -1077,6 +1080,7 @@ mod accuracy_table {
                     .join(" | ")
             );
         }
+        out.check_report();
         assert_eq!(refused, 0, "slope_space refused {refused} evaluations");
         let worst = |i: usize| t[i].iter().flatten().fold(0.0f64, |a, &b| a.max(b));
         assert!(worst(0) < 1e-12, "normalization {:e}", worst(0));

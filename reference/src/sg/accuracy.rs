@@ -10,7 +10,7 @@ use super::oracle::{cuts, directions, integrate_cut};
 use super::sg::f_a;
 use super::{Asg, CircularGaussian, Sg};
 use crate::geometry::{dot, from_spherical, Vec3};
-use crate::test_support::rel_err;
+use crate::test_support::{rel_err, tline, ReportTable};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_3, LN_10, PI};
 
 /// The columns: SG sharpness λ (ASG: the larger bandwidth; circular Gaussians: κ = 2/σ²).
@@ -315,20 +315,16 @@ fn circular_rows() -> Vec<Row> {
 
 #[test]
 fn accuracy_table_sg() {
-    if std::env::var_os("MFH_EXTENSIVE").is_none() {
-        eprintln!(
-            "skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")"
-        );
-        return;
-    }
+    let mut out = ReportTable::new("seed003");
     let sg = sg_rows();
     let asg = asg_rows();
     let circular = circular_rows();
-    println!(
+    tline!(
+        out,
         "| quantity | route | {} |",
         K.map(|k| format!("λ={k}")).join(" | ")
     );
-    println!("|---|---|{}", "---|".repeat(K.len()));
+    tline!(out, "|---|---|{}", "---|".repeat(K.len()));
     for r in sg.iter().chain(&asg).chain(&circular) {
         let cells: Vec<String> = r
             .cells
@@ -338,8 +334,15 @@ fn accuracy_table_sg() {
                 None => "—".to_string(),
             })
             .collect();
-        println!("| {} | {} | {} |", r.quantity, r.route, cells.join(" | "));
+        tline!(
+            out,
+            "| {} | {} | {} |",
+            r.quantity,
+            r.route,
+            cells.join(" | ")
+        );
     }
+    out.check_report();
     // Exact closed forms and quadrature routes agree with the oracle.
     for r in [
         &sg[0], &sg[1], &sg[2], &sg[4], &sg[5], &sg[6], &sg[8], &sg[9], &sg[11], &sg[13],

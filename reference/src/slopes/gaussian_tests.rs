@@ -5,7 +5,7 @@
 use super::*;
 use crate::geometry::{dot, from_spherical, normal_from_slopes};
 use crate::slopes::test_quadrature::{composite, quad};
-use crate::test_support::rel_err;
+use crate::test_support::{rel_err, tline, ReportTable};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 /// ∫ f over the real line for an f concentrated within 10 `sd` of `centre` (panels of one `sd`).
@@ -861,12 +861,7 @@ fn corrected_pseudocode_fails_far_below_the_cut() {
 /// Run: `MFH_EXTENSIVE=1 cargo test -p mfh-reference --release accuracy_table_gaussian_slopes -- --nocapture`.
 #[test]
 fn accuracy_table_gaussian_slopes() {
-    if std::env::var_os("MFH_EXTENSIVE").is_none() {
-        eprintln!(
-            "skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")"
-        );
-        return;
-    }
+    let mut out = ReportTable::new("seed002");
     let thetas = [
         0.0,
         1e-6,
@@ -910,7 +905,8 @@ fn accuracy_table_gaussian_slopes() {
             }
         }
     }
-    println!(
+    tline!(
+        out,
         "| quantity | route | {} |",
         cases
             .iter()
@@ -918,7 +914,7 @@ fn accuracy_table_gaussian_slopes() {
             .collect::<Vec<_>>()
             .join(" | ")
     );
-    println!("|---|---|{}", "---|".repeat(cases.len()));
+    tline!(out, "|---|---|{}", "---|".repeat(cases.len()));
     let fmt = |r: &Vec<f64>| {
         r.iter()
             .map(|e| format!("{e:.1e}"))
@@ -926,13 +922,18 @@ fn accuracy_table_gaussian_slopes() {
             .join(" | ")
     };
     for (i, route) in routes.iter().enumerate() {
-        println!("| mean, cov of D_s | `{route}` | {} |", fmt(&rows[i]));
+        tline!(out, "| mean, cov of D_s | `{route}` | {} |", fmt(&rows[i]));
     }
-    println!(
+    tline!(
+        out,
         "| N (rel) | eq 16, 24 (`visible_area`) | {} |",
         fmt(&rows[routes.len()])
     );
-    println!("(θ = 0: the transcribed routes return NaN, {nan_at_zero} times; not counted)");
+    tline!(
+        out,
+        "(θ = 0: the transcribed routes return NaN, {nan_at_zero} times; not counted)"
+    );
+    out.check_report();
     let worst = |i: usize| rows[i].iter().fold(0.0f64, |a, &b| a.max(b));
     assert!(worst(0) < 1e-9, "default {:e}", worst(0));
     assert!(worst(routes.len()) < 1e-10, "N {:e}", worst(routes.len()));

@@ -315,16 +315,22 @@ pub fn ks_statistic(sorted: &[f64], cdf: &(dyn Fn(f64) -> f64 + Sync)) -> (f64, 
             ((i as f64 + 1.0) / n - f).max(f - i as f64 / n)
         })
         .enumerate()
-        .reduce(
-            || (usize::MAX, f64::NEG_INFINITY),
-            |p, q| {
-                if q.1 > p.1 || (q.1 == p.1 && q.0 < p.0) {
-                    q
-                } else {
-                    p
-                }
-            },
-        );
+        .reduce(|| (usize::MAX, f64::NEG_INFINITY), first_largest);
+    located(best, sorted)
+}
+
+/// Of two (index, distance) candidates, the larger distance; of equal ones, the first index
+/// (so that the statistic's location does not depend on how the work was split).
+fn first_largest(p: (usize, f64), q: (usize, f64)) -> (usize, f64) {
+    if q.1 > p.1 || (q.1 == p.1 && q.0 < p.0) {
+        q
+    } else {
+        p
+    }
+}
+
+/// (D_N, the sorted value where it is reached) of the best candidate; NaN where there is none.
+fn located(best: (usize, f64), sorted: &[f64]) -> (f64, f64) {
     match best {
         (i, d) if i < sorted.len() => (d, sorted[i]),
         _ => (f64::NAN, f64::NAN),
@@ -353,20 +359,8 @@ pub fn ks_statistic_table(sorted: &[f64], table: &CdfTable) -> (f64, f64) {
             });
             best
         })
-        .reduce(
-            || (usize::MAX, f64::NEG_INFINITY),
-            |p, q| {
-                if q.1 > p.1 || (q.1 == p.1 && q.0 < p.0) {
-                    q
-                } else {
-                    p
-                }
-            },
-        );
-    match best {
-        (i, d) if i < sorted.len() => (d, sorted[i]),
-        _ => (f64::NAN, f64::NAN),
-    }
+        .reduce(|| (usize::MAX, f64::NEG_INFINITY), first_largest);
+    located(best, sorted)
 }
 
 /// Tests the marginal `marginal` of the sampler `sample` against that of the density `pdf`
