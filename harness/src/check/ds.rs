@@ -29,7 +29,8 @@ const BACKFACING_Z0: f64 = -3.0;
 /// The components of a D_s moment set, in the order of [`components`].
 const NAMES: [&str; 5] = ["mean_x", "mean_y", "var_x", "var_y", "cov_xy"];
 
-fn components(m: &VisibleMoments) -> [f64; 5] {
+/// The five components of a moment set: mean x, mean y, var x, var y, cov xy.
+pub(crate) fn components(m: &VisibleMoments) -> [f64; 5] {
     [m.mean[0], m.mean[1], m.cov[0][0], m.cov[1][1], m.cov[0][1]]
 }
 
@@ -221,7 +222,7 @@ fn oracle(spec: &Value, w: Vec3) -> Result<Oracle, String> {
 
 /// The scale each component's error is measured in: a mean in units of max(|mean_i|, σ_i) of
 /// D_s, a variance relative to itself, the covariance relative to σ_x σ_y (as a correlation).
-fn units(o: &[f64; 5]) -> [f64; 5] {
+pub(crate) fn units(o: &[f64; 5]) -> [f64; 5] {
     let (sx, sy) = (o[2].abs().sqrt(), o[3].abs().sqrt());
     [
         o[0].abs().max(sx),

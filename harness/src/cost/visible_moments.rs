@@ -9,13 +9,13 @@
 //!   definition D_s ∝ p_s(s)(w_z − s·w_xy)⁺ to relative 1e-11 (never one of the routes).
 //! - Inputs: three slope distributions (isotropic, anisotropic and correlated with a mean
 //!   offset, strongly correlated) seen from θ ∈ {0.3, 0.8, 1.2, 1.45, 1.55} at φ = 0.4; each
-//!   input is one component of the five (mean x, mean y, var x, cov xy, var y), so one
+//!   input is one component of the five (mean x, mean y, var x, var y, cov xy), so one
 //!   evaluation of a route computes the whole moment set.
 
 use super::{Candidate, Sweep};
+use crate::check::ds::{components, units};
 use crate::oracle::visible_moments::visible_moments_oracle;
 use mfh_reference::geometry::from_spherical;
-use mfh_reference::model::VisibleMoments;
 use mfh_reference::slopes::gaussian::GaussianSlopes;
 use mfh_reference::slopes::pseudocode::Transcription;
 use std::rc::Rc;
@@ -41,16 +41,12 @@ const COMPONENTS: usize = 5;
 /// A route: the five components of the moments of a slope distribution seen from a direction.
 type Route = Rc<dyn Fn(&GaussianSlopes, [f64; 3]) -> [f64; COMPONENTS]>;
 
-/// The five components in the oracle's order: mean x, mean y, var x, cov xy, var y.
-fn components(m: &VisibleMoments) -> [f64; COMPONENTS] {
-    [m.mean[0], m.mean[1], m.cov[0][0], m.cov[0][1], m.cov[1][1]]
-}
-
 /// Nodes and weights of the n-point Gauss–Hermite rule for the standard normal,
 /// E[f(Z)] ≈ Σ wᵢ f(zᵢ), by the Golub–Welsch eigenproblem of the Jacobi matrix of the
 /// probabilists' Hermite polynomials (off-diagonal √k; weights = first eigenvector
-/// components squared). Written here because no maintained crate ships the rule for the
-/// normal weight; nalgebra's symmetric eigensolver does the numerical work.
+/// components squared). Written here rather than taken from `gauss-quad` (whose rule is for
+/// the weight e^{−x²}) to add no dependency for one knob of `mfh cost`: nalgebra, already in
+/// the tree through statrs, does the numerical work.
 pub fn gauss_hermite_normal(n: usize) -> (Vec<f64>, Vec<f64>) {
     let jacobi = nalgebra::DMatrix::from_fn(n, n, |i, j| {
         if i + 1 == j || j + 1 == i {
@@ -69,7 +65,7 @@ pub fn gauss_hermite_normal(n: usize) -> (Vec<f64>, Vec<f64>) {
 
 /// The moments of D_s by the tensor Gauss–Hermite rule `(nodes, weights)` over the Gaussian
 /// slope distribution N(mean, cov) (Cholesky factor), weighted by (w_z − s·w_xy)⁺; the
-/// covariance about the computed mean (two passes).
+/// covariance about the computed mean (two passes); in the order of `check::ds::components`.
 fn cubature_moments(
     rule: &(Vec<f64>, Vec<f64>),
     mean: [f64; 2],
@@ -103,22 +99,7 @@ fn cubature_moments(
         xy += k * d[0] * d[1];
         yy += k * d[1] * d[1];
     }
-    [m[0], m[1], xx / n, xy / n, yy / n]
-}
-
-/// The error of component `k` of a moment set against the reference set `r`: a mean in units
-/// of max(|meanᵢ|, σᵢ) of D_s, a variance relative to itself, the covariance relative to
-/// σ_x σ_y (as a correlation) — the units of the audit's `ds.visible_moments` check.
-fn scaled_error(k: usize, v: f64, r: &[f64; COMPONENTS]) -> f64 {
-    let (sx, sy) = (r[2].abs().sqrt(), r[4].abs().sqrt());
-    let unit = match k {
-        0 => r[0].abs().max(sx),
-        1 => r[1].abs().max(sy),
-        2 => r[2].abs(),
-        3 => sx * sy,
-        _ => r[4].abs(),
-    };
-    (v - r[k]).abs() / unit
+    [m[0], m[1], xx / n, yy / n, xy / n]
 }
 
 /// The D_s sweep (see the module documentation).
@@ -142,7 +123,9 @@ pub fn sweep() -> Sweep<'static> {
     let refs: Vec<[f64; COMPONENTS]> = (0..inputs / COMPONENTS)
         .map(|p| {
             let (c, theta, _) = input(p * COMPONENTS);
-            visible_moments_oracle(&models[c], theta, PHI).map(|e| e.value)
+            let e = visible_moments_oracle(&models[c], theta, PHI).map(|e| e.value);
+            // The oracle's order (mean x, mean y, var x, cov xy, var y) → the check's.
+            [e[0], e[1], e[2], e[4], e[3]]
         })
         .collect();
     let route = |name: String, f: Route| {
@@ -192,7 +175,8 @@ pub fn sweep() -> Sweep<'static> {
         inputs,
         error_of: Box::new(move |i, v| {
             let (_, _, k) = input(i);
-            Some(scaled_error(k, v, &refs[i / COMPONENTS]))
+            let r = &refs[i / COMPONENTS];
+            Some((v - r[k]).abs() / units(r)[k])
         }),
         candidates,
     }

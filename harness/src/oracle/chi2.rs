@@ -208,6 +208,19 @@ pub struct Expected {
     pub evaluations: u64,
 }
 
+impl Expected {
+    /// The expected masses of the cells' estimates, in cell order, with their summed error
+    /// bound and evaluations.
+    fn of_cells(estimates: &[Estimate]) -> Self {
+        Expected {
+            mass: estimates.iter().map(|e| e.value).collect(),
+            total: estimates.iter().map(|e| e.value).sum(),
+            error_bound: estimates.iter().map(|e| e.error_bound).sum(),
+            evaluations: estimates.iter().map(|e| e.evaluations).sum(),
+        }
+    }
+}
+
 /// Draws `samples` normals with `sample` and bins them into `grid`, in parallel, with a result
 /// independent of the thread count (the scalar form of [`observe_batch`]: the same counts).
 pub fn observe<S>(sample: &S, grid: HemisphereGrid, samples: u64, seed: u64) -> Observed
@@ -367,12 +380,7 @@ where
             sum
         })
         .collect();
-    Expected {
-        mass: estimates.iter().map(|e| e.value).collect(),
-        total: estimates.iter().map(|e| e.value).sum(),
-        error_bound: estimates.iter().map(|e| e.error_bound).sum(),
-        evaluations: estimates.iter().map(|e| e.evaluations).sum(),
-    }
+    Expected::of_cells(&estimates)
 }
 
 /// A batch sampler: writes the normal of u[i] into m[i].
@@ -461,12 +469,7 @@ pub fn expected_mass_in_batch(
             sum
         })
         .collect();
-    Expected {
-        mass: estimates.iter().map(|e| e.value).collect(),
-        total: estimates.iter().map(|e| e.value).sum(),
-        error_bound: estimates.iter().map(|e| e.error_bound).sum(),
-        evaluations: estimates.iter().map(|e| e.evaluations).sum(),
-    }
+    Expected::of_cells(&estimates)
 }
 
 /// The cut points strictly inside `range`, with its ends.
