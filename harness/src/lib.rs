@@ -11,7 +11,6 @@ pub mod chi2_run;
 pub mod cli;
 pub mod cost;
 pub mod eval;
-pub mod eval_sg;
 pub mod external;
 pub mod gate;
 pub mod merge;

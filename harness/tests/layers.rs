@@ -14,7 +14,7 @@ fn layer(module: &str) -> Option<u32> {
         "audit" | "gate" | "external" | "shard" | "merge" | "baseline" | "cost" | "chi2_run"
         | "readback" | "selftest" => 4,
         "report" | "heatmap" => 5,
-        "cli" | "chi2_command" | "eval" | "eval_sg" | "main" | "lib" => 6,
+        "cli" | "chi2_command" | "eval" | "main" | "lib" => 6,
         _ => return None,
     })
 }

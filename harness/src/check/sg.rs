@@ -27,7 +27,7 @@ use mfh_reference::Vec3;
 use serde_json::Value;
 use std::f64::consts::{PI, TAU};
 
-/// Every closed-form id `mfh eval` exposes for SGs and ASGs (`harness/src/eval_sg.rs`):
+/// Every closed-form id `mfh eval` exposes for SGs and ASGs (`harness/src/eval/sg.rs`):
 /// `sg/<quantity>/<route>`.
 pub const CLOSED_FORMS: &[&str] = &[
     "sg/sg_eval/default",

@@ -46,7 +46,7 @@ fn standard_plan_covers_every_closed_form_of_eval() {
     // The ids are the quantities `mfh eval` answers.
     for id in CLOSED_FORMS {
         let quantity = id.split('/').nth(1).unwrap();
-        assert!(crate::eval_sg::QUANTITIES.contains(&quantity), "{id}");
+        assert!(crate::eval::sg::QUANTITIES.contains(&quantity), "{id}");
     }
 }
 

@@ -4,69 +4,19 @@
 //! Non-finite numbers, which JSON cannot carry, are written as the strings `"inf"`, `"-inf"`
 //! and `"nan"` (Λ at grazing incidence is +∞).
 
+mod args;
+mod ndf;
+pub mod sg;
+
+pub use args::{number, EvalError, UNIT_TOLERANCE};
+pub use ndf::arguments;
+
 use crate::messages::{compact_numbers, json_error_message};
-use mfh_reference::geometry::{from_spherical, is_unit, Vec3};
-use mfh_reference::{Masking, Model, ModelSpec, ParamError, QueryError};
-use serde_json::{json, Map, Value};
+use args::check_keys;
+use mfh_reference::ModelSpec;
+use ndf::evaluate_quantity;
+use serde_json::{json, Value};
 use std::io::{BufRead, Write};
-
-/// How far from unit length a given direction vector may be.
-pub const UNIT_TOLERANCE: f64 = 1e-9;
-
-/// The error kinds an answer line can carry.
-#[derive(Debug, Clone, PartialEq)]
-pub enum EvalError {
-    /// The line is not a JSON object.
-    Parse(String),
-    /// The model spec is malformed or its parameters are invalid.
-    Model(String),
-    /// An argument of the query is missing or outside its domain.
-    Argument(String),
-    /// The family has no meaning for this quantity.
-    Unsupported(String),
-    /// The requested route is unknown or does not apply.
-    Route(String),
-}
-
-impl EvalError {
-    /// The `kind` field of the error line.
-    pub fn kind(&self) -> &'static str {
-        match self {
-            EvalError::Parse(_) => "parse",
-            EvalError::Model(_) => "model",
-            EvalError::Argument(_) => "argument",
-            EvalError::Unsupported(_) => "unsupported",
-            EvalError::Route(_) => "route",
-        }
-    }
-
-    /// The human-readable message.
-    pub fn message(&self) -> &str {
-        match self {
-            EvalError::Parse(m)
-            | EvalError::Model(m)
-            | EvalError::Argument(m)
-            | EvalError::Unsupported(m)
-            | EvalError::Route(m) => m,
-        }
-    }
-}
-
-impl From<ParamError> for EvalError {
-    fn from(e: ParamError) -> Self {
-        EvalError::Model(e.to_string())
-    }
-}
-
-impl From<QueryError> for EvalError {
-    fn from(e: QueryError) -> Self {
-        match e {
-            QueryError::Unsupported { .. } => EvalError::Unsupported(e.to_string()),
-            QueryError::Route { .. } => EvalError::Route(e.to_string()),
-            QueryError::Argument(_) => EvalError::Argument(e.to_string()),
-        }
-    }
-}
 
 /// Counts of one `eval_stream` run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -219,15 +169,15 @@ pub fn evaluate(line: &str) -> Result<Value, EvalError> {
     let obj = query
         .as_object()
         .ok_or_else(|| EvalError::Parse("a query must be a JSON object".into()))?;
-    // Spherical-Gaussian quantities (seed 003) take no "model": see eval_sg.
+    // Spherical-Gaussian quantities (seed 003) take no "model": see [`sg`].
     if let Some(quantity) = obj.get("quantity").and_then(Value::as_str) {
-        if let Some(known) = crate::eval_sg::arguments(quantity) {
+        if let Some(known) = sg::arguments(quantity) {
             check_keys(obj, quantity, &["quantity", "route"], known)?;
         } else if let Some(known) = arguments(quantity) {
             check_keys(obj, quantity, &["model", "quantity", "route"], known)?;
         }
         let route = obj.get("route").and_then(Value::as_str);
-        if let Some(answer) = crate::eval_sg::evaluate(quantity, obj, route) {
+        if let Some(answer) = sg::evaluate(quantity, obj, route) {
             return answer;
         }
     }
@@ -247,322 +197,6 @@ pub fn evaluate(line: &str) -> Result<Value, EvalError> {
         Some(_) => return Err(EvalError::Argument("\"route\" must be a string".into())),
     };
     evaluate_quantity(model.as_ref(), quantity, obj, route)
-}
-
-fn unsupported(model: &dyn Model, quantity: &str) -> EvalError {
-    if matches!(quantity, "lambda" | "g1" | "g2") {
-        if let Some(why) = model.spec().smith_limit() {
-            return EvalError::Unsupported(format!(
-                "{} does not support {quantity}: {why}",
-                model.family()
-            ));
-        }
-    }
-    QueryError::Unsupported {
-        family: model.family().to_string(),
-        quantity: quantity.to_string(),
-    }
-    .into()
-}
-
-/// The argument keys each model quantity takes (besides `model`, `quantity`, `route`); None
-/// for an unknown quantity.
-pub fn arguments(quantity: &str) -> Option<&'static [&'static str]> {
-    Some(match quantity {
-        "d" | "pdf_wm" => &["m", "theta", "phi"],
-        "lambda" | "visible_moments" => &["w", "theta", "phi"],
-        "g1" => &["w", "theta", "phi", "m"],
-        "g2" => &[
-            "wo", "theta_o", "phi_o", "wi", "theta_i", "phi_i", "m", "masking",
-        ],
-        "p22" => &["p", "q"],
-        "p2" => &["q", "phi"],
-        "slope_moment" => &["k", "phi"],
-        "variance" => &["phi"],
-        "excess_kurtosis" => &[],
-        "sample_wm" => &["u"],
-        "sample_wm_visible" => &["wi", "theta_i", "phi_i", "u"],
-        "pdf_wm_visible" => &["wi", "theta_i", "phi_i", "m", "theta", "phi"],
-        _ => return None,
-    })
-}
-
-/// Rejects a key of `q` that is neither in `common` nor in `known`, naming it and the keys the
-/// quantity takes: a misspelled optional key (`"ph"`) must not silently answer for its default.
-pub(crate) fn check_keys(
-    q: &Map<String, Value>,
-    quantity: &str,
-    common: &[&str],
-    known: &[&str],
-) -> Result<(), EvalError> {
-    match q
-        .keys()
-        .find(|k| !common.contains(&k.as_str()) && !known.contains(&k.as_str()))
-    {
-        None => Ok(()),
-        Some(k) => {
-            let mut all: Vec<&str> = common.to_vec();
-            all.extend_from_slice(known);
-            let shown: String = k.chars().take(40).collect();
-            Err(EvalError::Argument(format!(
-                "unknown key {shown:?} for quantity {quantity} (known: {})",
-                all.join(", ")
-            )))
-        }
-    }
-}
-
-fn no_route(route: Option<&str>, quantity: &str) -> Result<(), EvalError> {
-    match route {
-        None | Some("default") => Ok(()),
-        Some(r) => Err(EvalError::Route(format!(
-            "route {r:?} is not available: {quantity} has a single route"
-        ))),
-    }
-}
-
-fn evaluate_quantity(
-    model: &dyn Model,
-    quantity: &str,
-    q: &Map<String, Value>,
-    route: Option<&str>,
-) -> Result<Value, EvalError> {
-    match quantity {
-        "d" => {
-            no_route(route, quantity)?;
-            Ok(number(model.d(direction(q, "m")?)))
-        }
-        "lambda" => {
-            let smith = model
-                .as_smith()
-                .ok_or_else(|| unsupported(model, quantity))?;
-            let w = direction(q, "w")?;
-            Ok(number(match route {
-                None => smith.lambda(w),
-                Some(r) => smith.lambda_route(w, r)?,
-            }))
-        }
-        "g1" => {
-            no_route(route, quantity)?;
-            let smith = model
-                .as_smith()
-                .ok_or_else(|| unsupported(model, quantity))?;
-            let w = direction(q, "w")?;
-            let m = optional_vector(q, "m")?.unwrap_or([0.0, 0.0, 1.0]);
-            Ok(number(smith.g1(w, m)))
-        }
-        "g2" => {
-            no_route(route, quantity)?;
-            let smith = model
-                .as_smith()
-                .ok_or_else(|| unsupported(model, quantity))?;
-            let wo = direction(q, "wo")?;
-            let wi = direction(q, "wi")?;
-            let m = optional_vector(q, "m")?.unwrap_or([0.0, 0.0, 1.0]);
-            let masking: Masking = match q.get("masking") {
-                None => Masking::HeightCorrelated,
-                Some(v) => serde_json::from_value(v.clone()).map_err(|_| {
-                    EvalError::Argument(
-                        "\"masking\" must be \"uncorrelated\" or \"height_correlated\"".into(),
-                    )
-                })?,
-            };
-            Ok(number(smith.g2(wo, wi, m, masking)))
-        }
-        "p22" => {
-            no_route(route, quantity)?;
-            let slopes = model
-                .as_slopes()
-                .ok_or_else(|| unsupported(model, quantity))?;
-            Ok(number(slopes.p22(finite(q, "p")?, finite(q, "q")?)))
-        }
-        "p2" => {
-            no_route(route, quantity)?;
-            let slopes = model
-                .as_slopes()
-                .ok_or_else(|| unsupported(model, quantity))?;
-            let phi = optional_finite(q, "phi")?.unwrap_or(0.0);
-            Ok(number(slopes.p2(finite(q, "q")?, phi)))
-        }
-        "slope_moment" | "variance" | "excess_kurtosis" => {
-            no_route(route, quantity)?;
-            let slopes = model
-                .as_slopes()
-                .ok_or_else(|| unsupported(model, quantity))?;
-            let phi = optional_finite(q, "phi")?.unwrap_or(0.0);
-            let v = match quantity {
-                "slope_moment" => {
-                    let k = q.get("k").and_then(Value::as_u64).ok_or_else(|| {
-                        EvalError::Argument("\"k\" must be a non-negative integer".into())
-                    })?;
-                    let k = u32::try_from(k)
-                        .map_err(|_| EvalError::Argument("\"k\" is too large".into()))?;
-                    slopes.slope_moment(k, phi)
-                }
-                "variance" => slopes.variance(phi),
-                _ => slopes.excess_kurtosis(),
-            };
-            Ok(v.map(number).unwrap_or(Value::Null))
-        }
-        "sample_wm" => {
-            no_route(route, quantity)?;
-            let sampler = model
-                .as_sampler()
-                .ok_or_else(|| unsupported(model, quantity))?;
-            let m = sampler.sample_wm(unit_square(q)?);
-            Ok(Value::Array(m.iter().map(|c| number(*c)).collect()))
-        }
-        "sample_wm_visible" => {
-            no_route(route, quantity)?;
-            let sampler = model
-                .as_visible_sampler()
-                .ok_or_else(|| unsupported(model, quantity))?;
-            let wi = visible_incidence(q)?;
-            let m = sampler.sample_wm_visible(wi, unit_square(q)?);
-            Ok(Value::Array(m.iter().map(|c| number(*c)).collect()))
-        }
-        "pdf_wm_visible" => {
-            no_route(route, quantity)?;
-            let sampler = model
-                .as_visible_sampler()
-                .ok_or_else(|| unsupported(model, quantity))?;
-            let wi = visible_incidence(q)?;
-            Ok(number(sampler.pdf_wm_visible(wi, direction(q, "m")?)))
-        }
-        "pdf_wm" => {
-            no_route(route, quantity)?;
-            let sampler = model
-                .as_sampler()
-                .ok_or_else(|| unsupported(model, quantity))?;
-            Ok(number(sampler.pdf_wm(direction(q, "m")?)))
-        }
-        "visible_moments" => {
-            let moments = model
-                .as_visible_moments()
-                .ok_or_else(|| unsupported(model, quantity))?;
-            let w = direction(q, "w")?;
-            let v = match route {
-                None => moments.visible_moments(w)?,
-                Some(r) => moments.visible_moments_route(w, r)?,
-            };
-            Ok(json!({
-                "mean": [number(v.mean[0]), number(v.mean[1])],
-                "cov": [
-                    [number(v.cov[0][0]), number(v.cov[0][1])],
-                    [number(v.cov[1][0]), number(v.cov[1][1])]
-                ],
-            }))
-        }
-        other => Err(EvalError::Argument(format!(
-            "unknown quantity {other:?} (known: d, lambda, g1, g2, p22, p2, slope_moment, \
-             variance, excess_kurtosis, sample_wm, pdf_wm, sample_wm_visible, pdf_wm_visible, \
-             visible_moments, and the SG/ASG quantities)"
-        ))),
-    }
-}
-
-/// The sample point `"u": [u1, u2]` in [0, 1)².
-fn unit_square(q: &Map<String, Value>) -> Result<[f64; 2], EvalError> {
-    let u = q
-        .get("u")
-        .and_then(Value::as_array)
-        .filter(|a| a.len() == 2)
-        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]))
-        .ok_or_else(|| EvalError::Argument("\"u\" must be [u1, u2]".into()))?;
-    if !u.iter().all(|x| (0.0..1.0).contains(x)) {
-        return Err(EvalError::Argument(format!(
-            "\"u\" must lie in [0, 1)² (got {u:?})"
-        )));
-    }
-    Ok(u)
-}
-
-/// The incident direction of the visible-normal quantities (`"wi"`, or `"theta_i"` and
-/// `"phi_i"`), which must lie strictly above the horizon.
-fn visible_incidence(q: &Map<String, Value>) -> Result<Vec3, EvalError> {
-    let wi = direction(q, "wi")?;
-    if !mfh_reference::model::visible_domain(wi) {
-        return Err(EvalError::Argument(format!(
-            "the incident direction must lie strictly above the horizon (got {wi:?})"
-        )));
-    }
-    Ok(wi)
-}
-
-/// A JSON number, or `"inf"`, `"-inf"`, `"nan"` for non-finite values.
-pub fn number(x: f64) -> Value {
-    if x.is_finite() {
-        json!(x)
-    } else if x.is_nan() {
-        json!("nan")
-    } else if x > 0.0 {
-        json!("inf")
-    } else {
-        json!("-inf")
-    }
-}
-
-fn finite(q: &Map<String, Value>, key: &str) -> Result<f64, EvalError> {
-    optional_finite(q, key)?.ok_or_else(|| EvalError::Argument(format!("missing \"{key}\"")))
-}
-
-fn optional_finite(q: &Map<String, Value>, key: &str) -> Result<Option<f64>, EvalError> {
-    match q.get(key) {
-        None => Ok(None),
-        Some(v) => match v.as_f64() {
-            Some(x) if x.is_finite() => Ok(Some(x)),
-            _ => Err(EvalError::Argument(format!(
-                "\"{key}\" must be a finite number (got {v})"
-            ))),
-        },
-    }
-}
-
-fn optional_vector(q: &Map<String, Value>, key: &str) -> Result<Option<Vec3>, EvalError> {
-    let Some(v) = q.get(key) else {
-        return Ok(None);
-    };
-    let a = v
-        .as_array()
-        .filter(|a| a.len() == 3)
-        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?, a[2].as_f64()?]))
-        .ok_or_else(|| EvalError::Argument(format!("\"{key}\" must be [x, y, z]")))?;
-    if !is_unit(a, UNIT_TOLERANCE) {
-        return Err(EvalError::Argument(format!(
-            "\"{key}\" must be a unit vector (got {a:?})"
-        )));
-    }
-    Ok(Some(a))
-}
-
-/// A direction given as the unit vector `key`, or as `theta` (and optional `phi`); for the
-/// two-direction quantities the angles are `theta_o`/`phi_o` and `theta_i`/`phi_i`.
-fn direction(q: &Map<String, Value>, key: &str) -> Result<Vec3, EvalError> {
-    let (theta_key, phi_key) = match key {
-        "wo" => ("theta_o", "phi_o"),
-        "wi" => ("theta_i", "phi_i"),
-        _ => ("theta", "phi"),
-    };
-    let vector = optional_vector(q, key)?;
-    let theta = optional_finite(q, theta_key)?;
-    match (vector, theta) {
-        (Some(_), Some(_)) => Err(EvalError::Argument(format!(
-            "give either \"{key}\" or \"{theta_key}\", not both"
-        ))),
-        (Some(v), None) => Ok(v),
-        (None, Some(theta)) => {
-            if !(0.0..=std::f64::consts::PI).contains(&theta) {
-                return Err(EvalError::Argument(format!(
-                    "\"{theta_key}\" must lie in [0, π] (got {theta})"
-                )));
-            }
-            let phi = optional_finite(q, phi_key)?.unwrap_or(0.0);
-            Ok(from_spherical(theta, phi))
-        }
-        (None, None) => Err(EvalError::Argument(format!(
-            "missing direction: give \"{key}\" ([x, y, z]) or \"{theta_key}\" (and \"{phi_key}\")"
-        ))),
-    }
 }
 
 /// Test helpers shared by the unit tests of every `eval` module.
@@ -593,6 +227,7 @@ pub(crate) mod testing {
 mod tests {
     use super::testing::{error_kind, value};
     use super::*;
+    use mfh_reference::geometry::from_spherical;
 
     #[test]
     fn std_lambda_matches_library() {

@@ -19,7 +19,7 @@
 //! | `asg_integral` | `asg` | `default` (§3.2.1 with F), `large_bandwidth` (π/√(λμ)), `exact` |
 //! | `asg_sg_convolution` | `asg`, `sg` (its axis is p; or give p as `v` and leave the axis out) | `default` (§3.2.3), `exact` |
 
-use crate::eval::{number, EvalError, UNIT_TOLERANCE};
+use super::args::{number, optional_finite, EvalError, UNIT_TOLERANCE};
 use mfh_reference::geometry::{is_unit, Vec3};
 use mfh_reference::sg::{Asg, Sg};
 use serde_json::{json, Map, Value};
@@ -188,18 +188,6 @@ fn routes(quantity: &str, route: &str, known: &[&str]) -> Result<(), EvalError> 
             "route {route:?} is not available for {quantity} (known: {})",
             known.join(", ")
         )))
-    }
-}
-
-fn optional_finite(q: &Map<String, Value>, key: &str) -> Result<Option<f64>, EvalError> {
-    match q.get(key) {
-        None => Ok(None),
-        Some(v) => match v.as_f64() {
-            Some(x) if x.is_finite() => Ok(Some(x)),
-            _ => Err(EvalError::Argument(format!(
-                "\"{key}\" must be a finite number (got {v})"
-            ))),
-        },
     }
 }
 
