@@ -24,14 +24,14 @@
 
 mod common;
 
-use common::{config, directions, golden, over, thetas, N};
+use common::{config, directions, golden, over, piecewise_model, thetas, N};
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, Throughput};
 use mfh_reference::geometry::from_spherical;
 use mfh_reference::model::VisibleSlopeMoments;
 use mfh_reference::ndf::gtr::Gtr;
 use mfh_reference::ndf::student::Member;
-use mfh_reference::ndf::{student_lambda, Beckmann, Blend, Ggx, PiecewiseLinear, Profile, Student};
+use mfh_reference::ndf::{student_lambda, Beckmann, Blend, Ggx, Student};
 use mfh_reference::slopes::gaussian::GaussianSlopes;
 use mfh_reference::special::{hyp2f1, student_tail};
 use mfh_reference::{Ndf, NormalSampler, Smith, Vec3};
@@ -99,16 +99,6 @@ fn over_uniforms(g: &mut BenchmarkGroup<'_, WallTime>, id: &str, s: &dyn NormalS
 
 fn std_model(member: Member, gamma: f64) -> Student {
     Student::new(member, gamma, ALPHA, ALPHA).expect("valid Student parameters")
-}
-
-/// The piecewise-linear model of the benchmarks: the anisotropic blend (eq 1 of seed 000) of
-/// GGX α = 0.2 along x and Beckmann α = 0.4 along y, each discretized at 32 breakpoints.
-fn piecewise_model() -> PiecewiseLinear {
-    let ggx = Ggx::new(0.2, 0.2).expect("valid");
-    let beckmann = Beckmann::new(0.4, 0.4).expect("valid");
-    let x = Profile::discretize(&|t| ggx.d(from_spherical(t, 0.0)), 32);
-    let y = Profile::discretize(&|t| beckmann.d(from_spherical(t, 0.0)), 32);
-    PiecewiseLinear::new(x, Some(y)).expect("valid profiles")
 }
 
 /// The blend model of the benchmarks: GGX α = 0.2 along x, Beckmann α = 0.4 along y.

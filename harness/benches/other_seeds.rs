@@ -20,16 +20,16 @@
 
 mod common;
 
-use common::{config, directions, golden, group, over, slow_group, thetas, N};
+use common::{config, directions, golden, group, over, piecewise_model, slow_group, thetas, N};
 use criterion::Criterion;
 use mfh_reference::geometry::from_spherical;
 use mfh_reference::model::VisibleSlopeMoments;
 use mfh_reference::ndf::gtr::Gtr;
-use mfh_reference::ndf::{Beckmann, Blend, Ggx, PiecewiseLinear, Profile};
+use mfh_reference::ndf::{Beckmann, Blend, Ggx};
 use mfh_reference::sg::circular::{self, CircularGaussian};
 use mfh_reference::sg::{Asg, Sg};
 use mfh_reference::slopes::gaussian::GaussianSlopes;
-use mfh_reference::{Ndf, Smith, Vec3};
+use mfh_reference::{Smith, Vec3};
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::time::Duration;
 
@@ -125,16 +125,6 @@ fn bench_gtr(c: &mut Criterion) {
         );
     }
     g.finish();
-}
-
-/// The piecewise-linear model of the benchmarks (as in closed_forms.rs): the anisotropic blend
-/// (eq 1 of seed 000) of GGX α = 0.2 along x and Beckmann α = 0.4 along y, 32 breakpoints each.
-fn piecewise_model() -> PiecewiseLinear {
-    let ggx = Ggx::new(0.2, 0.2).expect("valid");
-    let beckmann = Beckmann::new(0.4, 0.4).expect("valid");
-    let x = Profile::discretize(&|t| ggx.d(from_spherical(t, 0.0)), 32);
-    let y = Profile::discretize(&|t| beckmann.d(from_spherical(t, 0.0)), 32);
-    PiecewiseLinear::new(x, Some(y)).expect("valid profiles")
 }
 
 /// Piecewise-linear (seed 000): Algorithm 1 (φ), Algorithm 2 (θ | φ), the cdfs of eq 7 and
@@ -250,13 +240,18 @@ fn bench_sg(c: &mut Criterion) {
     g.finish();
 
     // Partner lobes: axes 64 directions over the sphere, sharpness fixed per benchmark.
-    let mut g = group(c, "sg_inner/sg", N);
-    for l in sharpnesses {
+    // The lobe of sharpness l and its partners of sharpness 0.7 l along the directions `sph`.
+    let partners = |l: f64| {
         let a = Sg::new(axis(0.4, 0.3), l, 1.5).expect("valid SG");
         let bs: Vec<Sg> = sph
             .iter()
             .map(|&p| Sg::new(p, l * 0.7, 0.8).expect("valid SG"))
             .collect();
+        (a, bs)
+    };
+    let mut g = group(c, "sg_inner/sg", N);
+    for l in sharpnesses {
+        let (a, bs) = partners(l);
         over(&mut g, &format!("lambda={l}/default"), &bs, |b| a.inner(&b));
         over(&mut g, &format!("lambda={l}/printed"), &bs, |b| {
             a.inner_printed(&b)
@@ -265,11 +260,7 @@ fn bench_sg(c: &mut Criterion) {
     g.finish();
     let mut g = group(c, "sg_product/sg", N);
     for l in sharpnesses {
-        let a = Sg::new(axis(0.4, 0.3), l, 1.5).expect("valid SG");
-        let bs: Vec<Sg> = sph
-            .iter()
-            .map(|&p| Sg::new(p, l * 0.7, 0.8).expect("valid SG"))
-            .collect();
+        let (a, bs) = partners(l);
         over(&mut g, &format!("lambda={l}"), &bs, |b| {
             a.product(&b).amplitude()
         });

@@ -124,29 +124,12 @@ fn model() -> impl Strategy<Value = Value> {
 }
 
 /// Every quantity `mfh eval` knows, and one it does not.
-const QUANTITIES: [&str; 21] = [
-    "d",
-    "lambda",
-    "g1",
-    "g2",
-    "p22",
-    "p2",
-    "slope_moment",
-    "variance",
-    "excess_kurtosis",
-    "sample_wm",
-    "sample_wm_visible",
-    "pdf_wm_visible",
-    "pdf_wm",
-    "visible_moments",
-    "sg_eval",
-    "sg_inner",
-    "sg_product",
-    "sg_integral",
-    "sg_warp",
-    "asg_eval",
-    "asg_sg_convolution",
-];
+fn quantities() -> Vec<&'static str> {
+    let mut all: Vec<&str> = mfh_harness::eval::QUANTITIES.to_vec();
+    all.extend_from_slice(&mfh_harness::eval::sg::QUANTITIES);
+    all.push("unknown");
+    all
+}
 
 /// An eval query: a quantity, a model, and arguments under known and unknown keys. Routes are
 /// the default ones: the quadrature routes (`exact`) take milliseconds each and are fuzzed in
@@ -159,7 +142,7 @@ fn query() -> impl Strategy<Value = Value> {
         vec!["default", "printed", "integer", "nope"]
     };
     (
-        prop::sample::select(QUANTITIES.to_vec()),
+        prop::sample::select(quantities()),
         model(),
         prop::collection::btree_map(key(), prop_oneof![2 => number(), 1 => value()], 0..5),
         prop::option::of(prop::sample::select(routes)),

@@ -5,21 +5,12 @@
 //! correct GGX and Beckmann samplers lie in their 99 % binomial intervals with uniform
 //! p-values.
 
-use mfh_harness::cli;
 use mfh_harness::selftest::{calibrate, catalog::CATALOG};
 use serde_json::Value;
 use std::path::PathBuf;
 
 fn mfh(args: &[&str]) -> (i32, String, String) {
-    let mut argv = vec!["mfh"];
-    argv.extend_from_slice(args);
-    let (mut out, mut err) = (Vec::new(), Vec::new());
-    let code = cli::run(argv, &mut std::io::empty(), &mut out, &mut err);
-    (
-        code,
-        String::from_utf8_lossy(&out).into_owned(),
-        String::from_utf8_lossy(&err).into_owned(),
-    )
+    mfh_harness::cli::run_captured(args)
 }
 
 fn out_dir(name: &str) -> PathBuf {

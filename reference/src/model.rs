@@ -156,16 +156,7 @@ pub trait Smith: Ndf {
 
     /// G2(wo, wi, m) in the uncorrelated (eq 22) or height-correlated (eq 23) form of seed 001.
     fn g2(&self, wo: Vec3, wi: Vec3, m: Vec3, masking: Masking) -> f64 {
-        match masking {
-            Masking::Uncorrelated => self.g1(wo, m) * self.g1(wi, m),
-            Masking::HeightCorrelated => {
-                if wo[2] <= 0.0 || wi[2] <= 0.0 || dot(wo, m) <= 0.0 || dot(wi, m) <= 0.0 {
-                    0.0
-                } else {
-                    1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
-                }
-            }
-        }
+        smith_g2(self, wo, wi, m, masking)
     }
 
     /// `out[i] = self.lambda(w[i])` for every i (the default loops over [`Smith::lambda`]).
@@ -180,6 +171,22 @@ pub trait Smith: Ndf {
         );
         for (o, &w) in out.iter_mut().zip(w) {
             *o = self.lambda(w);
+        }
+    }
+}
+
+/// G2(wo, wi, m) of seed 001 from `s`'s G1 and Λ: uncorrelated (eq 22), G1(wo)·G1(wi), or
+/// height-correlated (eq 23), χ⁺ / (1 + Λ(wo) + Λ(wi)). [`Smith::g2`]'s default, and what a
+/// wrapper that overrides `g2` (the self-test's mutants) calls after changing the masking.
+pub fn smith_g2<S: Smith + ?Sized>(s: &S, wo: Vec3, wi: Vec3, m: Vec3, masking: Masking) -> f64 {
+    match masking {
+        Masking::Uncorrelated => s.g1(wo, m) * s.g1(wi, m),
+        Masking::HeightCorrelated => {
+            if wo[2] <= 0.0 || wi[2] <= 0.0 || dot(wo, m) <= 0.0 || dot(wi, m) <= 0.0 {
+                0.0
+            } else {
+                1.0 / (1.0 + s.lambda(wo) + s.lambda(wi))
+            }
         }
     }
 }

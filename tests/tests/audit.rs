@@ -4,7 +4,6 @@
 
 use mfh_harness::audit::{audit_scene, run_plan, AuditOptions};
 use mfh_harness::check::{Planned, Profile};
-use mfh_harness::cli::run;
 use mfh_harness::plan::plan;
 use mfh_harness::record::{CheckRecord, Verdict, SCHEMA_VERSION};
 use mfh_harness::scene::Scene;
@@ -14,14 +13,7 @@ use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 fn mfh(args: &[&str]) -> (i32, String, String) {
-    let argv: Vec<&str> = std::iter::once("mfh").chain(args.iter().copied()).collect();
-    let (mut out, mut err) = (Vec::new(), Vec::new());
-    let status = run(argv, &mut std::io::empty(), &mut out, &mut err);
-    (
-        status,
-        String::from_utf8(out).expect("stdout is UTF-8"),
-        String::from_utf8(err).expect("stderr is UTF-8"),
-    )
+    mfh_harness::cli::run_captured(args)
 }
 
 fn temp(name: &str) -> PathBuf {

@@ -5,6 +5,8 @@
 //! answers keep the order of the queries, a bad line does not stop the others, and the exit
 //! status is 2 exactly when some line failed.
 
+// The quantities of the contract: every model quantity `mfh eval` answers.
+use mfh_harness::eval::QUANTITIES;
 use mfh_reference::geometry::{from_spherical, Vec3};
 use mfh_reference::ndf::gtr_lambda::ROUTES as GTR_ROUTES;
 use mfh_reference::ndf::student_lambda::ROUTES;
@@ -63,24 +65,6 @@ fn families() -> Vec<Value> {
     }));
     listed
 }
-
-/// The quantities of the contract.
-const QUANTITIES: [&str; 14] = [
-    "d",
-    "lambda",
-    "g1",
-    "g2",
-    "p22",
-    "p2",
-    "slope_moment",
-    "variance",
-    "excess_kurtosis",
-    "sample_wm",
-    "pdf_wm",
-    "visible_moments",
-    "sample_wm_visible",
-    "pdf_wm_visible",
-];
 
 /// The quantities a model has a meaning for (ARCHITECTURE.md and the source documents): everything
 /// for the elliptic slope families (but Λ, G1, G2 only where γ > 3/2); D, Smith and sampling for

@@ -5,21 +5,13 @@
 //! Also the bad-input contract: an unwritable `--out` or a report that cannot be written whole
 //! exits 2 with a clear message, and report.json is written first.
 
-use mfh_harness::cli::run;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 fn mfh(args: &[&str]) -> (i32, String, String) {
-    let argv: Vec<&str> = std::iter::once("mfh").chain(args.iter().copied()).collect();
-    let (mut out, mut err) = (Vec::new(), Vec::new());
-    let status = run(argv, &mut std::io::empty(), &mut out, &mut err);
-    (
-        status,
-        String::from_utf8(out).expect("stdout is UTF-8"),
-        String::from_utf8(err).expect("stderr is UTF-8"),
-    )
+    mfh_harness::cli::run_captured(args)
 }
 
 /// The test's output folder (kept after the run: the screenshot is for people to look at).

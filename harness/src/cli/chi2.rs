@@ -352,22 +352,7 @@ pub fn write_artefacts(
 
 #[cfg(test)]
 mod tests {
-    use crate::cli::run;
-
-    fn run_args(args: &[&str]) -> (i32, String, String) {
-        let (mut out, mut err) = (Vec::new(), Vec::new());
-        let code = run(
-            std::iter::once("mfh").chain(args.iter().copied()),
-            &mut std::io::empty(),
-            &mut out,
-            &mut err,
-        );
-        (
-            code,
-            String::from_utf8(out).unwrap(),
-            String::from_utf8(err).unwrap(),
-        )
-    }
+    use crate::cli::run_captured as run_args;
 
     #[test]
     fn chi2_cli_visible_normals_at_an_incidence() {

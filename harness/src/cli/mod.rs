@@ -132,6 +132,24 @@ pub enum Command {
     Cost(cost::CostArgs),
 }
 
+/// Runs the CLI in-process on `args` (without the program name) with an empty standard input:
+/// (exit code, standard output, standard error), the outputs as (lossy) UTF-8. For embedding
+/// `mfh` in another Rust program and for tests.
+pub fn run_captured(args: &[&str]) -> (i32, String, String) {
+    let (mut out, mut err) = (Vec::new(), Vec::new());
+    let code = run(
+        std::iter::once("mfh").chain(args.iter().copied()),
+        &mut std::io::empty(),
+        &mut out,
+        &mut err,
+    );
+    (
+        code,
+        String::from_utf8_lossy(&out).into_owned(),
+        String::from_utf8_lossy(&err).into_owned(),
+    )
+}
+
 /// Runs the command line `args` (including the program name) with the given streams and
 /// returns the exit status.
 pub fn run<I, T>(

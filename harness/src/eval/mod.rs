@@ -9,7 +9,7 @@ mod ndf;
 pub mod sg;
 
 pub use args::{number, EvalError, UNIT_TOLERANCE};
-pub use ndf::arguments;
+pub use ndf::{arguments, QUANTITIES};
 
 use crate::messages::{compact_numbers, json_error_message};
 use args::check_keys;

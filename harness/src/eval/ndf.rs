@@ -24,6 +24,24 @@ fn unsupported(model: &dyn Model, quantity: &str) -> EvalError {
     .into()
 }
 
+/// The model quantities `mfh eval` answers (the SG/ASG ones are [`super::sg::QUANTITIES`]).
+pub const QUANTITIES: [&str; 14] = [
+    "d",
+    "lambda",
+    "g1",
+    "g2",
+    "p22",
+    "p2",
+    "slope_moment",
+    "variance",
+    "excess_kurtosis",
+    "sample_wm",
+    "pdf_wm",
+    "visible_moments",
+    "sample_wm_visible",
+    "pdf_wm_visible",
+];
+
 /// The argument keys each model quantity takes (besides `model`, `quantity`, `route`); None
 /// for an unknown quantity.
 pub fn arguments(quantity: &str) -> Option<&'static [&'static str]> {
@@ -179,9 +197,21 @@ pub(crate) fn evaluate_quantity(
             }))
         }
         other => Err(EvalError::Argument(format!(
-            "unknown quantity {other:?} (known: d, lambda, g1, g2, p22, p2, slope_moment, \
-             variance, excess_kurtosis, sample_wm, pdf_wm, sample_wm_visible, pdf_wm_visible, \
-             visible_moments, and the SG/ASG quantities)"
+            "unknown quantity {other:?} (known: {}, and the SG/ASG quantities {})",
+            QUANTITIES.join(", "),
+            super::sg::QUANTITIES.join(", ")
         ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// `QUANTITIES` and `arguments` name the same quantities.
+    #[test]
+    fn every_quantity_has_its_argument_keys() {
+        for q in super::QUANTITIES {
+            assert!(super::arguments(q).is_some(), "{q}");
+        }
+        assert!(super::arguments("unknown").is_none());
     }
 }

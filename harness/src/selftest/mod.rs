@@ -312,7 +312,8 @@ fn describe(r: &CheckRecord) -> String {
     format!("{} {}", r.check, r.case)
 }
 
-fn kill_run(records: &[CheckRecord], expected: &[&str], seed: u64, seconds: f64) -> KillRun {
+/// The ids of the checks that failed, sorted, each once.
+fn killers(records: &[CheckRecord]) -> Vec<String> {
     let mut killers: Vec<String> = records
         .iter()
         .filter(|r| r.verdict.is_failure())
@@ -320,6 +321,11 @@ fn kill_run(records: &[CheckRecord], expected: &[&str], seed: u64, seconds: f64)
         .collect();
     killers.sort_unstable();
     killers.dedup();
+    killers
+}
+
+fn kill_run(records: &[CheckRecord], expected: &[&str], seed: u64, seconds: f64) -> KillRun {
+    let killers = killers(records);
     KillRun {
         seed,
         killed: !killers.is_empty(),

@@ -4,7 +4,6 @@
 //! and G2, which are the trait's own forms over the (possibly mutated) Λ — as a renderer
 //! derives them.
 
-use mfh_reference::geometry::dot;
 use mfh_reference::model::{
     Model, NormalSampler, SlopeDistribution, VisibleMoments, VisibleNormalSampler,
     VisibleSlopeMoments,
@@ -239,16 +238,7 @@ impl Smith for Mutated {
             }
             (_, m) => m,
         };
-        match masking {
-            Masking::Uncorrelated => self.g1(wo, m) * self.g1(wi, m),
-            Masking::HeightCorrelated => {
-                if wo[2] <= 0.0 || wi[2] <= 0.0 || dot(wo, m) <= 0.0 || dot(wi, m) <= 0.0 {
-                    0.0
-                } else {
-                    1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
-                }
-            }
-        }
+        mfh_reference::model::smith_g2(self, wo, wi, m, masking)
     }
 }
 

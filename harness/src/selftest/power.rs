@@ -100,13 +100,7 @@ pub fn measure(
                 };
                 let (mut records, _, _) = run_plan(&plan, &options);
                 judge_at(&mut records, alpha);
-                let mut killers: Vec<String> = records
-                    .iter()
-                    .filter(|r| r.verdict.is_failure())
-                    .map(|r| r.check.clone())
-                    .collect();
-                killers.sort_unstable();
-                killers.dedup();
+                let killers = super::killers(&records);
                 let min_p = records
                     .iter()
                     .filter_map(|r| match r.measured {

@@ -22,18 +22,7 @@ pub fn example(file: &str, args: &str) -> String {
 
 /// Runs the `mfh` CLI in-process: (exit code, stdout, stderr).
 pub fn run(args: &[&str]) -> (i32, String, String) {
-    let (mut out, mut err) = (Vec::new(), Vec::new());
-    let code = mfh_harness::cli::run(
-        std::iter::once("mfh").chain(args.iter().copied()),
-        &mut std::io::empty(),
-        &mut out,
-        &mut err,
-    );
-    (
-        code,
-        String::from_utf8(out).unwrap(),
-        String::from_utf8(err).unwrap(),
-    )
+    mfh_harness::cli::run_captured(args)
 }
 
 /// Whether python3 has numpy. Without it a numpy test is skipped with a message, except under

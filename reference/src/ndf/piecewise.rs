@@ -492,6 +492,14 @@ fn s1(h: f64) -> f64 {
     sum
 }
 
+/// The midpoint form [h, m, ḡ, δ] of the segment from (t0, g0) to (t1, g1): half-width
+/// h = (t1−t0)/2, midpoint m = (t0+t1)/2, mean ḡ = (g0+g1)/2, half-rise δ = (g1−g0)/2; None for
+/// an empty segment (h = 0, whose integrals are 0).
+fn midpoint_form(t0: f64, t1: f64, g0: f64, g1: f64) -> Option<[f64; 4]> {
+    let h = 0.5 * (t1 - t0);
+    (h != 0.0).then_some([h, 0.5 * (t0 + t1), 0.5 * (g0 + g1), 0.5 * (g1 - g0)])
+}
+
 /// ∫_{t0}^{t1} g(θ) cos θ sin θ dθ for g linear from g0 at t0 to g1 at t1 (seed 000 eq 5 per
 /// segment, in midpoint form: m = (t0+t1)/2, h = (t1−t0)/2, ḡ = (g0+g1)/2, δ = (g1−g0)/2):
 ///
@@ -499,13 +507,9 @@ fn s1(h: f64) -> f64 {
 /// ∫ = ½ [ḡ sin 2m sin 2h + (δ/h) cos 2m (sin 2h / 2 − h cos 2h)]
 /// ```
 pub(super) fn segment_cos_sin(t0: f64, t1: f64, g0: f64, g1: f64) -> f64 {
-    let h = 0.5 * (t1 - t0);
-    if h == 0.0 {
+    let Some([h, m, gm, d]) = midpoint_form(t0, t1, g0, g1) else {
         return 0.0;
-    }
-    let m = 0.5 * (t0 + t1);
-    let gm = 0.5 * (g0 + g1);
-    let d = 0.5 * (g1 - g0);
+    };
     0.5 * (gm * (2.0 * m).sin() * (2.0 * h).sin() + d / h * (2.0 * m).cos() * s3(h))
 }
 
@@ -515,13 +519,9 @@ pub(super) fn segment_cos_sin(t0: f64, t1: f64, g0: f64, g1: f64) -> f64 {
 /// ∫ = ½ [ḡ (2h − sin 2h + 2 sin²m sin 2h) + (δ/h) sin 2m (sin 2h / 2 − h cos 2h)]
 /// ```
 pub(super) fn segment_sin2(t0: f64, t1: f64, g0: f64, g1: f64) -> f64 {
-    let h = 0.5 * (t1 - t0);
-    if h == 0.0 {
+    let Some([h, m, gm, d]) = midpoint_form(t0, t1, g0, g1) else {
         return 0.0;
-    }
-    let m = 0.5 * (t0 + t1);
-    let gm = 0.5 * (g0 + g1);
-    let d = 0.5 * (g1 - g0);
+    };
     let sm = m.sin();
     0.5 * (gm * (s1(h) + 2.0 * sm * sm * (2.0 * h).sin()) + d / h * (2.0 * m).sin() * s3(h))
 }

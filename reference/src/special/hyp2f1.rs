@@ -421,14 +421,8 @@ pub fn hyp2f1_lambda_algorithm2_corrected(c: f64, z: f64) -> f64 {
 /// against the stable route: see `tests::algorithm2_corrected_at_the_stress_gammas`. NaN where
 /// the series would need more than `ALGORITHM2_MAX_TERMS` terms.
 pub fn lambda_algorithm2_corrected(c: f64, x: f64) -> f64 {
-    if !(c > 1.5) || x.is_nan() || x < 0.0 {
-        return f64::NAN;
-    }
-    if x == 0.0 {
-        return f64::INFINITY;
-    }
-    if x == f64::INFINITY {
-        return 0.0;
+    if let Some(edge) = super::student_tail::lambda_edges(c, x) {
+        return edge;
     }
     let x2 = x * x;
     let n = student_norm(c);

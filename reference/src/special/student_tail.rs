@@ -51,18 +51,27 @@ pub fn student_lambda_with_norm(c: f64, n: f64, x: f64) -> f64 {
     student_lambda_tabulated(c, n, None, x)
 }
 
+/// Λ_C(x) where no route needs computing, shared by every Λ_C route (this module's and
+/// `hyp2f1::lambda_algorithm2_corrected`): NaN outside the domain (C ≤ 3/2, x NaN or < 0), +∞
+/// at x = 0 (grazing), 0 at x = +∞ (normal incidence); None inside (0, ∞).
+pub fn lambda_edges(c: f64, x: f64) -> Option<f64> {
+    if !(c > 1.5) || x.is_nan() || x < 0.0 {
+        Some(f64::NAN)
+    } else if x == 0.0 {
+        Some(f64::INFINITY)
+    } else if x == f64::INFINITY {
+        Some(0.0)
+    } else {
+        None
+    }
+}
+
 /// `student_lambda_with_norm` with the continued fraction's coefficients read from `table`
 /// (`BetaCfTable::new(c)`, which a model builds once): no division per level; the same value
 /// to an ulp or two.
 pub fn student_lambda_tabulated(c: f64, n: f64, table: Option<&BetaCfTable>, x: f64) -> f64 {
-    if !(c > 1.5) || x.is_nan() || x < 0.0 {
-        return f64::NAN;
-    }
-    if x == 0.0 {
-        return f64::INFINITY;
-    }
-    if x == f64::INFINITY {
-        return 0.0;
+    if let Some(edge) = lambda_edges(c, x) {
+        return edge;
     }
     let x2 = x * x;
     let s = x2 / (1.0 + x2);
