@@ -6,20 +6,7 @@ use std::process::{Command, Output, Stdio};
 
 /// Runs the built `mfh` with `args`, feeding `stdin`.
 fn mfh(args: &[&str], stdin: &str) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_mfh"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("mfh starts");
-    child
-        .stdin
-        .take()
-        .expect("piped stdin")
-        .write_all(stdin.as_bytes())
-        .expect("mfh reads its input");
-    child.wait_with_output().expect("mfh finishes")
+    mfh_bytes(args, stdin.as_bytes())
 }
 
 fn text(bytes: &[u8]) -> String {
