@@ -278,16 +278,22 @@ impl CellFinder {
         let per_radian = self.columns_per_radian;
         let column_margin = COLUMN_MARGIN * per_radian;
         let (mut x, mut y, mut z) = ([0.0; FIND_BLOCK], [0.0; FIND_BLOCK], [0.0; FIND_BLOCK]);
-        let mut found = [0i32; FIND_BLOCK];
+        let mut found = [0.0f64; FIND_BLOCK];
         let mut inside = true;
+        let (columns_f, last_row_f, last_column_f) = (
+            f64::from(columns),
+            f64::from(last_row),
+            f64::from(last_column),
+        );
         for (m, cells) in m.chunks(FIND_BLOCK).zip(cells.chunks_mut(FIND_BLOCK)) {
             let n = m.len();
             // Components apart (three arrays), so the pass loads whole vectors.
             for (((m, x), y), z) in m.iter().zip(&mut x).zip(&mut y).zip(&mut z) {
                 (*x, *y, *z) = (m[0], m[1], m[2]);
             }
-            // Zipped slices of one length: no bounds checks, so the loop vectorizes. `found`
-            // is the cell, or −1 where the direction is not clear of the edges.
+            // Zipped slices of one length: no bounds checks, so the loop vectorizes. All in
+            // f64 lanes (floor, not a conversion, until the cell): `found` is the cell, an
+            // integer below 2³¹ held exactly, or −1 where the direction is not clear.
             for (((&x, &y), &z), found) in
                 x[..n].iter().zip(&y[..n]).zip(&z[..n]).zip(&mut found[..n])
             {
@@ -295,36 +301,45 @@ impl CellFinder {
                 let planar = x * x + y * y;
                 let squared = planar + z * z;
                 let valid = (squared >= low) & (squared <= high) & (z >= 0.0);
+                // For a valid direction (0 ≤ t ≤ R(1 + 1e-6)), ⌊t⌋ is `cell_of`'s ⌊t⌋ (through
+                // i64); NaN compares false below.
                 let t = z * rows;
-                // `as i32` saturates (NaN → 0): defined for every input, and for a valid
-                // direction (0 ≤ t ≤ R(1 + 1e-6)) it is `cell_of`'s ⌊t⌋ through i64.
-                let row = t as i32;
-                let fraction = t - row as f64;
-                let row_clear = (fraction > margin) & (fraction < 1.0 - margin) & (row <= last_row);
+                let row = t.floor();
+                let fraction = t - row;
+                let row_clear =
+                    (fraction > margin) & (fraction < 1.0 - margin) & (row <= last_row_f);
                 let u = approximate_azimuth(x, y) * per_radian;
-                let column = u as i32;
-                let fraction = u - column as f64;
+                let column = u.floor();
+                let fraction = u - column;
                 let column_clear = (fraction > column_margin)
                     & (fraction < 1.0 - column_margin)
-                    & (column <= last_column)
+                    & (column >= 0.0)
+                    & (column <= last_column_f)
                     & (planar > POLE_CLEARANCE);
                 let clear = valid & row_clear & column_clear;
-                // Clamped so the product stays in i32 whatever the (unused) lanes hold.
-                let cell = row.clamp(0, last_row) * columns + column.clamp(0, last_column);
-                *found = if clear { cell } else { -1 };
+                *found = if clear {
+                    row * columns_f + column
+                } else {
+                    -1.0
+                };
+            }
+            // −1 or an integer in [0, 2³¹): the conversion is exact.
+            for (cell, &found) in cells.iter_mut().zip(&found[..n]) {
+                *cell = found as i32 as usize;
+            }
+            if found[..n].iter().fold(true, |all, &f| all & (f >= 0.0)) {
+                continue;
             }
             for ((cell, &m), &found) in cells.iter_mut().zip(m).zip(&found[..n]) {
-                *cell = if found >= 0 {
-                    found as usize
-                } else {
-                    match self.cell_of(m) {
+                if found < 0.0 {
+                    *cell = match self.cell_of(m) {
                         Ok(c) => c,
                         Err(_) => {
                             inside = false;
                             0
                         }
-                    }
-                };
+                    };
+                }
             }
         }
         inside

@@ -169,6 +169,7 @@ fn elliptic_loop(
     let mut r = [0.0; BLOCK];
     let mut s = [0.0; BLOCK];
     let mut c = [0.0; BLOCK];
+    let mut fast = [false; BLOCK];
     for (u, out) in u.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
         let n = u.len();
         for ((a, b), u) in u0.iter_mut().zip(u1.iter_mut()).zip(u) {
@@ -176,19 +177,37 @@ fn elliptic_loop(
         }
         radius2_block(&u1[..n], &mut r[..n]);
         sin_cos_turns_block(&u0[..n], &mut s[..n], &mut c[..n]);
-        for (i, m) in out.iter_mut().enumerate() {
-            let radius = r[i].sqrt();
+        // Zipped slices of one length (no bounds checks, so the loop vectorizes); the normal
+        // goes back into (r, c, s) as (m_z, m_x, m_y) and is interleaved below.
+        for ((((r, s), c), fast), &u0) in r[..n]
+            .iter_mut()
+            .zip(&mut s[..n])
+            .zip(&mut c[..n])
+            .zip(&mut fast[..n])
+            .zip(&u0[..n])
+        {
+            let radius = r.sqrt();
             // elliptic_direction, then normal_from_slopes' finite branch.
-            let (p, q) = (radius * (sx * c[i]), radius * (sy * s[i]));
+            let (p, q) = (radius * (sx * *c), radius * (sy * *s));
             let inv = 1.0 / (1.0 + p * p + q * q).sqrt();
-            *m = [p * inv, q * inv, inv];
+            let (mx, my) = (p * inv, q * inv);
+            (*c, *s, *r) = (mx, my, inv);
+            // The scalar path's other branches: u₀ outside [0, 1) (a general argument
+            // reduction), an infinite or NaN slope (the horizon branch); either leaves m_x or
+            // m_y non-finite here or is flagged by u₀. (`&`, not `&&`: no branch.)
+            *fast = (u0 >= 0.0) & (u0 < 1.0) & mx.is_finite() & my.is_finite();
         }
-        // The scalar path's other branches: u₀ outside [0, 1) (a general argument reduction),
-        // an infinite or NaN slope (the horizon branch); either leaves m_x or m_y non-finite
-        // here or is flagged by u₀.
-        for (i, m) in out.iter_mut().enumerate() {
-            if !(u0[i] >= 0.0 && u0[i] < 1.0 && m[0].is_finite() && m[1].is_finite()) {
-                *m = scalar(u[i]);
+        for (((m, &mx), &my), &mz) in out.iter_mut().zip(&c[..n]).zip(&s[..n]).zip(&r[..n]) {
+            *m = [mx, my, mz];
+        }
+        // The other branches are rare (u₀ ∉ [0, 1), or u₁ = 1: never for the harness's
+        // uniforms in [0, 1)): one predictable test per block, then the flagged elements.
+        if fast[..n].iter().fold(true, |all, &f| all & f) {
+            continue;
+        }
+        for ((m, &fast), &u) in out.iter_mut().zip(&fast[..n]).zip(u) {
+            if !fast {
+                *m = scalar(u);
             }
         }
     }
