@@ -195,7 +195,7 @@ fn elliptic_loop(
             // The scalar path's other branches: u₀ outside [0, 1) (a general argument
             // reduction), an infinite or NaN slope (the horizon branch); either leaves m_x or
             // m_y non-finite here or is flagged by u₀. (`&`, not `&&`: no branch.)
-            *fast = (u0 >= 0.0) & (u0 < 1.0) & mx.is_finite() & my.is_finite();
+            *fast = (0.0..1.0).contains(&u0) & mx.is_finite() & my.is_finite();
         }
         for (((m, &mx), &my), &mz) in out.iter_mut().zip(&c[..n]).zip(&s[..n]).zip(&r[..n]) {
             *m = [mx, my, mz];
