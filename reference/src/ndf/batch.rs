@@ -42,8 +42,9 @@ const TINY: f64 = f64::from_bits(0x3e46_a09e_0000_0000);
 #[inline(always)]
 fn sin_cos_turns_block(u: &[f64], s: &mut [f64], c: &mut [f64]) {
     for ((&u, s), c) in u.iter().zip(s.iter_mut()).zip(c.iter_mut()) {
-        // 4u + 0.5 ∈ [0.5, 4.5): truncation through i32 is the scalar path's through i64.
-        let k = ((4.0 * u + 0.5) as i32) as f64;
+        // 4u + 0.5 ∈ [0.5, 4.5): its floor is the scalar path's truncation through i64 (a
+        // packed round, where a saturating conversion to i32 goes lane by lane).
+        let k = (4.0 * u + 0.5).floor();
         let r = u - 0.25 * k;
         let x = std::f64::consts::TAU * r;
         // k_sin(x, 0, 0)
