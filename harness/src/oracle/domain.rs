@@ -129,8 +129,10 @@ pub fn validate(m: Vec3) -> Result<f64, DomainError> {
 /// Bins directions into the cells of a [`HemisphereGrid`] like [`HemisphereGrid::cell_of`],
 /// without an `atan2` per direction (the chi-square oracle's hot loop).
 ///
-/// The column comes from an estimate of φ good to 0.0015 rad (a rational approximation of
-/// atan on [0, 1], folded by octant), corrected by side tests against the column boundaries,
+/// The column comes from an estimate of φ good to 1.2e-5 rad ([`approximate_azimuth`]: a
+/// polynomial approximation of atan on [0, 1], folded by octant), corrected by
+/// [`CellFinder::cell_of`] with side tests against the column boundaries (which
+/// [`CellFinder::cells_of`] skips where the estimate is clear of every edge by 1e-4 rad),
 /// unit vectors b_j = (cos φ_j, sin φ_j), φ_j = 2πj / 2R, tabulated once (by
 /// `sin_cos_turns`, exact at multiples of π/2): the direction is at or past boundary j iff
 /// b_j × (m_x, m_y) > 0, or = 0 with b_j · (m_x, m_y) > 0. Each test is exact up to the
