@@ -129,8 +129,10 @@ pub fn validate(m: Vec3) -> Result<f64, DomainError> {
 /// Bins directions into the cells of a [`HemisphereGrid`] like [`HemisphereGrid::cell_of`],
 /// without an `atan2` per direction (the chi-square oracle's hot loop).
 ///
-/// The column comes from an estimate of φ good to 0.0015 rad (a rational approximation of
-/// atan on [0, 1], folded by octant), corrected by side tests against the column boundaries,
+/// The column comes from an estimate of φ good to 1.2e-5 rad ([`approximate_azimuth`]: a
+/// polynomial approximation of atan on [0, 1], folded by octant), corrected by
+/// [`CellFinder::cell_of`] with side tests against the column boundaries (which
+/// [`CellFinder::cells_of`] skips where the estimate is clear of every edge by 1e-4 rad),
 /// unit vectors b_j = (cos φ_j, sin φ_j), φ_j = 2πj / 2R, tabulated once (by
 /// `sin_cos_turns`, exact at multiples of π/2): the direction is at or past boundary j iff
 /// b_j × (m_x, m_y) > 0, or = 0 with b_j · (m_x, m_y) > 0. Each test is exact up to the
@@ -211,96 +213,135 @@ impl CellFinder {
     /// (if not, the cells of those outside are unspecified: callers redo the block one by
     /// one for the errors).
     ///
-    /// Two passes per sub-block of [`FIND_BLOCK`] directions. The first is straight-line
-    /// arithmetic the compiler vectorizes (no branch, no table): the domain test on |m|², the
-    /// row ⌊z·R⌋ and whether z·R is clear of the row edges by `row_margin`, and the column
-    /// estimate j of [`approximate_azimuth`]. The second reads the two column boundaries b_j,
-    /// b_{j+1} of each estimate and accepts j if the direction is strictly past b_j (or j = 0)
-    /// and strictly before b_{j+1} (or j = 2R − 1) — where both searches of
-    /// [`CellFinder::cell_of`] (which starts from the same estimate) stop at once, so the
-    /// answer is its answer. Anything else (a direction outside the domain, near a row edge,
-    /// on a column edge, or an estimate off by a column: at R = 64, a fraction ~4e-4 of
-    /// directions) goes through [`CellFinder::cell_of`].
+    /// One straight-line pass per sub-block of [`FIND_BLOCK`] directions, no branch and no
+    /// table, so it vectorizes (4 lanes under AVX2: it runs through `pulp`'s safe runtime
+    /// dispatch, compiled for AVX2 + FMA where the CPU has it): the domain test on |m|², the
+    /// row ⌊z·R⌋ and the column ⌊φ̃·2R/2π⌋ of the azimuth estimate φ̃ of
+    /// [`approximate_azimuth`], and whether each is *clear*: z·R farther than `row_margin`
+    /// from an integer, φ̃·2R/2π farther than [`COLUMN_MARGIN`]·2R/2π (a margin of 1e-4 rad,
+    /// over 8× the estimate's error bound of 1.2e-5 rad, tested) and x² + y² above
+    /// [`POLE_CLEARANCE`] (so that the side tests of `cell_of` neither underflow nor tie).
+    /// Where both are clear, the exact side tests of [`CellFinder::cell_of`] against the
+    /// boundaries b_j, b_{j+1} are decided before they are made — the direction is at least
+    /// 1e-4 − 1.2e-5 rad inside the column, where |b × (x, y)| ≥ |(x, y)| sin(8.8e-5) dwarfs
+    /// the rounding of b_j (≤ 1 ulp) — so the answer is `cell_of`'s without making them. The
+    /// rest (outside the domain, near a row or column edge or the pole: at R = 64 a fraction
+    /// ≈ 2·1e-4·128/2π ≈ 4e-3 of directions for the columns) goes through
+    /// [`CellFinder::cell_of`]. Either way the cell is a function of the direction alone,
+    /// whatever the block, the thread or the dispatch path (the test
+    /// `cells_of_is_the_same_on_the_avx2_and_baseline_paths`).
     ///
     /// # Panics
     /// If `m` and `cells` differ in length.
     pub fn cells_of(&self, m: &[Vec3], cells: &mut [usize]) -> bool {
+        self.cells_of_on(pulp::Arch::new(), m, cells)
+    }
+
+    /// [`CellFinder::cells_of`] through the instruction set `arch` (`pulp::Arch::Scalar`: the
+    /// baseline path).
+    fn cells_of_on(&self, arch: pulp::Arch, m: &[Vec3], cells: &mut [usize]) -> bool {
         assert_eq!(
             m.len(),
             cells.len(),
             "cells_of: m and cells differ in length"
         );
-        let [low, high] = self.squared_length;
-        let (rows, margin) = (self.rows, self.row_margin);
-        // R and 2R fit an i32: 2R² cells are allocated by every caller, so R < 2¹⁶ in practice;
-        // larger grids take the scalar path below.
-        let columns = self.grid.columns();
-        if columns > i32::MAX as usize / 2 {
+        // The fast pass computes cell indices in i32: grids of more than 2³¹ − 1 cells (R >
+        // 32 767; every caller allocates 2R² counts, so none in practice) take the scalar path.
+        if self.grid.cells() > i32::MAX as usize {
             return self.cells_of_one_by_one(m, cells);
         }
-        let (last_row, last_column) = (self.grid.rows() as i32 - 1, columns as i32 - 1);
+        /// The pass as a `pulp::WithSimd` operation (instantiated per instruction set).
+        struct Op<'a> {
+            finder: &'a CellFinder,
+            m: &'a [Vec3],
+            cells: &'a mut [usize],
+        }
+        impl pulp::WithSimd for Op<'_> {
+            type Output = bool;
+            #[inline(always)]
+            fn with_simd<S: pulp::Simd>(self, _simd: S) -> bool {
+                self.finder.cells_of_block(self.m, self.cells)
+            }
+        }
+        arch.dispatch(Op {
+            finder: self,
+            m,
+            cells,
+        })
+    }
+
+    /// The body of [`CellFinder::cells_of`], inlined into each dispatch target.
+    #[inline(always)]
+    fn cells_of_block(&self, m: &[Vec3], cells: &mut [usize]) -> bool {
+        let [low, high] = self.squared_length;
+        let (rows, margin) = (self.rows, self.row_margin);
+        let columns = self.grid.columns() as i32;
+        let (last_row, last_column) = (self.grid.rows() as i32 - 1, columns - 1);
         let per_radian = self.columns_per_radian;
+        let column_margin = COLUMN_MARGIN * per_radian;
         let (mut x, mut y, mut z) = ([0.0; FIND_BLOCK], [0.0; FIND_BLOCK], [0.0; FIND_BLOCK]);
-        let mut row = [0i32; FIND_BLOCK];
-        let mut column = [0i32; FIND_BLOCK];
-        let mut clear = [false; FIND_BLOCK];
+        let mut found = [0.0f64; FIND_BLOCK];
         let mut inside = true;
+        let (columns_f, last_row_f, last_column_f) = (
+            f64::from(columns),
+            f64::from(last_row),
+            f64::from(last_column),
+        );
         for (m, cells) in m.chunks(FIND_BLOCK).zip(cells.chunks_mut(FIND_BLOCK)) {
             let n = m.len();
-            // Components apart (three arrays), so the arithmetic pass loads whole vectors.
+            // Components apart (three arrays), so the pass loads whole vectors.
             for (((m, x), y), z) in m.iter().zip(&mut x).zip(&mut y).zip(&mut z) {
                 (*x, *y, *z) = (m[0], m[1], m[2]);
             }
-            // Zipped slices of one length: no bounds checks, so the loop vectorizes.
-            for (((((&x, &y), &z), clear), row), column) in x[..n]
-                .iter()
-                .zip(&y[..n])
-                .zip(&z[..n])
-                .zip(&mut clear[..n])
-                .zip(&mut row[..n])
-                .zip(&mut column[..n])
+            // Zipped slices of one length: no bounds checks, so the loop vectorizes. All in
+            // f64 lanes (floor, not a conversion, until the cell): `found` is the cell, an
+            // integer below 2³¹ held exactly, or −1 where the direction is not clear.
+            for (((&x, &y), &z), found) in
+                x[..n].iter().zip(&y[..n]).zip(&z[..n]).zip(&mut found[..n])
             {
-                let squared = x * x + y * y + z * z;
+                // x² + y² + z² summed as in `validate`.
+                let planar = x * x + y * y;
+                let squared = planar + z * z;
                 let valid = (squared >= low) & (squared <= high) & (z >= 0.0);
+                // For a valid direction (0 ≤ t ≤ R(1 + 1e-6)), ⌊t⌋ is `cell_of`'s ⌊t⌋ (through
+                // i64); NaN compares false below.
                 let t = z * rows;
-                // `as i32` saturates (NaN → 0): defined for every input, and for a valid
-                // direction (0 ≤ t ≤ R(1 + 1e-6)) it is `cell_of`'s ⌊t⌋ through i64.
-                let floor = t as i32;
-                let fraction = t - floor as f64;
-                *clear = valid & (fraction > margin) & (fraction < 1.0 - margin);
-                *row = floor.min(last_row);
-                *column = ((approximate_azimuth(x, y) * per_radian) as i32).clamp(0, last_column);
-            }
-            for ((((((cell, &m), &clear), &row), &column), &x), &y) in cells
-                .iter_mut()
-                .zip(m)
-                .zip(&clear[..n])
-                .zip(&row[..n])
-                .zip(&column[..n])
-                .zip(&x[..n])
-                .zip(&y[..n])
-            {
-                // Strict side tests (a direction exactly on b_j or b_{j+1} goes through
-                // `cell_of`, which breaks the tie): past b_j if b_j × (x, y) > 0, not past
-                // b_{j+1} if b_{j+1} × (x, y) < 0 (`boundaries` has 2R + 1 entries).
-                let j = column as usize;
-                let cross = |j: usize| {
-                    let [c, s] = self.boundaries[j];
-                    c * y - s * x
-                };
-                let at = (j == 0) | (cross(j) > 0.0);
-                let before_next = (j + 1 == columns) | (cross(j + 1) < 0.0);
-                *cell = if clear & at & before_next {
-                    row as usize * columns + j
+                let row = t.floor();
+                let fraction = t - row;
+                let row_clear =
+                    (fraction > margin) & (fraction < 1.0 - margin) & (row <= last_row_f);
+                let u = approximate_azimuth(x, y) * per_radian;
+                let column = u.floor();
+                let fraction = u - column;
+                let column_clear = (fraction > column_margin)
+                    & (fraction < 1.0 - column_margin)
+                    & (column >= 0.0)
+                    & (column <= last_column_f)
+                    & (planar > POLE_CLEARANCE);
+                let clear = valid & row_clear & column_clear;
+                *found = if clear {
+                    row * columns_f + column
                 } else {
-                    match self.cell_of(m) {
+                    -1.0
+                };
+            }
+            // −1 or an integer in [0, 2³¹): the conversion is exact.
+            for (cell, &found) in cells.iter_mut().zip(&found[..n]) {
+                *cell = found as i32 as usize;
+            }
+            if found[..n].iter().fold(true, |all, &f| all & (f >= 0.0)) {
+                continue;
+            }
+            for ((cell, &m), &found) in cells.iter_mut().zip(m).zip(&found[..n]) {
+                if found < 0.0 {
+                    *cell = match self.cell_of(m) {
                         Ok(c) => c,
                         Err(_) => {
                             inside = false;
                             0
                         }
-                    }
-                };
+                    };
+                }
             }
         }
         inside
@@ -401,6 +442,17 @@ fn accepted_squared_lengths() -> [f64; 2] {
 
 /// Directions per pass of [`CellFinder::cells_of`] (its temporaries live on the stack).
 const FIND_BLOCK: usize = 64;
+
+/// How far (radians) the azimuth estimate of [`CellFinder::cells_of`] must be from a column
+/// edge for the column to be taken from it: over 8× the estimate's error bound (1.2e-5 rad,
+/// `azimuth_estimate_is_within_its_stated_error`), so that the exact side tests of
+/// [`CellFinder::cell_of`] would find the same column.
+const COLUMN_MARGIN: f64 = 1e-4;
+
+/// The least x² + y² for which [`CellFinder::cells_of`] takes the column from the estimate:
+/// nearer the pole (|(x, y)| < 1e-100), the side tests' products c·y − s·x may lose every
+/// digit to underflow, and `cell_of` decides.
+const POLE_CLEARANCE: f64 = 1e-200;
 
 /// atan2(y, x) in [0, 2π) to within 1.2e-5 rad, (x, y) ≠ (0, 0) (NaN at (0, 0)): atan q on q =
 /// min/max ∈ [0, 1] by Abramowitz & Stegun 4.4.47 (Hastings; |error| ≤ 1.15e-5 with the published
@@ -701,6 +753,49 @@ mod tests {
             }
         }
         assert!(rejected > 1000, "{rejected}");
+    }
+
+    /// The block finder on the dispatched path (AVX2 + FMA where the CPU has it) and on the
+    /// baseline path (`pulp::Arch::Scalar`, what a CPU without AVX2 runs) finds the cell of
+    /// `cell_of` for every direction: random ones, and ones at angular distances around the
+    /// column margin (1e-4 rad) and the estimate's error (1.2e-5 rad) from every column edge.
+    #[test]
+    fn cells_of_is_the_same_on_the_avx2_and_baseline_paths() {
+        let mut state: u64 = 13;
+        let mut uniform = || {
+            state = crate::random::splitmix64(state);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for resolution in [1, 2, 5, 64, 512] {
+            let grid = HemisphereGrid::new(resolution).unwrap();
+            let finder = CellFinder::new(grid);
+            let mut directions: Vec<Vec3> = (0..50_000)
+                .map(|_| HemisphereGrid::direction(uniform() * TAU, uniform()))
+                .collect();
+            let columns = grid.columns();
+            for j in 0..columns {
+                let edge = j as f64 * TAU / columns as f64;
+                for d in [
+                    0.0, 1e-12, 1e-5, 1.2e-5, 2e-5, 8e-5, 9.9e-5, 1e-4, 1.01e-4, 2e-4,
+                ] {
+                    for phi in [edge + d, edge - d] {
+                        directions.push(HemisphereGrid::direction(phi, uniform()));
+                    }
+                }
+            }
+            directions.extend([[0.0, 0.0, 1.0], [1e-120, 1e-120, 1.0], [f64::NAN, 0.0, 1.0]]);
+            let mut detected = vec![usize::MAX; directions.len()];
+            let mut baseline = vec![usize::MAX; directions.len()];
+            let inside_detected = finder.cells_of(&directions, &mut detected);
+            let inside_baseline =
+                finder.cells_of_on(pulp::Arch::Scalar, &directions, &mut baseline);
+            assert!(!inside_detected && !inside_baseline, "R = {resolution}");
+            for ((&m, &a), &b) in directions.iter().zip(&detected).zip(&baseline) {
+                if let Ok(c) = finder.cell_of(m) {
+                    assert_eq!((a, b), (c, c), "R = {resolution}, {m:?}");
+                }
+            }
+        }
     }
 
     #[test]
