@@ -237,25 +237,6 @@ impl CdfTable {
         }
     }
 
-    /// The bucket in 0..`buckets` of x by the CDF interpolated linearly between the knots and
-    /// divided by the total: a non-decreasing function of x for a non-decreasing table (what a
-    /// sort by binning needs; [`CdfTable::cdf`]'s Hermite form is not needed to order values).
-    pub fn bucket(&self, x: f64, buckets: usize) -> usize {
-        let n = self.knots.len();
-        let total = self.total();
-        if n < 2 || !(total > 0.0) || !(x > self.knots[0]) {
-            return 0;
-        }
-        if !(x < self.knots[n - 1]) {
-            return buckets - 1;
-        }
-        let i = self.knots.partition_point(|&k| k <= x) - 1;
-        let (k0, k1) = (self.knots[i], self.knots[i + 1]);
-        let (f0, f1) = (self.cdf[i], self.cdf[i + 1]);
-        let f = f0 + (f1 - f0).max(0.0) * ((x - k0) / (k1 - k0));
-        ((f / total * buckets as f64) as usize).min(buckets - 1)
-    }
-
     /// F(x), clamped to the table's range.
     pub fn cdf(&self, x: f64) -> f64 {
         let n = self.knots.len();
