@@ -338,14 +338,7 @@ pub fn write_artefacts(
     model: &str,
     result: &Chi2Result,
 ) -> Result<Vec<PathBuf>, crate::report::artefacts::ArtefactError> {
-    let data = crate::record::RecordData::Chi2Table {
-        rows: result.resolution,
-        columns: 2 * result.resolution,
-        samples: result.samples,
-        seed: result.seed,
-        observed: result.observed.clone(),
-        expected: result.expected.clone(),
-    };
+    let data = crate::check::sampling::chi2_table(result);
     let title = format!("mfh chi2 · {model} · {} samples", result.samples);
     crate::report::artefacts::write_record_data(dir, &title, "mfh chi2", &data)
 }

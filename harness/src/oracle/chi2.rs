@@ -53,13 +53,17 @@ pub const CELL_ABSOLUTE_TOLERANCE: f64 = 1e-14;
 /// Per-cell relative tolerance of the expected-mass cubature for densities with a kink inside
 /// cells (the terminator of ⟨wi·m⟩⁺ of a visible-normal density): the expected counts need a
 /// relative accuracy well below 1/√(expected count), ≥ 5e-3 even at 2·10⁷ samples over 512
-/// cells, so 1e-6 keeps a margin of over 1000 while the cubature no longer subdivides the kink
-/// to 1e-9 (2–5 s per test instead of ~0.3 s).
-pub const KINKED_CELL_RELATIVE_TOLERANCE: f64 = 1e-6;
-/// [`KINKED_CELL_RELATIVE_TOLERANCE`] for a remote model (an external process, where each of
-/// the tens of millions of evaluations the kink costs at 1e-6 is protocol traffic): 1e-5 still
-/// keeps a margin of 500 on the 5e-3 the expected counts need at 2·10⁷ samples.
-pub const REMOTE_KINKED_CELL_RELATIVE_TOLERANCE: f64 = 1e-5;
+/// cells, so 1e-4 keeps a margin of 50; a relative error ε of every expected count moves χ² by
+/// about ε²·N, 0.2 at N = 2·10⁷ (2e-3 at the quick audit's 2·10⁵) against its standard
+/// deviation √(2·dof) ≈ 32. It was 1e-6: each factor 10 costs the cubature ~√10 times the
+/// pieces along the kink (the error of a piece across a kink is ∝ its size squared), 3.3 s for
+/// GGX's visible normals at θi = 1.3 in the quick audit.
+pub const KINKED_CELL_RELATIVE_TOLERANCE: f64 = 1e-4;
+/// [`KINKED_CELL_RELATIVE_TOLERANCE`] for a remote model (an external process, where each
+/// evaluation the kink costs is protocol traffic): the same 1e-4 (it was 1e-5 against the
+/// reference models' 1e-6; the reference models' tolerance is now as loose, with the same
+/// margin of 50), the remote model keeping only its looser absolute tolerance.
+pub const REMOTE_KINKED_CELL_RELATIVE_TOLERANCE: f64 = KINKED_CELL_RELATIVE_TOLERANCE;
 /// [`CELL_ABSOLUTE_TOLERANCE`] for a remote model: 1e-11 of mass per cell is 2e-4 counts at
 /// 2·10⁷ samples, far below the ≥ 5 counts a cell needs to enter the statistic unpooled.
 pub const REMOTE_CELL_ABSOLUTE_TOLERANCE: f64 = 1e-11;
@@ -107,19 +111,25 @@ pub enum Verdict {
     Fail,
 }
 
+/// Samples outside the upper hemisphere (a sanity failure of the chi-square and KS tests):
+/// how many, and the first of them (in the seeded sequence) with what is wrong with it.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("{count} samples outside the domain; the first, sample {index}: {error}")]
+pub struct OutsideDomain {
+    /// Index of the first offending sample (in the seeded sequence).
+    pub index: u64,
+    /// What is wrong with it.
+    pub error: DomainError,
+    /// How many samples were outside.
+    pub count: u64,
+}
+
 /// Why a test failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Failure {
-    /// A sample lies outside the upper hemisphere; `index` is the first such sample.
-    #[error("{count} samples outside the domain; the first, sample {index}: {error}")]
-    OutsideDomain {
-        /// Index of the first offending sample (in the seeded sequence).
-        index: u64,
-        /// What is wrong with it.
-        error: DomainError,
-        /// How many samples were outside.
-        count: u64,
-    },
+    /// Samples lie outside the upper hemisphere.
+    #[error(transparent)]
+    OutsideDomain(OutsideDomain),
     /// The pdf does not integrate to 1 over the hemisphere.
     #[error("pdf mass {mass} (± {error_bound:.1e}) differs from 1 by more than {tolerance}")]
     MassOff {
@@ -333,27 +343,36 @@ where
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
     let lobe = lobe::measure_density(&|m| pdf(m));
-    let mut e = expected_mass_in(pdf, grid, relative, &lobe);
+    let mut e = expected_mass_in(pdf, grid, relative, &lobe, &[]);
     e.evaluations += lobe.evaluations;
     e
 }
 
 /// Integrates `pdf` over every cell of `grid` to the per-cell relative tolerance `relative`,
-/// with the cells cut where `lobe` says the density varies.
+/// with the cells cut where `lobe` says the density varies and at `theta_kinks` (polar angles
+/// where the density has a kink for every azimuth, e.g. a piecewise-linear profile's
+/// breakpoints: cut there, every piece is smooth and the cubature does not subdivide the kink
+/// down to the tolerance).
 ///
 /// Each cell, a rectangle in (φ, z = cos θ), is integrated in (φ, θ) (dω = sin θ dθ dφ: no
 /// loss of precision near the pole, where 1 − z² cancels), cut at the lobe's polar cuts
-/// ([`Lobe::polar_cuts`]: log-spaced about every θ scale, so that a lobe of width 1e-4 inside a
-/// top row 0.25 rad high is resolved) and azimuthal cuts ([`Lobe::azimuth_cuts`]) that fall
+/// ([`Lobe::polar_cuts_with`]: log-spaced about every θ scale, so that a lobe of width 1e-4
+/// inside a top row 0.25 rad high is resolved, and the kinks) and azimuthal cuts ([`Lobe::azimuth_cuts`]) that fall
 /// inside it. Every piece is integrated by adaptive G7/K15 product cubature to max(relative ×
 /// its first estimate, [`CELL_ABSOLUTE_TOLERANCE`] / pieces); the cell's error bound is the sum
 /// of its pieces' bounds, so it is at most ≈ relative × cell mass + the absolute tolerance for
 /// integrands smooth on each piece (a piece at [`crate::oracle::cubature::MAX_DEPTH`] still reports its error).
-pub fn expected_mass_in<P>(pdf: &P, grid: HemisphereGrid, relative: f64, lobe: &Lobe) -> Expected
+pub fn expected_mass_in<P>(
+    pdf: &P,
+    grid: HemisphereGrid,
+    relative: f64,
+    lobe: &Lobe,
+    theta_kinks: &[f64],
+) -> Expected
 where
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
-    let polar = lobe.polar_cuts(FRAC_PI_2);
+    let polar = lobe.polar_cuts_with(FRAC_PI_2, theta_kinks);
     let azimuth = lobe.azimuth_cuts();
     let estimates: Vec<_> = (0..grid.cells())
         .into_par_iter()
@@ -417,8 +436,9 @@ pub fn expected_mass_in_batch(
     grid: HemisphereGrid,
     (relative, absolute): (f64, f64),
     lobe: &Lobe,
+    theta_kinks: &[f64],
 ) -> Expected {
-    let polar = lobe.polar_cuts(FRAC_PI_2);
+    let polar = lobe.polar_cuts_with(FRAC_PI_2, theta_kinks);
     let azimuth = lobe.azimuth_cuts();
     let mut rectangles = Vec::new();
     let mut per_cell = Vec::with_capacity(grid.cells());
@@ -574,15 +594,29 @@ where
     S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
+    timed(
+        config,
+        |grid| observe_batch(sample, grid, config.samples, config.seed),
+        |grid| match lobe {
+            Some(lobe) => expected_mass_in(pdf, grid, cell_relative, lobe, &[]),
+            None => expected_mass_to(pdf, grid, cell_relative),
+        },
+    )
+}
+
+/// The test on `config`'s grid: the observed counts (`observe`), then the expected masses
+/// (`expect`), each timed, judged by [`judge`].
+fn timed(
+    config: &Chi2Config,
+    observe: impl FnOnce(HemisphereGrid) -> Observed,
+    expect: impl FnOnce(HemisphereGrid) -> Expected,
+) -> Chi2Result {
     let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
     let t = Instant::now();
-    let observed = observe_batch(sample, grid, config.samples, config.seed);
+    let observed = observe(grid);
     let sampling_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let expected = match lobe {
-        Some(lobe) => expected_mass_in(pdf, grid, cell_relative, lobe),
-        None => expected_mass_to(pdf, grid, cell_relative),
-    };
+    let expected = expect(grid);
     let integration_seconds = t.elapsed().as_secs_f64();
     judge(
         config,
@@ -661,28 +695,33 @@ pub fn chi2_test_batches_in(
     cell_tolerance: (f64, f64),
     lobe: Option<&Lobe>,
 ) -> Chi2Result {
-    let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
-    let t = Instant::now();
-    let observed = observe_blocks(sample, grid, config.samples, config.seed, CHUNK as usize);
-    let sampling_seconds = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let expected = match lobe {
-        Some(lobe) => expected_mass_in_batch(pdf, grid, cell_tolerance, lobe),
-        None => {
-            let lobe = lobe::measure_with_batch(pdf, &lobe::Options::default());
-            let mut e = expected_mass_in_batch(pdf, grid, cell_tolerance, &lobe);
-            e.evaluations += lobe.evaluations;
-            e
-        }
-    };
-    let integration_seconds = t.elapsed().as_secs_f64();
-    judge(
+    chi2_test_batches_cut(sample, pdf, config, cell_tolerance, lobe, &[])
+}
+
+/// [`chi2_test_batches_in`] with the cells also cut at `theta_kinks`, the polar angles where
+/// the density has a kink for every azimuth (a reference model's registry knows them, e.g. a
+/// piecewise-linear profile's breakpoints): the same masses to the same tolerance, at a
+/// fraction of the cost (the cubature no longer subdivides the kinks).
+pub fn chi2_test_batches_cut(
+    sample: &BatchSampler<'_>,
+    pdf: &BatchPdf<'_>,
+    config: &Chi2Config,
+    cell_tolerance: (f64, f64),
+    lobe: Option<&Lobe>,
+    theta_kinks: &[f64],
+) -> Chi2Result {
+    timed(
         config,
-        grid,
-        observed,
-        expected,
-        sampling_seconds,
-        integration_seconds,
+        |grid| observe_blocks(sample, grid, config.samples, config.seed, CHUNK as usize),
+        |grid| match lobe {
+            Some(lobe) => expected_mass_in_batch(pdf, grid, cell_tolerance, lobe, theta_kinks),
+            None => {
+                let lobe = lobe::measure_with_batch(pdf, &lobe::Options::default());
+                let mut e = expected_mass_in_batch(pdf, grid, cell_tolerance, &lobe, theta_kinks);
+                e.evaluations += lobe.evaluations;
+                e
+            }
+        },
     )
 }
 
@@ -708,11 +747,11 @@ fn sanity(
     first_outside: Option<(u64, DomainError)>,
 ) -> Option<Failure> {
     if let Some((index, error)) = first_outside {
-        return Some(Failure::OutsideDomain {
+        return Some(Failure::OutsideDomain(OutsideDomain {
             index,
             error,
             count: outside,
-        });
+        }));
     }
     if let Some((cell, &mass)) = expected
         .mass

@@ -475,6 +475,19 @@ impl Lobe {
         tidy(cuts, 0.0, theta_max)
     }
 
+    /// [`Lobe::polar_cuts`] with the polar angles `kinks` strictly inside (0, `theta_max`)
+    /// added exactly (where a density has a kink for every azimuth, e.g. the breakpoints of a
+    /// piecewise-linear profile: an integral cut there meets only smooth pieces), sorted,
+    /// exact duplicates removed (a kink close to a lobe cut keeps both: a thin piece costs one
+    /// more rule, a kink moved by 1e-3 would cost the quadrature its smoothness).
+    pub fn polar_cuts_with(&self, theta_max: f64, kinks: &[f64]) -> Vec<f64> {
+        let mut polar = self.polar_cuts(theta_max);
+        polar.extend(kinks.iter().copied().filter(|t| *t > 0.0 && *t < theta_max));
+        polar.sort_by(f64::total_cmp);
+        polar.dedup();
+        polar
+    }
+
     /// Azimuthal cut points in [0, 2π] (both ends included): the quadrants; for an anisotropic
     /// lobe (widest/narrowest > 1.5) the widest and narrowest azimuths and their opposites, with
     /// cuts about the widest at ± (narrowest/widest) × {0.3 … 30} (where the lobe's azimuthal

@@ -62,13 +62,19 @@ fn a_model_without_a_visible_sampler_is_skipped_with_its_reason() {
 
 #[test]
 fn the_printed_pseudo_vnis_weight_is_biased_and_the_unbiased_one_is_not() {
-    let (spec, _) = model(r#"{"family":"std","gamma":3,"alpha":0.4}"#);
-    let records = run(&plan_pseudo_vnis(
-        &spec,
-        Some(Masking::Uncorrelated),
-        Profile::Quick,
-        "test",
-    ));
+    let pseudo_vnis = |json: &str, masking| {
+        let (spec, _) = model(json);
+        run(&plan_pseudo_vnis(
+            &spec,
+            Some(masking),
+            Profile::Quick,
+            "test",
+        ))
+    };
+    let records = pseudo_vnis(
+        r#"{"family":"std","gamma":3,"alpha":0.4}"#,
+        Masking::Uncorrelated,
+    );
     assert_eq!(records.len(), 3 * VISIBLE_INCIDENCES.len());
     for r in &records {
         assert_eq!(r.case["proxy"], "ggx");
@@ -82,13 +88,10 @@ fn the_printed_pseudo_vnis_weight_is_biased_and_the_unbiased_one_is_not() {
         }
     }
     // γ = 2 is GGX: the proxy is exact and eq 43 unbiased.
-    let (spec, _) = model(r#"{"family":"std","gamma":2,"alpha":0.4}"#);
-    let records = run(&plan_pseudo_vnis(
-        &spec,
-        Some(Masking::HeightCorrelated),
-        Profile::Quick,
-        "test",
-    ));
+    let records = pseudo_vnis(
+        r#"{"family":"std","gamma":2,"alpha":0.4}"#,
+        Masking::HeightCorrelated,
+    );
     for r in &records {
         assert_eq!(r.verdict, Verdict::Pass, "{r:?}");
     }
@@ -104,9 +107,9 @@ fn the_ks_curves_show_the_samples_the_test_judged() {
             seed: 11,
             alpha: STATISTICAL_ALPHA.value,
         };
-        let kept = oracle_ks::ks_test_lobe_kept(
-            &|u| sampler.sample_wm(u),
-            &|w| sampler.pdf_wm(w),
+        let kept = oracle_ks::ks_test_lobe_batch_kept(
+            &|u: &[[f64; 2]], out: &mut [Vec3]| sampler.sample_wm_batch(u, out),
+            &|w: &[Vec3], out: &mut [f64]| sampler.pdf_wm_batch(w, out),
             marginal,
             m.lobe(),
             &[],

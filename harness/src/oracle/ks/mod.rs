@@ -6,7 +6,7 @@
 //!
 //! 1. **Samples.** `samples` normals are drawn with `u` from the same seeded streams as the
 //!    chi-square test ([`stream`]`(seed, chunk)` per chunk of [`CHUNK`] sample indices, two
-//!    [`uniform`] draws per sample), in parallel, concatenated in chunk order: the sample set
+//!    [`crate::random::uniform`] draws per sample, generated in blocks), in parallel, concatenated in chunk order: the sample set
 //!    does not depend on the thread count. A sample outside the closed upper hemisphere
 //!    (non-finite, non-unit, below the horizon) is a sanity failure, as in the chi-square test.
 //! 2. **The marginal.** For cos θ_m the test runs on θ_m = atan2(√(m_x² + m_y²), m_z) ∈ [0, π/2]
@@ -37,7 +37,7 @@
 //! 4. **Its error bound**, stated in every result: Σ |S₂ − S₁| + Σ (b − a)·max inner error at
 //!    the interval's nodes + max midpoint interpolation error. The test refuses to judge
 //!    ([`Failure::TableInaccurate`]) unless this bound is below [`TABLE_FRACTION`] of the KS
-//!    resolution 1/√N (it is typically ~1e-9, against 1/√N ≥ 3e-4 for N ≤ 10⁷). A total mass
+//!    resolution 1/√N (it is typically ~1e-7, against 1/√N ≥ 3e-4 for N ≤ 10⁷). A total mass
 //!    off from 1 by more than [`MASS_TOLERANCE`] is a sanity failure, as in the chi-square test;
 //!    a smaller defect of the mass is left to the statistic (F is not renormalized).
 //! 5. **Statistic and p-value.** D_N = max_i max(i/N − F(x₍ᵢ₎), F(x₍ᵢ₎) − (i − 1)/N) over the
@@ -53,11 +53,11 @@ pub use table::{
     marginal_cdf, marginal_cdf_batch, marginal_cdf_lobe, marginal_cdf_lobe_batch, CdfTable,
 };
 
-use crate::oracle::chi2::{BatchSampler, Verdict, CHUNK, MASS_TOLERANCE};
+use crate::oracle::chi2::{BatchSampler, OutsideDomain, Verdict, CHUNK, MASS_TOLERANCE};
 use crate::oracle::domain::{validate, DomainError};
 use crate::oracle::lobe::{self, Lobe};
 use crate::oracle::quadrature::Accuracy;
-use crate::random::{stream, uniform};
+use crate::random::stream;
 use mfh_reference::geometry::Vec3;
 use mfh_reference::NormalSampler;
 use rayon::prelude::*;
@@ -65,9 +65,18 @@ use std::f64::consts::{FRAC_PI_2, TAU};
 use std::time::Instant;
 
 /// The summed |S₂ − S₁| the outer Simpson quadrature may reach over the whole table.
-pub const QUADRATURE_TOLERANCE: f64 = 1e-9;
-/// The largest interpolation error at an interval's midpoint the table accepts.
-pub const INTERPOLATION_TOLERANCE: f64 = 1e-9;
+///
+/// What the test needs: the table's error bound below [`TABLE_FRACTION`]/√N (3.2e-6 at the
+/// thorough profile's N = 10⁷, 7e-6 at quick's 2·10⁶), where an error of the CDF moves D_N by at
+/// most itself, against D_N's scale 1/√N ≥ 3.2e-4. 1e-7 here and in
+/// [`INTERPOLATION_TOLERANCE`] keeps the bound (≈ 2e-7 with the inner errors) 15× below that
+/// limit at N = 10⁷ (35× at 2·10⁶), and moves D_N by ≤ 6e-4 of its scale; it was 1e-9, 100×
+/// tighter than needed, which cost ~3× the knots (Simpson's and the Hermite error ∝ h⁴: ×100
+/// in tolerance is ×100^{1/4} ≈ 3.2 in spacing) and each knot an inner integral.
+pub const QUADRATURE_TOLERANCE: f64 = 1e-7;
+/// The largest interpolation error at an interval's midpoint the table accepts (see
+/// [`QUADRATURE_TOLERANCE`] for the margin).
+pub const INTERPOLATION_TOLERANCE: f64 = 1e-7;
 /// The table's error bound must be below this fraction of the KS resolution 1/√N.
 pub const TABLE_FRACTION: f64 = 0.01;
 /// Accuracy of the inner integrals (the marginal densities at the knots).
@@ -165,16 +174,9 @@ pub struct KsConfig {
 /// Why a KS test failed, or could not judge.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Failure {
-    /// A sample lies outside the upper hemisphere; `index` is the first such sample.
-    #[error("{count} samples outside the domain; the first, sample {index}: {error}")]
-    OutsideDomain {
-        /// Index of the first offending sample (in the seeded sequence).
-        index: u64,
-        /// What is wrong with it.
-        error: DomainError,
-        /// How many samples were outside.
-        count: u64,
-    },
+    /// Samples lie outside the upper hemisphere.
+    #[error(transparent)]
+    OutsideDomain(OutsideDomain),
     /// The marginal density is negative or not finite somewhere.
     #[error("marginal density {value} at {at}")]
     InvalidDensity {
@@ -271,9 +273,9 @@ fn draw_batch(sample: &BatchSampler<'_>, marginal: Marginal, samples: u64, seed:
                 outside: 0,
                 first_outside: None,
             };
-            let u: Vec<[f64; 2]> = (start..end)
-                .map(|_| [uniform(&mut rng), uniform(&mut rng)])
-                .collect();
+            // In one block: the pairs of `uniform` calls, generated in bulk.
+            let mut u = vec![[0.0; 2]; (end - start) as usize];
+            rng.fill_pairs(&mut u);
             let mut normals = vec![[0.0; 3]; u.len()];
             sample(&u, &mut normals);
             for (index, m) in (start..end).zip(normals) {
@@ -401,35 +403,7 @@ where
     S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
-    ks_test_lobe_kept(sample, pdf, marginal, lobe, theta_kinks, config).result
-}
-
-/// A KS test's result with what it judged: the sorted marginal values it drew and the model's
-/// CDF table, so that a plot of the two shows the test without drawing the samples again.
-#[derive(Debug, Clone)]
-pub struct KsKept {
-    /// The result.
-    pub result: KsResult,
-    /// The drawn marginal values, sorted (samples outside the domain are not among them).
-    pub sorted: Vec<f64>,
-    /// The model's CDF table of the marginal.
-    pub table: CdfTable,
-}
-
-/// [`ks_test_lobe`], keeping the sorted samples and the CDF table ([`KsKept`]).
-pub fn ks_test_lobe_kept<S, P>(
-    sample: &S,
-    pdf: &P,
-    marginal: Marginal,
-    lobe: &Lobe,
-    theta_kinks: &[f64],
-    config: &KsConfig,
-) -> KsKept
-where
-    S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
-    P: Fn(Vec3) -> f64 + Sync + ?Sized,
-{
-    ks_test_lobe_batch_kept(
+    ks_test_lobe_batch(
         &|u: &[[f64; 2]], m: &mut [Vec3]| {
             for (m, &u) in m.iter_mut().zip(u) {
                 *m = sample(u);
@@ -445,6 +419,18 @@ where
         theta_kinks,
         config,
     )
+}
+
+/// A KS test's result with what it judged: the sorted marginal values it drew and the model's
+/// CDF table, so that a plot of the two shows the test without drawing the samples again.
+#[derive(Debug, Clone)]
+pub struct KsKept {
+    /// The result.
+    pub result: KsResult,
+    /// The drawn marginal values, sorted (samples outside the domain are not among them).
+    pub sorted: Vec<f64>,
+    /// The model's CDF table of the marginal.
+    pub table: CdfTable,
 }
 
 /// [`ks_test_lobe`] with a batch sampler and a batch density (an external model: a round trip
@@ -471,10 +457,13 @@ pub fn ks_test_lobe_batch_kept(
 ) -> KsKept {
     let t = Instant::now();
     let mut drawn = draw_batch(sample, marginal, config.samples, config.seed);
-    drawn.values.par_sort_unstable_by(f64::total_cmp);
-    let sampling_seconds = t.elapsed().as_secs_f64();
+    let mut sampling_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let table = marginal_cdf_lobe_batch(pdf, marginal, lobe, theta_kinks);
+    let table_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    sort_values(&mut drawn.values);
+    sampling_seconds += t.elapsed().as_secs_f64();
     let mut result = KsResult {
         marginal,
         statistic: f64::NAN,
@@ -491,7 +480,7 @@ pub fn ks_test_lobe_batch_kept(
         pdf_mass: table.total(),
         evaluations: table.evaluations,
         sampling_seconds,
-        table_seconds: t.elapsed().as_secs_f64(),
+        table_seconds,
     };
     result.reason = sanity(&drawn, &table, config.samples);
     if result.reason.is_none() {
@@ -501,6 +490,20 @@ pub fn ks_test_lobe_batch_kept(
         result,
         sorted: drawn.values,
         table,
+    }
+}
+
+/// Sorts `values` ascending in `f64::total_cmp`'s order. The marginals' values are ≥ +0 (θ and
+/// φ), whose bit patterns as u64 sort as the numbers do: sorted as integers (a comparison a
+/// cycle, where `total_cmp` transforms both operands each time; 2·10⁶ values were a quarter of
+/// a KS test's time), the same order bit for bit; a value with its sign bit set (−0, say)
+/// takes the comparison sort of `total_cmp`.
+fn sort_values(values: &mut [f64]) {
+    if values.iter().all(|v| v.is_sign_positive()) {
+        let bits: &mut [u64] = bytemuck::cast_slice_mut(values);
+        bits.par_sort_unstable();
+    } else {
+        values.par_sort_unstable_by(f64::total_cmp);
     }
 }
 
@@ -525,11 +528,11 @@ fn judge(result: &mut KsResult, values: &[f64], table: &CdfTable, config: &KsCon
 /// density or mass, a table too coarse for N.
 fn sanity(drawn: &Drawn, table: &CdfTable, samples: u64) -> Option<Failure> {
     if let Some((index, error)) = drawn.first_outside {
-        return Some(Failure::OutsideDomain {
+        return Some(Failure::OutsideDomain(OutsideDomain {
             index,
             error,
             count: drawn.outside,
-        });
+        }));
     }
     if samples == 0 {
         return Some(Failure::NoSamples);

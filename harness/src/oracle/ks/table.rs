@@ -446,15 +446,7 @@ pub fn marginal_cdf_lobe_batch(
     lobe: &Lobe,
     theta_kinks: &[f64],
 ) -> CdfTable {
-    let mut polar = lobe.polar_cuts(FRAC_PI_2);
-    polar.extend(
-        theta_kinks
-            .iter()
-            .copied()
-            .filter(|t| *t > 0.0 && *t < FRAC_PI_2),
-    );
-    polar.sort_by(f64::total_cmp);
-    polar.dedup();
+    let polar = lobe.polar_cuts_with(FRAC_PI_2, theta_kinks);
     let azimuth = lobe.azimuth_cuts();
     // The inner integrals of one wave of the table run in lockstep: one call of `pdf` per
     // step of all of them (an external model pays a round trip per step, not per knot), each
