@@ -108,11 +108,22 @@ pub fn lambda_oracle(model: &dyn Model, w: Vec3) -> Estimate {
 
 /// [`lambda_oracle`] of a subject (its hints and registry entry place the quadrature's cuts).
 pub fn lambda_oracle_for(subject: &Subject, w: Vec3) -> Estimate {
+    lambda_oracle_to(subject, w, LAMBDA_ORACLE_RELATIVE)
+}
+
+/// The relative accuracy the Λ oracle asks of its quadrature: a hundredth of the tightest
+/// tolerance it serves (`CLOSED_FORM`, 1e-10).
+const LAMBDA_ORACLE_RELATIVE: f64 = 1e-12;
+
+/// [`lambda_oracle_for`] with the slope-space quadrature asked for `relative` (the lune
+/// quadrature of models without slopes keeps its own target): for a claim that measures
+/// errors of 1e-4 and needs a few digits of 600 Λ values, not twelve.
+pub fn lambda_oracle_to(subject: &Subject, w: Vec3, relative: f64) -> Estimate {
     let (sin_t, cos_t) = ((w[0] * w[0] + w[1] * w[1]).sqrt(), w[2]);
     if cos_t >= 1.0 || sin_t == 0.0 {
         return Estimate::default();
     }
-    let accuracy = Accuracy::relative(1e-12);
+    let accuracy = Accuracy::relative(relative);
     if let Some(slopes) = subject.model.as_slopes() {
         let mu = cos_t / sin_t;
         let phi = w[1].atan2(w[0]);
@@ -130,6 +141,64 @@ pub fn lambda_oracle_for(subject: &Subject, w: Vec3) -> Estimate {
         };
     }
     lambda_oracle_lune(subject, w)
+}
+
+/// Λ at several μ = cot θ along one azimuth φ of a slope-space model, each (1/μ)∫_μ^∞ (q − μ)
+/// P2(q) dq to the relative target `relative` (as [`lambda_oracle_to`], for models whose tail
+/// quadrature converges), with P2 evaluated once per node for all of them: the integral of μ_j
+/// is split at the larger μ_k (a piece [μ_k, μ_{k+1}] per k ≥ j, the tail past the largest), so
+/// every μ integrates over the same pieces with the same nodes, and a memo of P2 serves them
+/// all. For a claim over a grid of μ with a P2 that is itself a quadrature (GTR: 600 Λ in
+/// the spline claim); the integrands (q − μ_j)P2 ≥ 0, so nothing cancels.
+pub fn lambda_oracle_many(
+    slopes: &dyn mfh_reference::model::SlopeDistribution,
+    phi: f64,
+    mus: &[f64],
+    scale: f64,
+    relative: f64,
+) -> Vec<Estimate> {
+    let memo = std::cell::RefCell::new(std::collections::HashMap::<u64, f64>::new());
+    let p2 = |q: f64| -> f64 {
+        if let Some(v) = memo.borrow().get(&q.to_bits()) {
+            return *v;
+        }
+        let v = slopes.p2(q, phi);
+        memo.borrow_mut().insert(q.to_bits(), v);
+        v
+    };
+    let mut cuts: Vec<f64> = mus.iter().copied().filter(|m| *m > 0.0).collect();
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup();
+    let accuracy = Accuracy::relative(relative);
+    mus.iter()
+        .map(|&mu| {
+            if !(mu > 0.0 && mu.is_finite()) {
+                return Estimate {
+                    value: f64::NAN,
+                    error_bound: f64::INFINITY,
+                    evaluations: 0,
+                };
+            }
+            let f = |q: f64| (q - mu) * p2(q);
+            let mut points = vec![mu];
+            points.extend(cuts.iter().copied().filter(|c| *c > mu));
+            let last = *points.last().unwrap_or(&mu);
+            // The tail's substitution depends on its start and scale only: the same nodes for
+            // every μ (a scale depending on μ would defeat the memo).
+            let mut total = integrate_upper(&f, last, scale.max(1e-6), accuracy);
+            for w in points.windows(2) {
+                let e = crate::oracle::quadrature::integrate_pieces(&f, w, accuracy);
+                total.value += e.value;
+                total.error_bound += e.error_bound;
+                total.evaluations += e.evaluations;
+            }
+            Estimate {
+                value: total.value / mu,
+                error_bound: total.error_bound / mu,
+                evaluations: total.evaluations,
+            }
+        })
+        .collect()
 }
 
 /// ∫⟨−w·m⟩⁺ D(m) dm / cos θ over the lune of back-facing normals: m at azimuth

@@ -188,8 +188,14 @@ pub(super) fn plan_asg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
                         Ok(v) => v,
                         Err(e) => return error(r, e),
                     };
+                    // G vanishes below the horizon of its axis z: the sphere integral is the
+                    // one over the hemisphere about z (its kink is the cap's rim), in polar
+                    // coordinates about the narrower lobe's axis (z, where G peaks) at the
+                    // narrower width, as `sg.asg_integral_route` integrates G itself (about p,
+                    // 0.3 rad off the ASG's peak, the quadrature bisected its way to it).
                     let o = *memo.get_or_init(|| {
-                        sphere(&|v| g.eval(v) * s.eval(v), p, PI, width(20.0), Some(z))
+                        let narrow = width(bw[0].max(bw[1]).max(20.0));
+                        sphere(&|v| g.eval(v) * s.eval(v), z, 0.5 * PI, narrow, None)
                     });
                     if route == "exact" {
                         compare(r, value, o, &NUMERICAL_ROUTE);
