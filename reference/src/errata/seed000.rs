@@ -24,6 +24,16 @@ pub struct Bounded {
 /// The printed tolerance of Algorithms 1 and 2 (`if |value| < 1e-5 then break`).
 pub const PRINTED_TOLERANCE: f64 = 1e-5;
 
+/// Seed 000 eq 8 as printed, read as the cdf of θ_m (ERRATA.md seed 000 E1): it integrates
+/// φ over [0, 2π], so it is the marginal cdf of θ, ∫₀^θ (k_x D_x + k_y D_y) cos t sin t dt
+/// normalized to 1 at π/2 (∫₀^{2π} cos²φ dφ = ∫₀^{2π} sin²φ dφ = π), not the conditional cdf
+/// of θ given φ_m that Algorithm 2 inverts. Equal weights on cos²φ and sin²φ are the
+/// conditional's at φ = π/4, so the model's exact segment sums evaluate it. The corrected form
+/// (eq 9 with 2π/c) is the model's conditional, [`PiecewiseLinear::cdf_theta`].
+pub fn eq8_theta_cdf_printed(m: &PiecewiseLinear, theta: f64) -> f64 {
+    m.cdf_theta(theta, std::f64::consts::FRAC_PI_4)
+}
+
 /// Seed 000 Algorithm 1 (φ_m by Newton's method in a quadrant bracket), line by line as
 /// printed, stopped after `max_iterations` (the printed loop is `while true`). With
 /// D_x(0) = D_y(0) = 0 the factor (D_y(0) − D_x(0))/(D_y(0) + D_x(0)) of line 18 is 0/0:

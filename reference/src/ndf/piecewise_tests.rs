@@ -608,9 +608,12 @@ fn printed_eq8_is_the_marginal_not_the_conditional() {
     let printed = eq8(FRAC_PI_2);
     assert!((printed - 1.0).abs() < 1e-12);
     assert!((stated - 1.0).abs() > 0.05, "stated {stated}");
-    // The conditional of θ given φ differs from the marginal eq 8 describes.
+    // The conditional of θ given φ differs from the marginal eq 8 describes; the named printed
+    // form (`errata::seed000`, which the harness demonstrates) is this marginal.
     let t = 0.5;
     let marginal = eq8(t);
+    let named = crate::errata::seed000::eq8_theta_cdf_printed(&m, t);
+    assert!(rel_err(named, marginal) < 1e-9, "{named} vs {marginal}");
     let conditional = m.cdf_theta(t, phi_m);
     assert!(
         (marginal - conditional).abs() > 1e-3,

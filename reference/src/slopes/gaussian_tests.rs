@@ -558,35 +558,22 @@ fn erratum_pseudocode_lines_36_39_printed_fails() {
     assert_eq!(route, printed);
 }
 
-/// The view-frame quantities of eq 47–50 at a point: (p_s, ∂p_s/∂s_o, ∂p_s/∂s_⊥, s_o, s_⊥,
-/// s̄_o, s̄_⊥, σ_o², σ_⊥², c_o⊥).
-fn view_frame_point(model: &GaussianSlopes, phi: f64, s_o: f64, s_perp: f64) -> [f64; 10] {
-    let r = model.rotated(phi);
-    let (m, n) = (r.mean[0], r.mean[1]);
-    let (so2, sp2, c) = (r.cov[0][0], r.cov[1][1], r.cov[0][1]);
-    let det = so2 * sp2 - c * c;
-    let (a, b, cc) = (sp2 / det, -c / det, so2 / det); // eq 48
-    let (sn, cs) = phi.sin_cos();
-    let p = model.ps([s_o * cs - s_perp * sn, s_o * sn + s_perp * cs]); // eq 4–5
-    let dpo = (-a * (s_o - m) - b * (s_perp - n)) * p; // eq 49
-    let dpp = (-b * (s_o - m) - cc * (s_perp - n)) * p; // eq 50
-    [p, dpo, dpp, s_o, s_perp, m, n, so2, sp2, c]
-}
-
 /// Erratum 3: eq 52 (and so eq 54) prints s_⊥ p_s = −σ_o² ∂p_s/∂s_⊥ + c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s;
 /// the identity holds with −σ_⊥² ∂p_s/∂s_⊥ − c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s. Eq 51 is right.
 #[test]
 fn erratum_eq52_printed_fails() {
+    use crate::errata::seed002::{eq51, eq52_corrected, eq52_printed, ViewFramePoint};
     let model = GaussianSlopes::new([0.3, -0.2], correlated(0.5, 0.8, 0.4)).unwrap();
     let mut printed_worst: f64 = 0.0;
     for (phi, so, sp) in [(0.4, 0.2, 0.7), (1.9, -0.5, 0.1), (-2.2, 1.0, -0.9)] {
-        let [p, dpo, dpp, s_o, s_perp, m, n, so2, sp2, c] = view_frame_point(&model, phi, so, sp);
-        let eq51 = -c * dpp - so2 * dpo + m * p;
-        assert!(rel_err(eq51, s_o * p) < 1e-12, "eq 51");
-        let corrected = -sp2 * dpp - c * dpo + n * p;
-        assert!(rel_err(corrected, s_perp * p) < 1e-12, "corrected eq 52");
-        let printed = -so2 * dpp + c * dpo + n * p;
-        printed_worst = printed_worst.max(rel_err(printed, s_perp * p));
+        let f = ViewFramePoint::new(&model, phi, so, sp);
+        let p = f.p;
+        assert!(rel_err(eq51(&f), so * p) < 1e-12, "eq 51");
+        assert!(
+            rel_err(eq52_corrected(&f), sp * p) < 1e-12,
+            "corrected eq 52"
+        );
+        printed_worst = printed_worst.max(rel_err(eq52_printed(&f), sp * p));
     }
     assert!(printed_worst > 0.1, "printed eq 52 off by {printed_worst}");
 }
@@ -596,23 +583,16 @@ fn erratum_eq52_printed_fails() {
 /// and every derivative term vanishes, so the printed right side is s̄_o p_s ≠ 0.
 #[test]
 fn erratum_eq53_printed_fails() {
+    use crate::errata::seed002::{
+        eq53_last_term_corrected, eq53_last_term_printed, ViewFramePoint,
+    };
     let model = GaussianSlopes::new([0.3, -0.2], correlated(0.5, 0.8, 0.4)).unwrap();
     let theta: f64 = 1.1;
     let cot = theta.cos() / theta.sin();
-    let so = cot + 0.5; // H(s) = Heaviside(cos θ − s_o sin θ) = 0 here
-    let [p, _, _, s_o, _, m, _, _, _, _] = view_frame_point(&model, 0.4, so, 0.2);
-    let h = if theta.cos() - s_o * theta.sin() > 0.0 {
-        1.0
-    } else {
-        0.0
-    };
-    let lhs = s_o * p * h;
-    // ∂(p_s H)/∂s = 0 and p_s ∂H/∂s = 0 off the cut.
-    let printed_rhs = m * p;
-    let corrected_rhs = m * p * h;
-    assert_eq!(lhs, 0.0);
-    assert_eq!(corrected_rhs, lhs);
-    assert!(printed_rhs.abs() > 1e-3 * p);
+    let f = ViewFramePoint::new(&model, 0.4, cot + 0.5, 0.2); // H(s) = 0 here
+                                                              // The left side s_o p_s H vanishes, and so do ∂(p_s H)/∂s and p_s ∂H/∂s off the cut.
+    assert_eq!(eq53_last_term_corrected(&f, theta), 0.0);
+    assert!(eq53_last_term_printed(&f).abs() > 1e-3 * f.p);
 }
 
 #[test]

@@ -59,28 +59,9 @@ fn ratio(a: Estimate, b: Estimate) -> Estimate {
 fn e000_1() -> Result<Shown, String> {
     let m = pl()?;
     let (phi, theta) = (0.3f64, 0.5f64);
-    let (kx, ky) = m.weights();
-    // ∫₀^{2π} cos²φ dφ = ∫₀^{2π} sin²φ dφ = π.
-    let marginal = |t: f64| {
-        integrate_pieces(
-            &|s: f64| PI * (kx * m.d_x(s) + ky * m.d_y(s)) * s.cos() * s.sin(),
-            &[0.0, t],
-            acc(),
-        )
-        .value
-    };
-    let conditional = |t: f64| {
-        let (c2, s2) = (phi.cos().powi(2), phi.sin().powi(2));
-        integrate_pieces(
-            &|s: f64| TAU * (kx * c2 * m.d_x(s) + ky * s2 * m.d_y(s)) * s.cos() * s.sin(),
-            &[0.0, t],
-            acc(),
-        )
-        .value
-    };
     Ok(Shown::new(
-        marginal(theta) / marginal(FRAC_PI_2),
-        conditional(theta) / conditional(FRAC_PI_2),
+        seed000::eq8_theta_cdf_printed(&m, theta),
+        m.cdf_theta(theta, phi),
         ratio(
             theta_mass(&m, phi, 0.0, theta),
             theta_mass(&m, phi, 0.0, FRAC_PI_2),

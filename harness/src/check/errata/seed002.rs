@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::oracle::visible_moments::visible_moments_oracle;
+use mfh_reference::errata::seed002 as errata002;
 
 const GS_MEAN: [f64; 2] = [1.0, 1.0];
 const GS_COV: [[f64; 2]; 2] = [[1.0, 0.75], [0.75, 1.0]];
@@ -38,38 +39,16 @@ fn e002_2() -> Result<Shown, String> {
     visible_route("pseudocode_printed", 1.56, -FRAC_PI_2)
 }
 
-/// The Gaussian p_s of seed 002 in the frame (s_o, s_⊥) along φ = 0, with its gradient.
-fn gaussian_and_gradient(gs: &GaussianSlopes, s: [f64; 2]) -> (f64, [f64; 2]) {
-    let m = gs.mean();
-    let c = gs.cov();
-    let det = c[0][0] * c[1][1] - c[0][1] * c[0][1];
-    let inv = [
-        [c[1][1] / det, -c[0][1] / det],
-        [-c[0][1] / det, c[0][0] / det],
-    ];
-    let d = [s[0] - m[0], s[1] - m[1]];
-    let g = [
-        inv[0][0] * d[0] + inv[0][1] * d[1],
-        inv[1][0] * d[0] + inv[1][1] * d[1],
-    ];
-    let p = gs.ps(s);
-    (p, [-g[0] * p, -g[1] * p])
-}
-
 /// 002-3: seed 002 eq 52, s_⊥ p_s = −σ_o² ∂p_s/∂s_⊥ + c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s (printed) against
-/// −σ_⊥² ∂p_s/∂s_⊥ − c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s; oracle: the left side.
+/// −σ_⊥² ∂p_s/∂s_⊥ − c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s (`errata::seed002`); oracle: the left side.
 fn e002_3() -> Result<Shown, String> {
     let gs =
         GaussianSlopes::new([0.3, -0.2], [[0.5, 0.2], [0.2, 0.3]]).map_err(|e| e.to_string())?;
-    let s = [0.7, 0.4];
-    let (p, grad) = gaussian_and_gradient(&gs, s);
-    let c = gs.cov();
-    let (var_o, var_perp, c_op) = (c[0][0], c[1][1], c[0][1]);
-    let mean_perp = gs.mean()[1];
+    let f = errata002::ViewFramePoint::new(&gs, 0.0, 0.7, 0.4);
     Ok(Shown::new(
-        -var_o * grad[1] + c_op * grad[0] + mean_perp * p,
-        -var_perp * grad[1] - c_op * grad[0] + mean_perp * p,
-        exact(s[1] * p),
+        errata002::eq52_printed(&f),
+        errata002::eq52_corrected(&f),
+        exact(f.s_perp * gs.ps([0.7, 0.4])),
         &ERRATUM,
     ))
 }
@@ -82,11 +61,11 @@ fn e002_4() -> Result<Shown, String> {
     let theta = 1.0f64;
     let s = [1.0 / theta.tan() + 0.5, 0.1]; // s_o > cot θ: H = 0
     let h = if s[0] < 1.0 / theta.tan() { 1.0 } else { 0.0 };
-    let p = gs.ps(s);
+    let f = errata002::ViewFramePoint::new(&gs, 0.0, s[0], s[1]);
     Ok(Shown::new(
-        gs.mean()[0] * p,
-        gs.mean()[0] * p * h,
-        exact(s[0] * p * h),
+        errata002::eq53_last_term_printed(&f),
+        errata002::eq53_last_term_corrected(&f, theta),
+        exact(s[0] * gs.ps(s) * h),
         &ERRATUM,
     ))
 }
