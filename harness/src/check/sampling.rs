@@ -22,7 +22,6 @@ use crate::check::{need, Check};
 use crate::oracle::chi2::{
     chi2_test_batches_cut, BatchPdf, BatchSampler, Chi2Config, CELL_ABSOLUTE_TOLERANCE,
     CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE, REMOTE_CELL_ABSOLUTE_TOLERANCE,
-    REMOTE_KINKED_CELL_RELATIVE_TOLERANCE,
 };
 use crate::oracle::ks::Marginal;
 use crate::oracle::monte_carlo::{estimate_batch, two_sided_p};
@@ -274,14 +273,12 @@ fn chi2_kinked(
         seed: ctx.seed,
         alpha: STATISTICAL_ALPHA.value,
     };
-    let tolerance = if remote {
-        (
-            REMOTE_KINKED_CELL_RELATIVE_TOLERANCE,
-            REMOTE_CELL_ABSOLUTE_TOLERANCE,
-        )
+    let absolute = if remote {
+        REMOTE_CELL_ABSOLUTE_TOLERANCE
     } else {
-        (KINKED_CELL_RELATIVE_TOLERANCE, CELL_ABSOLUTE_TOLERANCE)
+        CELL_ABSOLUTE_TOLERANCE
     };
+    let tolerance = (KINKED_CELL_RELATIVE_TOLERANCE, absolute);
     let result = chi2_test_batches_cut(sample, pdf, &config, tolerance, None, &[]);
     fill_chi2(r, &result, ctx, samples);
 }

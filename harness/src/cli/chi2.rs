@@ -157,7 +157,7 @@ fn run_external(
                 &|m: &[mfh_reference::Vec3], out: &mut [f64]| v.pdf_wm_visible_batch(wi, m, out),
                 &plan.config,
                 (
-                    crate::oracle::chi2::REMOTE_KINKED_CELL_RELATIVE_TOLERANCE,
+                    crate::oracle::chi2::KINKED_CELL_RELATIVE_TOLERANCE,
                     crate::oracle::chi2::REMOTE_CELL_ABSOLUTE_TOLERANCE,
                 ),
                 None,

@@ -98,13 +98,21 @@ pub(crate) fn no_route(route: Option<&str>, quantity: &str) -> Result<(), EvalEr
     }
 }
 
+/// `v` as an array of exactly `N` numbers, or None (the callers name the key in their error).
+pub(crate) fn numbers<const N: usize>(v: &Value) -> Option<[f64; N]> {
+    let a = v.as_array().filter(|a| a.len() == N)?;
+    let mut out = [0.0; N];
+    for (o, x) in out.iter_mut().zip(a) {
+        *o = x.as_f64()?;
+    }
+    Some(out)
+}
+
 /// The sample point `"u": [u1, u2]` in [0, 1)².
 pub(crate) fn unit_square(q: &Map<String, Value>) -> Result<[f64; 2], EvalError> {
     let u = q
         .get("u")
-        .and_then(Value::as_array)
-        .filter(|a| a.len() == 2)
-        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]))
+        .and_then(numbers::<2>)
         .ok_or_else(|| EvalError::Argument("\"u\" must be [u1, u2]".into()))?;
     if !u.iter().all(|x| (0.0..1.0).contains(x)) {
         return Err(EvalError::Argument(format!(
@@ -164,10 +172,7 @@ pub(crate) fn optional_vector(
     let Some(v) = q.get(key) else {
         return Ok(None);
     };
-    let a = v
-        .as_array()
-        .filter(|a| a.len() == 3)
-        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?, a[2].as_f64()?]))
+    let a = numbers::<3>(v)
         .ok_or_else(|| EvalError::Argument(format!("\"{key}\" must be [x, y, z]")))?;
     if !is_unit(a, UNIT_TOLERANCE) {
         return Err(EvalError::Argument(format!(

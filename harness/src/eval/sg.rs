@@ -19,7 +19,7 @@
 //! | `asg_integral` | `asg` | `default` (§3.2.1 with F), `large_bandwidth` (π/√(λμ)), `exact` |
 //! | `asg_sg_convolution` | `asg`, `sg` (its axis is p; or give p as `v` and leave the axis out) | `default` (§3.2.3), `exact` |
 
-use super::args::{number, optional_finite, EvalError, UNIT_TOLERANCE};
+use super::args::{number, numbers, optional_finite, EvalError, UNIT_TOLERANCE};
 use mfh_reference::geometry::{is_unit, Vec3};
 use mfh_reference::sg::{Asg, Sg};
 use serde_json::{json, Map, Value};
@@ -192,10 +192,7 @@ fn routes(quantity: &str, route: &str, known: &[&str]) -> Result<(), EvalError> 
 }
 
 fn array3(v: &Value, what: &str) -> Result<Vec3, EvalError> {
-    v.as_array()
-        .filter(|a| a.len() == 3)
-        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?, a[2].as_f64()?]))
-        .ok_or_else(|| EvalError::Argument(format!("{what} must be [x, y, z]")))
+    numbers::<3>(v).ok_or_else(|| EvalError::Argument(format!("{what} must be [x, y, z]")))
 }
 
 /// An SG as the JSON object the queries take (`{"axis", "sharpness", "amplitude"}`).
@@ -277,9 +274,7 @@ fn asg(q: &Map<String, Value>) -> Result<Asg, EvalError> {
     };
     let bandwidths = o
         .get("bandwidths")
-        .and_then(Value::as_array)
-        .filter(|a| a.len() == 2)
-        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]))
+        .and_then(numbers::<2>)
         .ok_or_else(|| EvalError::Model("\"asg\".\"bandwidths\" must be [λ, μ]".into()))?;
     let amplitude = match o.get("amplitude") {
         None => 1.0,

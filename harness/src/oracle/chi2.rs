@@ -57,13 +57,10 @@ pub const CELL_ABSOLUTE_TOLERANCE: f64 = 1e-14;
 /// about ε²·N, 0.2 at N = 2·10⁷ (2e-3 at the quick audit's 2·10⁵) against its standard
 /// deviation √(2·dof) ≈ 32. It was 1e-6: each factor 10 costs the cubature ~√10 times the
 /// pieces along the kink (the error of a piece across a kink is ∝ its size squared), 3.3 s for
-/// GGX's visible normals at θi = 1.3 in the quick audit.
+/// GGX's visible normals at θi = 1.3 in the quick audit. Remote models (an external process)
+/// take the same relative tolerance and only a looser absolute one
+/// ([`REMOTE_CELL_ABSOLUTE_TOLERANCE`]).
 pub const KINKED_CELL_RELATIVE_TOLERANCE: f64 = 1e-4;
-/// [`KINKED_CELL_RELATIVE_TOLERANCE`] for a remote model (an external process, where each
-/// evaluation the kink costs is protocol traffic): the same 1e-4 (it was 1e-5 against the
-/// reference models' 1e-6; the reference models' tolerance is now as loose, with the same
-/// margin of 50), the remote model keeping only its looser absolute tolerance.
-pub const REMOTE_KINKED_CELL_RELATIVE_TOLERANCE: f64 = KINKED_CELL_RELATIVE_TOLERANCE;
 /// [`CELL_ABSOLUTE_TOLERANCE`] for a remote model: 1e-11 of mass per cell is 2e-4 counts at
 /// 2·10⁷ samples, far below the ≥ 5 counts a cell needs to enter the statistic unpooled.
 pub const REMOTE_CELL_ABSOLUTE_TOLERANCE: f64 = 1e-11;
