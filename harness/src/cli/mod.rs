@@ -46,7 +46,7 @@ pub enum ProfileArg {
     Quick,
     /// More incidence angles and 2·10⁶ samples per sampler.
     Standard,
-    /// Dense grids and 2·10⁷ samples per sampler.
+    /// Dense grids, 10⁸ chi-square and Monte Carlo samples and 10⁷ KS samples per sampler.
     Thorough,
 }
 

@@ -52,17 +52,17 @@ pub const CELL_RELATIVE_TOLERANCE: f64 = 1e-9;
 pub const CELL_ABSOLUTE_TOLERANCE: f64 = 1e-14;
 /// Per-cell relative tolerance of the expected-mass cubature for densities with a kink inside
 /// cells (the terminator of ⟨wi·m⟩⁺ of a visible-normal density): the expected counts need a
-/// relative accuracy well below 1/√(expected count), ≥ 5e-3 even at 2·10⁷ samples over 512
-/// cells, so 1e-4 keeps a margin of 50; a relative error ε of every expected count moves χ² by
-/// about ε²·N, 0.2 at N = 2·10⁷ (2e-3 at the quick audit's 2·10⁵) against its standard
-/// deviation √(2·dof) ≈ 32. It was 1e-6: each factor 10 costs the cubature ~√10 times the
+/// relative accuracy well below 1/√(expected count), ≥ 2.3e-3 even at the thorough profile's
+/// 10⁸ samples over 512 cells, so 1e-4 keeps a margin of 23; a relative error ε of every
+/// expected count moves χ² by about ε²·N, 1 at N = 10⁸ (2e-3 at the quick audit's 2·10⁵)
+/// against its standard deviation √(2·dof) ≈ 32. It was 1e-6: each factor 10 costs the cubature ~√10 times the
 /// pieces along the kink (the error of a piece across a kink is ∝ its size squared), 3.3 s for
 /// GGX's visible normals at θi = 1.3 in the quick audit. Remote models (an external process)
 /// take the same relative tolerance and only a looser absolute one
 /// ([`REMOTE_CELL_ABSOLUTE_TOLERANCE`]).
 pub const KINKED_CELL_RELATIVE_TOLERANCE: f64 = 1e-4;
-/// [`CELL_ABSOLUTE_TOLERANCE`] for a remote model: 1e-11 of mass per cell is 2e-4 counts at
-/// 2·10⁷ samples, far below the ≥ 5 counts a cell needs to enter the statistic unpooled.
+/// [`CELL_ABSOLUTE_TOLERANCE`] for a remote model: 1e-11 of mass per cell is 1e-3 counts at
+/// 10⁸ samples, far below the ≥ 5 counts a cell needs to enter the statistic unpooled.
 pub const REMOTE_CELL_ABSOLUTE_TOLERANCE: f64 = 1e-11;
 
 /// The parameters of one chi-square test.

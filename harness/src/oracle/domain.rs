@@ -214,8 +214,8 @@ impl CellFinder {
     /// one for the errors).
     ///
     /// One straight-line pass per sub-block of [`FIND_BLOCK`] directions, no branch and no
-    /// table, so it vectorizes (4 lanes under AVX2: it runs through `pulp`'s safe runtime
-    /// dispatch, compiled for AVX2 + FMA where the CPU has it): the domain test on |m|², the
+    /// table, so it vectorizes (8 lanes under AVX-512, 4 under AVX2: it runs through `pulp`'s
+    /// safe runtime dispatch, compiled for x86-64-v4 or v3 where the CPU has it): the domain test on |m|², the
     /// row ⌊z·R⌋ and the column ⌊φ̃·2R/2π⌋ of the azimuth estimate φ̃ of
     /// [`approximate_azimuth`], and whether each is *clear*: z·R farther than `row_margin`
     /// from an integer, φ̃·2R/2π farther than [`COLUMN_MARGIN`]·2R/2π (a margin of 1e-4 rad,
@@ -755,8 +755,8 @@ mod tests {
         assert!(rejected > 1000, "{rejected}");
     }
 
-    /// The block finder on the dispatched path (AVX2 + FMA where the CPU has it) and on the
-    /// baseline path (`pulp::Arch::Scalar`, what a CPU without AVX2 runs) finds the cell of
+    /// The block finder on the dispatched path (AVX-512 or AVX2 + FMA where the CPU has it) and
+    /// on the baseline path (`pulp::Arch::Scalar`, what a CPU without AVX2 runs) finds the cell of
     /// `cell_of` for every direction: random ones, and ones at angular distances around the
     /// column margin (1e-4 rad) and the estimate's error (1.2e-5 rad) from every column edge.
     #[test]

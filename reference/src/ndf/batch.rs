@@ -2,7 +2,7 @@
 //! them shares — (cos 2πu₀, sin 2πu₀) scaled by the axis scales, times the slope radius, and
 //! the normal of the slope — written as straight-line loops over fixed blocks that the compiler
 //! vectorizes (no branch, no call per element; SSE2 two-lane f64 on the baseline x86-64 target,
-//! wider where the build enables AVX2).
+//! 4 or 8 lanes where the CPU has AVX2 or AVX-512, through `pulp`'s dispatch below).
 //!
 //! **Bit for bit.** Every step performs the same IEEE operations in the same order as the
 //! scalar path (`geometry::sin_cos_turns` with musl's `__sin`/`__cos` kernels as ported by the
@@ -78,8 +78,9 @@ fn sin_cos_turns_block(u: &[f64], s: &mut [f64], c: &mut [f64]) {
 /// fast path.
 ///
 /// **Dispatch.** The loop runs through `pulp::Arch::dispatch` (safe runtime dispatch; pulp is
-/// the SIMD layer of faer): on a CPU with AVX2 + FMA (x86-64-v3) it is compiled for it, so the
-/// straight-line loops vectorize 4 f64 lanes wide instead of baseline SSE2's 2; elsewhere
+/// the SIMD layer of faer): on a CPU with AVX-512 (x86-64-v4) or AVX2 + FMA (x86-64-v3) it is
+/// compiled for it, so the straight-line loops vectorize 8 or 4 f64 lanes wide instead of
+/// baseline SSE2's 2; elsewhere
 /// (or on other architectures) the same source compiled for the baseline. Both give the same
 /// bits: Rust never contracts a·b + c into an FMA, and packed +, −, ×, ÷, √ and conversions
 /// round as scalar ones (the test `avx2_and_baseline_paths_agree_bit_for_bit`).
@@ -284,7 +285,7 @@ mod tests {
         }
     }
 
-    /// The dispatched loop (AVX2 + FMA on a CPU that has it) and the baseline loop
+    /// The dispatched loop (AVX-512 or AVX2 + FMA on a CPU that has it) and the baseline loop
     /// (`pulp::Arch::Scalar`, what a CPU without AVX2 runs) give the same bits, and both the
     /// scalar sampler's.
     #[test]

@@ -23,25 +23,57 @@
 //! **Per-check seeds.** [`derive_seed`] mixes a seed with a label (e.g. a hash of a check's
 //! name) through SplitMix64's finalizer, a bijection of 64 bits.
 
+mod keystream;
+
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
 /// One random stream: a ChaCha8 keystream keyed by a seed and numbered by a stream id.
 #[derive(Debug, Clone)]
-pub struct Stream(ChaCha8Rng);
+pub struct Stream {
+    /// `rand_chacha`'s generator: the scalar draws, and the position in the stream.
+    rng: ChaCha8Rng,
+    /// The key as ChaCha words, for the bulk path of [`Stream::fill_pairs`].
+    key: [u32; 8],
+    /// The stream id.
+    id: u64,
+    /// Where the stream is (in ChaCha words) after a bulk fill, until the next draw moves
+    /// `rng` there: consecutive bulk fills then never make `rand_chacha` refill its buffer.
+    parked: Option<u128>,
+}
+
+/// Pairs of uniforms per ChaCha block (64 bytes, 16 bytes a pair).
+const PAIRS_PER_BLOCK: usize = keystream::WORDS / 4;
+/// Whole blocks below which [`Stream::fill_pairs`] leaves the work to `rand_chacha` (moving
+/// it back to the stream's position after a bulk fill costs one 4-block refill).
+const MIN_BULK_BLOCKS: usize = 16;
 
 impl Stream {
     /// Stream `id` under `seed`, at its start.
     pub fn new(seed: u64, id: u64) -> Self {
-        let mut rng = ChaCha8Rng::from_seed(key_of(seed));
+        let seed_bytes = key_of(seed);
+        let mut rng = ChaCha8Rng::from_seed(seed_bytes);
         rng.set_stream(id);
-        Self(rng)
+        let key = std::array::from_fn(|i| {
+            u32::from_le_bytes([
+                seed_bytes[4 * i],
+                seed_bytes[4 * i + 1],
+                seed_bytes[4 * i + 2],
+                seed_bytes[4 * i + 3],
+            ])
+        });
+        Self {
+            rng,
+            key,
+            id,
+            parked: None,
+        }
     }
 
     /// The next uniform in [0, 1) (53 random bits).
     #[inline]
     pub fn uniform(&mut self) -> f64 {
-        to_unit(self.0.next_u64())
+        to_unit(self.generator().next_u64())
     }
 
     /// The next pair of uniforms.
@@ -55,10 +87,12 @@ impl Stream {
     /// calls of [`Stream::pair`]. The keystream is written straight into `out` (16 bytes per
     /// pair, through `bytemuck`'s safe cast of `[f64; 2]` to bytes) and each 8-byte word
     /// (little-endian, as [`Stream::pair`] reads it) is converted in place: no buffer to
-    /// clear or copy, a conversion loop the compiler vectorizes.
+    /// clear or copy, a conversion loop the compiler vectorizes. The whole blocks of a large
+    /// request are computed many at once ([`keystream`]: the same words as `rand_chacha`'s),
+    /// the pairs before the first and after the last block boundary by `rand_chacha`.
     pub fn fill_pairs(&mut self, out: &mut [[f64; 2]]) {
-        self.0.fill_bytes(bytemuck::cast_slice_mut(out));
-        /// The conversion as a `pulp::WithSimd` operation: under AVX2 the u64 → f64
+        self.fill_keystream(out);
+        /// The conversion as a `pulp::WithSimd` operation: under AVX2 or AVX-512 the u64 → f64
         /// conversions (which x86 has no packed instruction for below AVX-512) go 4 lanes
         /// wide through the compiler's exact magic-number sequence.
         struct Convert<'a>(&'a mut [[f64; 2]]);
@@ -83,25 +117,63 @@ impl Stream {
     /// drawn is the one the stream would give after `index` pairs from its start.
     pub fn seek_pair(&mut self, index: u64) {
         // 4 ChaCha words (u32) per pair.
-        self.0.set_word_pos(u128::from(index) * 4);
+        self.parked = None;
+        self.rng.set_word_pos(u128::from(index) * 4);
+    }
+
+    /// The next `out.len()` pairs' keystream bytes, as stored in `out` (16 per pair).
+    fn fill_keystream(&mut self, out: &mut [[f64; 2]]) {
+        let position = match self.parked {
+            Some(words) => words,
+            None => self.rng.get_word_pos(),
+        };
+        // Words to the next block boundary, as pairs (4 words each); a stream left between
+        // two words of a pair (an odd number of `next_u32` calls) takes the plain path.
+        let to_boundary = (keystream::WORDS as u128 - position % keystream::WORDS as u128)
+            % keystream::WORDS as u128;
+        let head = (to_boundary / 4) as usize;
+        let bulk = out.len().saturating_sub(head) / PAIRS_PER_BLOCK;
+        if position % 4 != 0 || bulk < MIN_BULK_BLOCKS {
+            self.generator().fill_bytes(bytemuck::cast_slice_mut(out));
+            return;
+        }
+        let (first, rest) = out.split_at_mut(head);
+        let (middle, last) = rest.split_at_mut(bulk * PAIRS_PER_BLOCK);
+        if !first.is_empty() {
+            self.generator().fill_bytes(bytemuck::cast_slice_mut(first));
+        }
+        let block = ((position + to_boundary) / keystream::WORDS as u128) as u64;
+        keystream::blocks(&self.key, self.id, block, bytemuck::cast_slice_mut(middle));
+        self.parked = Some(position + to_boundary + (bulk * keystream::WORDS) as u128);
+        if !last.is_empty() {
+            self.generator().fill_bytes(bytemuck::cast_slice_mut(last));
+        }
+    }
+
+    /// `rand_chacha`'s generator, first moved to where a bulk fill left the stream.
+    fn generator(&mut self) -> &mut ChaCha8Rng {
+        if let Some(words) = self.parked.take() {
+            self.rng.set_word_pos(words);
+        }
+        &mut self.rng
     }
 }
 
 impl RngCore for Stream {
     fn next_u32(&mut self) -> u32 {
-        self.0.next_u32()
+        self.generator().next_u32()
     }
 
     fn next_u64(&mut self) -> u64 {
-        self.0.next_u64()
+        self.generator().next_u64()
     }
 
     fn fill_bytes(&mut self, dest: &mut [u8]) {
-        self.0.fill_bytes(dest)
+        self.generator().fill_bytes(dest)
     }
 
     fn try_fill_bytes(&mut self, dest: &mut [u8]) -> Result<(), rand_core::Error> {
-        self.0.try_fill_bytes(dest)
+        self.generator().try_fill_bytes(dest)
     }
 }
 
@@ -175,6 +247,44 @@ mod tests {
         let mut generic = stream(42, 3);
         assert_eq!(uniform(&mut generic), expected[0][0]);
         assert_eq!(uniform(&mut generic), expected[0][1]);
+    }
+
+    #[test]
+    fn bulk_fills_continue_any_position_of_the_stream() {
+        // Pair-aligned, word-misaligned (one `next_u32` before) and seeked starts, each
+        // followed by bulk fills of many blocks and by scalar draws.
+        for start in 0..3 {
+            let mut scalar = stream(7, 11);
+            let mut bulk = stream(7, 11);
+            match start {
+                1 => {
+                    assert_eq!(scalar.next_u32(), bulk.next_u32());
+                }
+                2 => {
+                    scalar.seek_pair(1_000_003);
+                    bulk.seek_pair(1_000_003);
+                }
+                _ => {}
+            }
+            let want: Vec<[f64; 2]> = (0..5000)
+                .map(|_| {
+                    let a = scalar.next_u64();
+                    [to_unit(a), to_unit(scalar.next_u64())]
+                })
+                .collect();
+            let mut got = vec![[0.0; 2]; 5000];
+            let (a, b) = got.split_at_mut(1999);
+            bulk.fill_pairs(a);
+            bulk.fill_pairs(b);
+            assert_eq!(got, want, "start {start}");
+            assert_eq!(bulk.next_u64(), scalar.next_u64());
+            // A seek right after a bulk fill (the stream parked where the fill ended).
+            bulk.fill_pairs(&mut got[..256]);
+            bulk.seek_pair(17);
+            let mut fresh = stream(7, 11);
+            fresh.seek_pair(17);
+            assert_eq!(bulk.pair(), fresh.pair());
+        }
     }
 
     #[test]
