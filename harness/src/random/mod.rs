@@ -133,7 +133,7 @@ impl Stream {
             % keystream::WORDS as u128;
         let head = (to_boundary / 4) as usize;
         let bulk = out.len().saturating_sub(head) / PAIRS_PER_BLOCK;
-        if position % 4 != 0 || bulk < MIN_BULK_BLOCKS {
+        if position % 4 != 0 || bulk < MIN_BULK_BLOCKS || !keystream::pays() {
             self.generator().fill_bytes(bytemuck::cast_slice_mut(out));
             return;
         }
