@@ -88,8 +88,9 @@ impl Stream {
     /// pair, through `bytemuck`'s safe cast of `[f64; 2]` to bytes) and each 8-byte word
     /// (little-endian, as [`Stream::pair`] reads it) is converted in place: no buffer to
     /// clear or copy, a conversion loop the compiler vectorizes. The whole blocks of a large
-    /// request are computed many at once ([`keystream`]: the same words as `rand_chacha`'s),
-    /// the pairs before the first and after the last block boundary by `rand_chacha`.
+    /// request are computed 16 at once under AVX-512 ([`keystream`]: the same words as
+    /// `rand_chacha`'s), the pairs before the first and after the last block boundary, and
+    /// everything on a CPU without AVX-512, by `rand_chacha`.
     pub fn fill_pairs(&mut self, out: &mut [[f64; 2]]) {
         self.fill_keystream(out);
         /// The conversion as a `pulp::WithSimd` operation: under AVX2 or AVX-512 the u64 → f64
@@ -133,17 +134,20 @@ impl Stream {
             % keystream::WORDS as u128;
         let head = (to_boundary / 4) as usize;
         let bulk = out.len().saturating_sub(head) / PAIRS_PER_BLOCK;
-        if position % 4 != 0 || bulk < MIN_BULK_BLOCKS || !keystream::pays() {
-            self.generator().fill_bytes(bytemuck::cast_slice_mut(out));
-            return;
-        }
+        let fast = match keystream::Fast::detect() {
+            Some(fast) if position % 4 == 0 && bulk >= MIN_BULK_BLOCKS => fast,
+            _ => {
+                self.generator().fill_bytes(bytemuck::cast_slice_mut(out));
+                return;
+            }
+        };
         let (first, rest) = out.split_at_mut(head);
         let (middle, last) = rest.split_at_mut(bulk * PAIRS_PER_BLOCK);
         if !first.is_empty() {
             self.generator().fill_bytes(bytemuck::cast_slice_mut(first));
         }
         let block = ((position + to_boundary) / keystream::WORDS as u128) as u64;
-        keystream::blocks(&self.key, self.id, block, bytemuck::cast_slice_mut(middle));
+        fast.blocks(&self.key, self.id, block, bytemuck::cast_slice_mut(middle));
         self.parked = Some(position + to_boundary + (bulk * keystream::WORDS) as u128);
         if !last.is_empty() {
             self.generator().fill_bytes(bytemuck::cast_slice_mut(last));
