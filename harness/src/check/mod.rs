@@ -32,8 +32,9 @@ pub use run::{need, Check, Missing, Outcome};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Profile {
-    /// The CI gate for one model: the quick grids, 10⁶ chi-square samples, no document-level
-    /// checks; ≤ 10 s for an isotropic model with D, Λ and normal sampling on 2 cores.
+    /// The CI gate for one model: the quick grids, 10⁶ chi-square and 2·10⁵ KS samples; ≤ 10 s
+    /// for an isotropic model with D, Λ and normal sampling on 2 cores. (Document-level checks
+    /// come from a scene's documents, not from the profile: a gate of one model has none.)
     Ci,
     /// A few cases per property, 2·10⁵ chi-square and 2·10⁶ KS samples per sampler: ≤ 60 s
     /// on 2 cores.

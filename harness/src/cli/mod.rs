@@ -40,7 +40,7 @@ pub struct Cli {
 /// library's [`crate::check::Profile`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ProfileArg {
-    /// One model in CI: the quick grids, 10⁶ chi-square samples, no document-level checks.
+    /// Sized for one model in CI: the quick grids, 10⁶ chi-square and 2·10⁵ KS samples.
     Ci,
     /// A few cases per property, 2·10⁵ chi-square and 2·10⁶ KS samples per sampler.
     Quick,
