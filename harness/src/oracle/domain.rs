@@ -229,7 +229,7 @@ impl CellFinder {
     /// ≈ 2·1e-4·128/2π ≈ 4e-3 of directions for the columns) goes through
     /// [`CellFinder::cell_of`]. Either way the cell is a function of the direction alone,
     /// whatever the block, the thread or the dispatch path (the test
-    /// `cells_of_is_the_same_on_the_avx2_and_baseline_paths`).
+    /// `cells_of_is_the_same_on_the_dispatched_and_baseline_paths`).
     ///
     /// # Panics
     /// If `m` and `cells` differ in length.
@@ -760,7 +760,7 @@ mod tests {
     /// `cell_of` for every direction: random ones, and ones at angular distances around the
     /// column margin (1e-4 rad) and the estimate's error (1.2e-5 rad) from every column edge.
     #[test]
-    fn cells_of_is_the_same_on_the_avx2_and_baseline_paths() {
+    fn cells_of_is_the_same_on_the_dispatched_and_baseline_paths() {
         let mut state: u64 = 13;
         let mut uniform = || {
             state = crate::random::splitmix64(state);

@@ -32,11 +32,13 @@ pub(super) struct Fast(pulp::x86::V4);
 pub(super) enum Fast {}
 
 impl Fast {
-    /// The fast keystream if this CPU has AVX-512.
+    /// The fast keystream if this CPU has AVX-512 (detected once per process: `fill_pairs`
+    /// asks per block of uniforms).
     pub(super) fn detect() -> Option<Fast> {
         #[cfg(target_arch = "x86_64")]
         {
-            pulp::x86::V4::try_new().map(Fast)
+            static DETECTED: std::sync::OnceLock<Option<Fast>> = std::sync::OnceLock::new();
+            *DETECTED.get_or_init(|| pulp::x86::V4::try_new().map(Fast))
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
@@ -45,17 +47,21 @@ impl Fast {
     }
 
     /// Writes blocks `counter`, `counter + 1`, … of the keystream of (`key`, `stream`) into
-    /// `out`, one block of 16 words (as stored little-endian bytes) per element.
+    /// `out`, one block of 16 words (as stored little-endian bytes) per element; `key` is the
+    /// 32-byte ChaCha key as `rand_chacha` takes it (words little-endian).
     pub(super) fn blocks(
         self,
-        key: &[u32; 8],
+        key: &[u8; 32],
         stream: u64,
         counter: u64,
         out: &mut [[u32; WORDS]],
     ) {
         #[cfg(target_arch = "x86_64")]
         {
-            avx512::blocks(self.0, key, stream, counter, out);
+            let key = std::array::from_fn(|i| {
+                u32::from_le_bytes([key[4 * i], key[4 * i + 1], key[4 * i + 2], key[4 * i + 3]])
+            });
+            avx512::blocks(self.0, &key, stream, counter, out);
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
@@ -250,8 +256,6 @@ mod tests {
             return;
         };
         let seed = super::super::key_of(0x5eed);
-        let key: [u32; 8] =
-            std::array::from_fn(|i| u32::from_le_bytes(seed[4 * i..4 * i + 4].try_into().unwrap()));
         // Whole groups of 16 and remainders; a counter that carries from word 12 into word 13
         // inside a group; a stream id using both of its words.
         for (stream, counter, n) in [
@@ -262,7 +266,7 @@ mod tests {
         ] {
             let want = reference(seed, stream, counter, n);
             let mut got = vec![[0u32; WORDS]; n];
-            fast.blocks(&key, stream, counter, &mut got);
+            fast.blocks(&seed, stream, counter, &mut got);
             assert_eq!(got, want, "stream {stream}, counter {counter}");
         }
     }

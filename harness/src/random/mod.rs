@@ -31,12 +31,9 @@ use rand_core::{RngCore, SeedableRng};
 /// One random stream: a ChaCha8 keystream keyed by a seed and numbered by a stream id.
 #[derive(Debug, Clone)]
 pub struct Stream {
-    /// `rand_chacha`'s generator: the scalar draws, and the position in the stream.
+    /// `rand_chacha`'s generator: the scalar draws, the key and stream id of the bulk path of
+    /// [`Stream::fill_pairs`], and the position in the stream.
     rng: ChaCha8Rng,
-    /// The key as ChaCha words, for the bulk path of [`Stream::fill_pairs`].
-    key: [u32; 8],
-    /// The stream id.
-    id: u64,
     /// Where the stream is (in ChaCha words) after a bulk fill, until the next draw moves
     /// `rng` there: consecutive bulk fills then never make `rand_chacha` refill its buffer.
     parked: Option<u128>,
@@ -51,23 +48,9 @@ const MIN_BULK_BLOCKS: usize = 16;
 impl Stream {
     /// Stream `id` under `seed`, at its start.
     pub fn new(seed: u64, id: u64) -> Self {
-        let seed_bytes = key_of(seed);
-        let mut rng = ChaCha8Rng::from_seed(seed_bytes);
+        let mut rng = ChaCha8Rng::from_seed(key_of(seed));
         rng.set_stream(id);
-        let key = std::array::from_fn(|i| {
-            u32::from_le_bytes([
-                seed_bytes[4 * i],
-                seed_bytes[4 * i + 1],
-                seed_bytes[4 * i + 2],
-                seed_bytes[4 * i + 3],
-            ])
-        });
-        Self {
-            rng,
-            key,
-            id,
-            parked: None,
-        }
+        Self { rng, parked: None }
     }
 
     /// The next uniform in [0, 1) (53 random bits).
@@ -147,7 +130,8 @@ impl Stream {
             self.generator().fill_bytes(bytemuck::cast_slice_mut(first));
         }
         let block = ((position + to_boundary) / keystream::WORDS as u128) as u64;
-        fast.blocks(&self.key, self.id, block, bytemuck::cast_slice_mut(middle));
+        let (key, id) = (self.rng.get_seed(), self.rng.get_stream());
+        fast.blocks(&key, id, block, bytemuck::cast_slice_mut(middle));
         self.parked = Some(position + to_boundary + (bulk * keystream::WORDS) as u128);
         if !last.is_empty() {
             self.generator().fill_bytes(bytemuck::cast_slice_mut(last));

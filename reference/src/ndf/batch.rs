@@ -83,7 +83,7 @@ fn sin_cos_turns_block(u: &[f64], s: &mut [f64], c: &mut [f64]) {
 /// baseline SSE2's 2; elsewhere
 /// (or on other architectures) the same source compiled for the baseline. Both give the same
 /// bits: Rust never contracts a·b + c into an FMA, and packed +, −, ×, ÷, √ and conversions
-/// round as scalar ones (the test `avx2_and_baseline_paths_agree_bit_for_bit`).
+/// round as scalar ones (the test `dispatched_and_baseline_paths_agree_bit_for_bit`).
 ///
 /// # Panics
 /// If `u` and `out` differ in length.
@@ -289,7 +289,7 @@ mod tests {
     /// (`pulp::Arch::Scalar`, what a CPU without AVX2 runs) give the same bits, and both the
     /// scalar sampler's.
     #[test]
-    fn avx2_and_baseline_paths_agree_bit_for_bit() {
+    fn dispatched_and_baseline_paths_agree_bit_for_bit() {
         let u = arguments();
         for (ax, ay) in [(0.3, 0.3), (0.02, 0.8)] {
             let ggx = Ggx::new(ax, ay).unwrap();
