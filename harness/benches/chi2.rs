@@ -8,12 +8,14 @@
 //! - `scalar_user`: a wrapper that implements only `sample_wm` (a renderer's own sampler),
 //!   drawn through the default `sample_wm_batch` (a loop over the scalar method);
 //!
-//! each on 1 thread and on every thread of the machine. Run: `cargo bench -p mfh-harness
-//! --bench chi2` (`-- --quick` for a fast pass).
+//! each on 1 thread and on every thread of the machine; and, in the group `chi2_stages`, each
+//! stage of the loop alone on 1 thread, per block of 256 samples (the uniforms, GGX's batch
+//! sampler, the cell finder, the counting), so that the loop's time can be apportioned. Run:
+//! `cargo bench -p mfh-harness --bench chi2` (`-- --quick` for a fast pass).
 
 use criterion::{black_box, Criterion, Throughput};
 use mfh_harness::oracle::chi2::{observe_batch, CHUNK};
-use mfh_harness::oracle::domain::HemisphereGrid;
+use mfh_harness::oracle::domain::{CellFinder, HemisphereGrid};
 use mfh_harness::random::stream;
 use mfh_reference::geometry::Vec3;
 use mfh_reference::ndf::Ggx;
@@ -103,8 +105,43 @@ fn chi2_sampling(c: &mut Criterion) {
     group.finish();
 }
 
+/// Each stage of `observe_batch`'s loop alone, on one block of [`BATCH`] samples of GGX
+/// α = 0.3 (the blocks of the other stages made once, beforehand).
+fn chi2_stages(c: &mut Criterion) {
+    let ggx = Ggx::new(0.3, 0.3).expect("valid roughness");
+    let finder = CellFinder::new(HemisphereGrid::new(64).expect("resolution ≥ 1"));
+    let mut rng = stream(1, 0);
+    let (mut u, mut m, mut cells) = ([[0.0; 2]; BATCH], [[0.0; 3]; BATCH], [0usize; BATCH]);
+    rng.fill_pairs(&mut u);
+    ggx.sample_wm_batch(&u, &mut m);
+    assert!(
+        finder.cells_of(&m, &mut cells),
+        "GGX samples are in the domain"
+    );
+    let mut counts = vec![0u64; finder.grid().cells()];
+    let mut group = c.benchmark_group("chi2_stages");
+    group.throughput(Throughput::Elements(BATCH as u64));
+    group.bench_function("uniforms", |b| b.iter(|| rng.fill_pairs(black_box(&mut u))));
+    group.bench_function("ggx_sampler", |b| {
+        b.iter(|| ggx.sample_wm_batch(black_box(&u), black_box(&mut m)))
+    });
+    group.bench_function("cell_finder", |b| {
+        b.iter(|| finder.cells_of(black_box(&m), black_box(&mut cells)))
+    });
+    group.bench_function("counting", |b| {
+        b.iter(|| {
+            for &cell in black_box(&cells).iter() {
+                counts[cell] += 1;
+            }
+        })
+    });
+    group.finish();
+    black_box(counts);
+}
+
 fn main() {
     let mut c = Criterion::default().configure_from_args();
+    chi2_stages(&mut c);
     chi2_sampling(&mut c);
     c.final_summary();
 }

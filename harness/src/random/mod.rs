@@ -76,9 +76,9 @@ impl Stream {
     /// everything on a CPU without AVX-512, by `rand_chacha`.
     pub fn fill_pairs(&mut self, out: &mut [[f64; 2]]) {
         self.fill_keystream(out);
-        /// The conversion as a `pulp::WithSimd` operation: under AVX2 or AVX-512 the u64 → f64
-        /// conversions (which x86 has no packed instruction for below AVX-512) go 4 lanes
-        /// wide through the compiler's exact magic-number sequence.
+        /// The conversion as a `pulp::WithSimd` operation: under AVX2 or AVX-512 it goes 4 or
+        /// 8 lanes wide ([`to_unit_in_halves`]: x86 has no packed u64 → f64 conversion below
+        /// AVX-512, and the compiler converted `to_unit`'s one lane at a time).
         struct Convert<'a>(&'a mut [[f64; 2]]);
         impl pulp::WithSimd for Convert<'_> {
             type Output = ();
@@ -88,8 +88,8 @@ impl Stream {
                     // to_bits returns the stored bytes as written (bit copies preserve every
                     // pattern).
                     *u = [
-                        to_unit(u64::from_le(u[0].to_bits())),
-                        to_unit(u64::from_le(u[1].to_bits())),
+                        to_unit_in_halves(u64::from_le(u[0].to_bits())),
+                        to_unit_in_halves(u64::from_le(u[1].to_bits())),
                     ];
                 }
             }
@@ -180,6 +180,21 @@ pub fn uniform(rng: &mut impl RngCore) -> f64 {
 #[inline(always)]
 pub fn to_unit(x: u64) -> f64 {
     (x >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// [`to_unit`] bit for bit, in operations that vectorize without a u64 → f64 conversion: v =
+/// x >> 11 < 2⁵³ is split into its 32-bit halves, each made exactly into a double by writing
+/// it into the mantissa of 2⁵² (low half: 2⁵² + lo) or 2⁸⁴ (high half: 2⁸⁴ + hi·2³²) and
+/// subtracting that power; hi·2³² + lo = v < 2⁵³ is then exact, as is the product by 2⁻⁵³ (a
+/// power of 2), so the result is `to_unit`'s (the test `to_unit_in_halves_is_to_unit`).
+#[inline(always)]
+pub fn to_unit_in_halves(x: u64) -> f64 {
+    const LOW: u64 = 0x4330_0000_0000_0000; // 2⁵²
+    const HIGH: u64 = 0x4530_0000_0000_0000; // 2⁸⁴
+    let v = x >> 11;
+    let low = f64::from_bits((v & 0xffff_ffff) | LOW) - f64::from_bits(LOW);
+    let high = f64::from_bits((v >> 32) | HIGH) - f64::from_bits(HIGH);
+    (high + low) * (1.0 / (1u64 << 53) as f64)
 }
 
 /// SplitMix64's finalizer (Steele, Lea & Flood 2014): a bijective mix of 64 bits.
@@ -300,6 +315,31 @@ mod tests {
         assert!(values.iter().all(|&v| (0.0..1.0).contains(&v)));
         assert_eq!(to_unit(u64::MAX), 1.0 - f64::EPSILON / 2.0);
         assert_eq!(to_unit(0), 0.0);
+    }
+
+    #[test]
+    fn to_unit_in_halves_is_to_unit() {
+        let mut x = 0x0123_4567_89ab_cdefu64;
+        let edges = [
+            0,
+            1,
+            (1 << 11) - 1,
+            1 << 11,
+            (1 << 43) - 1,
+            1 << 43,
+            u64::MAX,
+            u64::MAX - (1 << 11),
+        ];
+        for i in 0..1_000_000u64 {
+            x = splitmix64(x ^ i);
+            for v in [x, x >> (i % 64), x << (i % 64)].into_iter().chain(edges) {
+                assert_eq!(
+                    to_unit_in_halves(v).to_bits(),
+                    to_unit(v).to_bits(),
+                    "x = {v:#x}"
+                );
+            }
+        }
     }
 
     #[test]
