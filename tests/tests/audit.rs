@@ -84,6 +84,7 @@ fn a_passing_audit_exits_0_and_writes_a_versioned_report_and_junit() {
     assert!(junit.starts_with("<?xml"), "{junit}");
     assert!(junit.contains("<testsuite"), "{junit}");
     assert_eq!(junit.matches("<testcase").count(), records.len());
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -113,6 +114,7 @@ fn bad_input_exits_2_with_a_located_message() {
 
     let (code, _, stderr) = mfh(&["audit", "--profile", "fastest"]);
     assert_eq!(code, 2, "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// A failing check fails the audit (the CLI maps `passed() == false` to exit status 1).

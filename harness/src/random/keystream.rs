@@ -91,9 +91,10 @@ impl Fast {
             let key = std::array::from_fn(|i| {
                 u32::from_le_bytes([key[4 * i], key[4 * i + 1], key[4 * i + 2], key[4 * i + 3]])
             });
+            let key = &key;
             match self {
-                Fast::Avx512(simd) => avx512::blocks(simd, &key, stream, counter, out),
-                Fast::Avx2(simd) => avx2::blocks(simd, &key, stream, counter, out),
+                Fast::Avx512(simd) => dispatch(simd, Keyed { simd, key, stream }, counter, out),
+                Fast::Avx2(simd) => dispatch(simd, Keyed { simd, key, stream }, counter, out),
             }
         }
         #[cfg(not(target_arch = "x86_64"))]
@@ -195,6 +196,15 @@ fn in_groups<G: Group>(g: &G, counter: u64, out: &mut [[u32; WORDS]]) {
     }
 }
 
+/// The keystream of (`key`, `stream`) computed with the instruction set `simd` proves (its
+/// [`Group`] is in the module of that instruction set).
+#[cfg(target_arch = "x86_64")]
+struct Keyed<'a, S> {
+    simd: S,
+    key: &'a [u32; 8],
+    stream: u64,
+}
+
 /// Runs `in_groups` of `G` compiled for the instruction set `simd` proves (`G::group`
 /// inlined into it).
 #[cfg(target_arch = "x86_64")]
@@ -218,32 +228,15 @@ fn dispatch<S: pulp::Simd, G: Group>(simd: S, g: G, counter: u64, out: &mut [[u3
 
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
-    use super::{initial, rounds, Group, WORDS};
+    use super::{initial, rounds, Group, Keyed, WORDS};
     use core::arch::x86_64::__m512i;
     use pulp::x86::V4;
 
     /// Blocks per group: one per 32-bit lane of a 512-bit register.
     const LANES: usize = 16;
 
-    /// [`super::Fast::blocks`] (`simd` is the proof of AVX-512).
-    pub(super) fn blocks(
-        simd: V4,
-        key: &[u32; 8],
-        stream: u64,
-        counter: u64,
-        out: &mut [[u32; WORDS]],
-    ) {
-        super::dispatch(simd, Sixteen { simd, key, stream }, counter, out);
-    }
-
-    /// 16 blocks of the keystream of (`key`, `stream`) at once.
-    struct Sixteen<'a> {
-        simd: V4,
-        key: &'a [u32; 8],
-        stream: u64,
-    }
-
-    impl Group for Sixteen<'_> {
+    /// 16 blocks at once.
+    impl Group for Keyed<'_, V4> {
         const LANES: usize = LANES;
 
         #[inline(always)]
@@ -298,30 +291,12 @@ mod avx512 {
 
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
-    use super::{initial, Group, WORDS};
+    use super::{initial, Group, Keyed, WORDS};
     use core::arch::x86_64::__m256i;
     use pulp::x86::V3;
 
     /// Blocks per group: one per 32-bit lane of a 256-bit register.
     const LANES: usize = 8;
-
-    /// [`super::Fast::blocks`] (`simd` is the proof of AVX2).
-    pub(super) fn blocks(
-        simd: V3,
-        key: &[u32; 8],
-        stream: u64,
-        counter: u64,
-        out: &mut [[u32; WORDS]],
-    ) {
-        super::dispatch(simd, Eight { simd, key, stream }, counter, out);
-    }
-
-    /// 8 blocks of the keystream of (`key`, `stream`) at once.
-    struct Eight<'a> {
-        simd: V3,
-        key: &'a [u32; 8],
-        stream: u64,
-    }
 
     /// The `vpshufb` control that rotates every 32-bit word left by `k` bytes: byte i of a
     /// rotated word is byte (i − k) mod 4 of the word (the control indexes bytes within each
@@ -333,7 +308,7 @@ mod avx2 {
         bytemuck::cast(control)
     }
 
-    impl Eight<'_> {
+    impl Keyed<'_, V3> {
         /// The ChaCha quarter round on words a, b, c, d of every lane (`rotate` holds the
         /// byte shuffles that rotate by 16 and 8 bits).
         #[inline(always)]
@@ -364,7 +339,8 @@ mod avx2 {
         }
     }
 
-    impl Group for Eight<'_> {
+    /// 8 blocks at once.
+    impl Group for Keyed<'_, V3> {
         const LANES: usize = LANES;
 
         #[inline(always)]
