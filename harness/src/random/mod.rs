@@ -71,9 +71,9 @@ impl Stream {
     /// pair, through `bytemuck`'s safe cast of `[f64; 2]` to bytes) and each 8-byte word
     /// (little-endian, as [`Stream::pair`] reads it) is converted in place: no buffer to
     /// clear or copy, a conversion loop the compiler vectorizes. The whole blocks of a large
-    /// request are computed 16 at once under AVX-512 ([`keystream`]: the same words as
-    /// `rand_chacha`'s), the pairs before the first and after the last block boundary, and
-    /// everything on a CPU without AVX-512, by `rand_chacha`.
+    /// request are computed 16 at once under AVX-512 or 8 at once under AVX2 ([`keystream`]:
+    /// the same words as `rand_chacha`'s), the pairs before the first and after the last
+    /// block boundary, and everything on a CPU without AVX2, by `rand_chacha`.
     pub fn fill_pairs(&mut self, out: &mut [[f64; 2]]) {
         self.fill_keystream(out);
         /// The conversion as a `pulp::WithSimd` operation: under AVX2 or AVX-512 it goes 4 or
