@@ -8,15 +8,16 @@
 //! rounds, in `rand_chacha`'s layout: constants, the 8 key words, a 64-bit block counter in
 //! words 12–13, the 64-bit stream id in words 14–15 — is computed for consecutive blocks at
 //! once, one block per 32-bit lane of the vector registers (16 lanes under AVX-512, 8 under
-//! AVX2): the rounds as straight-line loops over `[u32; LANES]` that the compiler vectorizes
-//! (`vprold` under AVX-512; shifts and `vpshufb` under AVX2), then the transposition of words
-//! into blocks by shuffles through `pulp`'s safe wrappers of the intrinsics (no `unsafe`).
+//! AVX2): the rounds — under AVX-512 straight-line loops over `[u32; 16]` that the compiler
+//! vectorizes (`vprold`), under AVX2 intrinsics (`vpshufb` for the rotations by 16 and 8, a
+//! shift pair for 12 and 7) — then the transposition of words into blocks by shuffles, all
+//! through `pulp`'s safe wrappers of the intrinsics (no `unsafe`).
 //!
 //! Per pair of uniforms (16 bytes), against `rand_chacha`: 1.2 ns against 4.7 on an AMD EPYC
 //! Zen 5 (AVX-512, keystream alone); 4.1 ns against 5.8 on an AMD EPYC Zen 3 (AVX2, with the
-//! conversion to doubles: the `chi2_stages/uniforms` benchmark). The words are those of `rand_chacha` bit for bit (the test
-//! `blocks_are_rand_chacha_s`, on every path the CPU has), so every seeded number of mfh is
-//! unchanged. The transpositions are intrinsics, not element-wise loops: those compiled to
+//! conversion to doubles: the `chi2_stages/uniforms` benchmark). The words are those of
+//! `rand_chacha` bit for bit (the test `blocks_are_rand_chacha_s`, on every path the CPU has),
+//! so every seeded number of mfh is unchanged. The transpositions are intrinsics, not element-wise loops: those compiled to
 //! gathers and scatters (4.4 ns a pair under AVX2 on Zen 5, no faster than `rand_chacha`).
 //! Without AVX2 [`Fast::detect`] says no and `rand_chacha` does the work.
 
@@ -177,8 +178,8 @@ trait Group {
     fn group(&self, counter: u64, out: &mut [[u32; WORDS]]);
 }
 
-/// Blocks `counter`, `counter + 1`, … into `out` in groups of `G::LANES` (whole groups in
-/// place, the remainder through a buffer).
+/// Blocks `counter`, `counter + 1`, … into `out` in groups of `G::LANES` ≤ 16 (whole groups
+/// in place, the remainder through a buffer).
 #[inline(always)]
 fn in_groups<G: Group>(g: &G, counter: u64, out: &mut [[u32; WORDS]]) {
     let mut chunks = out.chunks_exact_mut(G::LANES);
