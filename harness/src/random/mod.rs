@@ -77,8 +77,7 @@ impl Stream {
     pub fn fill_pairs(&mut self, out: &mut [[f64; 2]]) {
         self.fill_keystream(out);
         /// The conversion as a `pulp::WithSimd` operation: under AVX2 or AVX-512 it goes 4 or
-        /// 8 lanes wide ([`to_unit_in_halves`]: x86 has no packed u64 → f64 conversion below
-        /// AVX-512, and the compiler converted `to_unit`'s one lane at a time).
+        /// 8 lanes wide ([`to_unit`] is written to vectorize).
         struct Convert<'a>(&'a mut [[f64; 2]]);
         impl pulp::WithSimd for Convert<'_> {
             type Output = ();
@@ -88,8 +87,8 @@ impl Stream {
                     // to_bits returns the stored bytes as written (bit copies preserve every
                     // pattern).
                     *u = [
-                        to_unit_in_halves(u64::from_le(u[0].to_bits())),
-                        to_unit_in_halves(u64::from_le(u[1].to_bits())),
+                        to_unit(u64::from_le(u[0].to_bits())),
+                        to_unit(u64::from_le(u[1].to_bits())),
                     ];
                 }
             }
@@ -177,18 +176,16 @@ pub fn uniform(rng: &mut impl RngCore) -> f64 {
 }
 
 /// The top 53 bits of `x` times 2⁻⁵³: a uniform double in [0, 1) when `x` is uniform.
+///
+/// Written without a u64 → f64 conversion, so that the loop of [`Stream::fill_pairs`]
+/// vectorizes (x86 has no packed one below AVX-512, and the compiler converted one lane at a
+/// time): v = x >> 11 < 2⁵³ is split into its 32-bit halves, each made exactly into a double
+/// by writing it into the mantissa of 2⁵² (low half: 2⁵² + lo) or 2⁸⁴ (high half: 2⁸⁴ +
+/// hi·2³²) and subtracting that power; hi·2³² + lo = v < 2⁵³ is then exact, as is the product
+/// by 2⁻⁵³ (a power of 2), so the result is `(x >> 11) as f64 · 2⁻⁵³` bit for bit (the test
+/// `to_unit_is_the_top_53_bits_times_2_to_the_minus_53`).
 #[inline(always)]
 pub fn to_unit(x: u64) -> f64 {
-    (x >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-}
-
-/// [`to_unit`] bit for bit, in operations that vectorize without a u64 → f64 conversion: v =
-/// x >> 11 < 2⁵³ is split into its 32-bit halves, each made exactly into a double by writing
-/// it into the mantissa of 2⁵² (low half: 2⁵² + lo) or 2⁸⁴ (high half: 2⁸⁴ + hi·2³²) and
-/// subtracting that power; hi·2³² + lo = v < 2⁵³ is then exact, as is the product by 2⁻⁵³ (a
-/// power of 2), so the result is `to_unit`'s (the test `to_unit_in_halves_is_to_unit`).
-#[inline(always)]
-pub fn to_unit_in_halves(x: u64) -> f64 {
     const LOW: u64 = 0x4330_0000_0000_0000; // 2⁵²
     const HIGH: u64 = 0x4530_0000_0000_0000; // 2⁸⁴
     let v = x >> 11;
@@ -318,8 +315,8 @@ mod tests {
     }
 
     #[test]
-    fn to_unit_in_halves_is_to_unit() {
-        let mut x = 0x0123_4567_89ab_cdefu64;
+    fn to_unit_is_the_top_53_bits_times_2_to_the_minus_53() {
+        let direct = |v: u64| (v >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
         let edges = [
             0,
             1,
@@ -330,15 +327,13 @@ mod tests {
             u64::MAX,
             u64::MAX - (1 << 11),
         ];
-        for i in 0..1_000_000u64 {
+        let mut x = 0x0123_4567_89ab_cdefu64;
+        let random = (0..1_000_000u64).flat_map(|i| {
             x = splitmix64(x ^ i);
-            for v in [x, x >> (i % 64), x << (i % 64)].into_iter().chain(edges) {
-                assert_eq!(
-                    to_unit_in_halves(v).to_bits(),
-                    to_unit(v).to_bits(),
-                    "x = {v:#x}"
-                );
-            }
+            [x, x >> (i % 64), x << (i % 64)]
+        });
+        for v in edges.into_iter().chain(random) {
+            assert_eq!(to_unit(v).to_bits(), direct(v).to_bits(), "x = {v:#x}");
         }
     }
 
