@@ -17,6 +17,7 @@ pub mod spec;
 pub mod special;
 #[cfg(test)]
 mod test_support;
+pub mod trig;
 
 pub use error::{ParamError, QueryError};
 pub use geometry::Vec3;

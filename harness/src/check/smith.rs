@@ -13,6 +13,7 @@ use crate::record::Verdict;
 use crate::subject::Subject;
 use crate::tolerance::{CLOSED_FORM, IDENTITY, NUMERICAL_ROUTE};
 use mfh_reference::geometry::{dot, from_spherical};
+use mfh_reference::trig::{sin_cos, sin_cos_block};
 use mfh_reference::{Masking, Model, Vec3};
 use serde_json::json;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -36,8 +37,7 @@ fn projection(w: Vec3) -> impl Fn(f64) -> (f64, f64) {
 
 /// `from_spherical(θ, φ)` with φ's (sin, cos) given (hoisted out of a run of nodes at one
 /// azimuth): the same operations, so the same direction bit for bit.
-fn spherical(theta: f64, (sp, cp): (f64, f64)) -> Vec3 {
-    let (st, ct) = theta.sin_cos();
+fn spherical(theta: f64, (st, ct): (f64, f64), (sp, cp): (f64, f64)) -> Vec3 {
     let ct = if (theta - FRAC_PI_2).abs() < 1e-15 {
         0.0
     } else {
@@ -238,23 +238,32 @@ fn lambda_oracle_lune(subject: &Subject, w: Vec3) -> Estimate {
             points.push(eps_t);
             points.sort_by(f64::total_cmp);
             problems.push((points, Accuracy::relative(2e-13)));
-            geometry.push((r, eps_t, psi.sin_cos()));
+            geometry.push((r, eps_t, sin_cos(psi)));
             index.push(i);
         }
-        let mut dirs = Vec::new();
+        let (mut dirs, mut angles, mut sines, mut cosines) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let estimates = integrate_pieces_many(
             &mut |tx: &[(usize, f64)], values: &mut [f64]| {
+                // sin and cos of every ε and sin(ε_t − ε), a block at a time (vectorized).
+                let n = tx.len();
+                angles.clear();
+                angles.extend(tx.iter().map(|&(_, eps)| eps));
+                angles.extend(tx.iter().map(|&(k, eps)| geometry[k].1 - eps));
+                sines.resize(2 * n, 0.0);
+                cosines.resize(2 * n, 0.0);
+                sin_cos_block(&angles, &mut sines, &mut cosines);
                 dirs.clear();
-                dirs.extend(tx.iter().map(|&(k, eps)| {
-                    let (se, ce) = eps.sin_cos();
+                dirs.extend(tx.iter().enumerate().map(|(j, &(k, _))| {
+                    let (se, ce) = (sines[j], cosines[j]);
                     let (sp, cp) = geometry[k].2;
                     [ce * cp, ce * sp, se]
                 }));
                 model.d_batch(&dirs, values);
-                for (v, &(k, eps)) in values.iter_mut().zip(tx) {
-                    let ce = eps.cos();
-                    let (r, eps_t, _) = geometry[k];
-                    *v = r * (eps_t - eps).sin() * *v * ce;
+                for (j, (v, &(k, _))) in values.iter_mut().zip(tx).enumerate() {
+                    let ce = cosines[j];
+                    let (r, _, _) = geometry[k];
+                    *v = r * sines[n + j] * *v * ce;
                 }
             },
             &problems,
@@ -396,28 +405,44 @@ pub fn plan<'a>(
                         // D only where the normal faces w (as the scalar form did). The nodes
                         // of one inner integral share φ_m and come together: the projection at
                         // φ_m is computed once per run of equal φ_m (the same values).
-                        let (mut dirs, mut at) = (Vec::new(), Vec::new());
+                        // The sines and cosines of the kept nodes' θ_m and θ_t − θ_m a block at
+                        // a time (vectorized).
+                        let (mut at, mut angles) = (Vec::new(), Vec::new());
                         let mut memo = (f64::NAN, (0.0, 0.0), (0.0, 0.0));
                         let mut at_phi = |phi_m: f64| {
                             if phi_m.to_bits() != memo.0.to_bits() {
-                                memo = (phi_m, p(phi_m), phi_m.sin_cos());
+                                memo = (phi_m, p(phi_m), sin_cos(phi_m));
                             }
                             (memo.1, memo.2)
                         };
                         for (i, &[theta_m, phi_m]) in tp.iter().enumerate() {
                             out[i] = 0.0;
-                            let ((_, theta_t), sin_cos_phi) = at_phi(phi_m);
+                            let ((_, theta_t), _) = at_phi(phi_m);
                             if theta_m < theta_t {
-                                dirs.push(spherical(theta_m, sin_cos_phi));
                                 at.push(i);
+                                angles.push(theta_m);
                             }
                         }
-                        let mut d = vec![0.0; dirs.len()];
-                        m.model.d_batch(&dirs, &mut d);
-                        for (d, i) in d.into_iter().zip(at) {
+                        let n = at.len();
+                        for &i in &at {
                             let [theta_m, phi_m] = tp[i];
-                            let ((rr, theta_t), _) = at_phi(phi_m);
-                            out[i] = g1 * rr * (theta_t - theta_m).sin() * d;
+                            angles.push(at_phi(phi_m).0 .1 - theta_m);
+                        }
+                        let (mut sines, mut cosines) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
+                        sin_cos_block(&angles, &mut sines, &mut cosines);
+                        let dirs: Vec<Vec3> = at
+                            .iter()
+                            .enumerate()
+                            .map(|(j, &i)| {
+                                let [theta_m, phi_m] = tp[i];
+                                spherical(theta_m, (sines[j], cosines[j]), at_phi(phi_m).1)
+                            })
+                            .collect();
+                        let mut d = vec![0.0; n];
+                        m.model.d_batch(&dirs, &mut d);
+                        for (j, (d, &i)) in d.into_iter().zip(&at).enumerate() {
+                            let ((rr, _), _) = at_phi(tp[i][1]);
+                            out[i] = g1 * rr * sines[n + j] * d;
                         }
                     },
                     m.lobe().width(),
@@ -609,13 +634,13 @@ pub fn plan<'a>(
 mod tests {
     use super::*;
 
-    /// The hoisted form of the white furnace's directions is `from_spherical` bit for bit,
-    /// the horizon snap included.
+    /// The hoisted form of the white furnace's directions is `from_spherical` bit for bit
+    /// when given the sines and cosines `from_spherical` computes, the horizon snap included.
     #[test]
     fn hoisted_spherical_is_from_spherical() {
         for theta in [0.0, 1e-9, 0.3, 1.0, FRAC_PI_2 - 1e-16, FRAC_PI_2, 1.7] {
             for phi in [0.0f64, 0.4, 2.0, 3.9, 6.2] {
-                let got = spherical(theta, phi.sin_cos());
+                let got = spherical(theta, theta.sin_cos(), phi.sin_cos());
                 let want = from_spherical(theta, phi);
                 assert_eq!(
                     got.map(f64::to_bits),

@@ -10,6 +10,7 @@
 use super::double_exponential::{run_states, BatchFn, State, TaggedBatchFn};
 use super::lobe::Lobe;
 use super::Estimate;
+use mfh_reference::trig::{sin_cos, sin_cos_block};
 use mfh_reference::Vec3;
 use std::cell::Cell;
 
@@ -371,10 +372,10 @@ pub fn integrate_line(
     }
 }
 
-/// The direction at polar angle θ and azimuth φ about the frame (t, b, n).
-fn direction(frame: &[Vec3; 3], theta: f64, phi: f64) -> Vec3 {
-    let (st, ct) = theta.sin_cos();
-    let (sp, cp) = phi.sin_cos();
+/// The direction at polar angle θ and azimuth φ about the frame (t, b, n), from (sin θ, cos θ)
+/// and (sin φ, cos φ).
+#[inline]
+fn in_frame(frame: &[Vec3; 3], (st, ct): (f64, f64), (sp, cp): (f64, f64)) -> Vec3 {
     let [t, b, n] = frame;
     [
         st * cp * t[0] + st * sp * b[0] + ct * n[0],
@@ -419,13 +420,24 @@ pub fn integrate_cap(
     accuracy: Accuracy,
 ) -> Estimate {
     let frame = frame_about(axis);
-    integrate_cap_polar(
-        &|theta, phi| f(direction(&frame, theta, phi)),
+    let (polar_cuts, phi_points) = width_cuts(width, theta_max);
+    cap_polar_batch(
+        CapIntegrand::Directions(&frame, &scalar_directions(f)),
         theta_max,
-        width,
+        &polar_cuts,
+        &phi_points,
         cuts,
         accuracy,
     )
+}
+
+/// A scalar integrand of directions as a batch one (a loop).
+fn scalar_directions<'f>(f: &'f dyn Fn(Vec3) -> f64) -> impl Fn(&[Vec3], &mut [f64]) + 'f {
+    move |m: &[Vec3], out: &mut [f64]| {
+        for (o, &m) in out.iter_mut().zip(m) {
+            *o = f(m);
+        }
+    }
 }
 
 /// [`integrate_cap`] for an integrand given in the cap's own polar coordinates (θ, φ), for
@@ -488,11 +500,11 @@ fn cap_polar(
     accuracy: Accuracy,
 ) -> Estimate {
     cap_polar_batch(
-        &|tp: &[[f64; 2]], out: &mut [f64]| {
+        CapIntegrand::Polar(&|tp: &[[f64; 2]], out: &mut [f64]| {
             for (o, &[theta, phi]) in out.iter_mut().zip(tp) {
                 *o = f(theta, phi);
             }
-        },
+        }),
         theta_max,
         polar_cuts,
         phi_cuts,
@@ -504,12 +516,25 @@ fn cap_polar(
 /// A batch integrand over a cap: writes f(θ[i], φ[i]) into out[i] for each `[θ, φ]`.
 pub type PolarBatchFn<'a> = dyn Fn(&[[f64; 2]], &mut [f64]) + 'a;
 
+/// What a cap quadrature integrates.
+#[derive(Clone, Copy)]
+enum CapIntegrand<'a> {
+    /// f(θ, φ) of the cap's polar angles, a batch of `[θ, φ]` at a time.
+    Polar(&'a PolarBatchFn<'a>),
+    /// f(m) of the direction m = sin θ cos φ t + sin θ sin φ b + cos θ n in the frame
+    /// (t, b, n), a batch of directions at a time.
+    Directions(&'a [Vec3; 3], &'a dyn Fn(&[Vec3], &mut [f64])),
+}
+
 /// [`cap_polar`] for a batch integrand: the inner (polar) integrals of one step of the outer
 /// (azimuthal) rule run in lockstep ([`integrate_pieces_many`]), so each call of `f` carries
 /// the nodes of all of them. Values are those of the scalar form bit for bit (the summed inner
-/// error bounds may differ in the last bits: they are added in another order).
+/// error bounds may differ in the last bits: they are added in another order). The sines and
+/// cosines of the polar nodes (the Jacobian sin θ, and the directions) are computed a step at
+/// a time by the vectorized [`sin_cos_block`], those of an inner integral's azimuth once per
+/// integral: the trigonometry of glibc's scalar `sincos` per node was a quarter of an audit.
 fn cap_polar_batch(
-    f: &PolarBatchFn<'_>,
+    f: CapIntegrand<'_>,
     theta_max: f64,
     polar_cuts: &[f64],
     phi_cuts: &[f64],
@@ -539,30 +564,50 @@ fn cap_polar_batch(
         points
     };
     let calls = Cell::new(0u64);
-    let inner = |phis: &[f64], out: &mut [f64]| {
-        calls.set(calls.get() + phis.len() as u64);
-        let problems: Vec<(Vec<f64>, Accuracy)> = phis
-            .iter()
-            .map(|&phi| (points_at(phi), inner_accuracy))
-            .collect();
-        let mut tp = Vec::new();
-        let estimates = integrate_pieces_many(
-            &mut |tx: &[(usize, f64)], values: &mut [f64]| {
-                tp.clear();
-                tp.extend(tx.iter().map(|&(k, theta)| [theta, phis[k]]));
-                f(&tp, values);
-                for (v, &(_, theta)) in values.iter_mut().zip(tx) {
-                    *v = if *v == 0.0 { 0.0 } else { *v * theta.sin() };
-                }
-            },
-            &problems,
-        );
-        for (o, e) in out.iter_mut().zip(estimates) {
-            evaluations.set(evaluations.get() + e.evaluations);
-            inner_error.set(inner_error.get() + e.error_bound.abs());
-            *o = e.value;
-        }
-    };
+    let inner =
+        |phis: &[f64], out: &mut [f64]| {
+            calls.set(calls.get() + phis.len() as u64);
+            let problems: Vec<(Vec<f64>, Accuracy)> = phis
+                .iter()
+                .map(|&phi| (points_at(phi), inner_accuracy))
+                .collect();
+            let azimuths: Vec<(f64, f64)> = phis.iter().map(|&phi| sin_cos(phi)).collect();
+            let (mut tp, mut dirs) = (Vec::new(), Vec::new());
+            let (mut thetas, mut st, mut ct) = (Vec::new(), Vec::new(), Vec::new());
+            let estimates =
+                integrate_pieces_many(
+                    &mut |tx: &[(usize, f64)], values: &mut [f64]| {
+                        thetas.clear();
+                        thetas.extend(tx.iter().map(|&(_, theta)| theta));
+                        st.resize(tx.len(), 0.0);
+                        ct.resize(tx.len(), 0.0);
+                        sin_cos_block(&thetas, &mut st, &mut ct);
+                        match f {
+                            CapIntegrand::Polar(f) => {
+                                tp.clear();
+                                tp.extend(tx.iter().map(|&(k, theta)| [theta, phis[k]]));
+                                f(&tp, values);
+                            }
+                            CapIntegrand::Directions(frame, f) => {
+                                dirs.clear();
+                                dirs.extend(tx.iter().zip(&st).zip(&ct).map(
+                                    |((&(k, _), &s), &c)| in_frame(frame, (s, c), azimuths[k]),
+                                ));
+                                f(&dirs, values);
+                            }
+                        }
+                        for (v, &s) in values.iter_mut().zip(&st) {
+                            *v = if *v == 0.0 { 0.0 } else { *v * s };
+                        }
+                    },
+                    &problems,
+                );
+            for (o, e) in out.iter_mut().zip(estimates) {
+                evaluations.set(evaluations.get() + e.evaluations);
+                inner_error.set(inner_error.get() + e.error_bound.abs());
+                *o = e.value;
+            }
+        };
     let tau = std::f64::consts::TAU;
     let mut phi_points: Vec<f64> = phi_cuts.to_vec();
     if let Some(c) = cuts {
@@ -601,13 +646,7 @@ pub fn integrate_hemisphere_lobe(
     cuts: Option<Cuts<'_>>,
     accuracy: Accuracy,
 ) -> Estimate {
-    integrate_cap_polar_lobe(
-        &|theta, phi| f(direction(&IDENTITY, theta, phi)),
-        std::f64::consts::FRAC_PI_2,
-        lobe,
-        cuts,
-        accuracy,
-    )
+    integrate_hemisphere_lobe_batch(&scalar_directions(f), lobe, cuts, accuracy)
 }
 
 /// [`integrate_hemisphere_lobe`] for a batch integrand (`f(m, out)` writes f(m[i]) into
@@ -620,13 +659,7 @@ pub fn integrate_hemisphere_lobe_batch(
 ) -> Estimate {
     let polar = lobe.polar_cuts(std::f64::consts::FRAC_PI_2);
     cap_polar_batch(
-        &|tp: &[[f64; 2]], out: &mut [f64]| {
-            let dirs: Vec<Vec3> = tp
-                .iter()
-                .map(|&[t, p]| direction(&IDENTITY, t, p))
-                .collect();
-            f(&dirs, out)
-        },
+        CapIntegrand::Directions(&IDENTITY, f),
         std::f64::consts::FRAC_PI_2,
         &polar[..polar.len() - 1],
         &lobe.azimuth_cuts(),
@@ -644,12 +677,12 @@ pub fn integrate_hemisphere_batch(
     accuracy: Accuracy,
 ) -> Estimate {
     let frame = frame_about([0.0, 0.0, 1.0]);
-    integrate_hemisphere_polar_batch(
-        &|tp: &[[f64; 2]], out: &mut [f64]| {
-            let dirs: Vec<Vec3> = tp.iter().map(|&[t, p]| direction(&frame, t, p)).collect();
-            f(&dirs, out)
-        },
-        width,
+    let (polar_cuts, phi_points) = width_cuts(width, std::f64::consts::FRAC_PI_2);
+    cap_polar_batch(
+        CapIntegrand::Directions(&frame, f),
+        std::f64::consts::FRAC_PI_2,
+        &polar_cuts,
+        &phi_points,
         cuts,
         accuracy,
     )
@@ -665,7 +698,14 @@ pub fn integrate_hemisphere_polar_batch(
 ) -> Estimate {
     let theta_max = std::f64::consts::FRAC_PI_2;
     let (polar_cuts, phi_points) = width_cuts(width, theta_max);
-    cap_polar_batch(f, theta_max, &polar_cuts, &phi_points, cuts, accuracy)
+    cap_polar_batch(
+        CapIntegrand::Polar(f),
+        theta_max,
+        &polar_cuts,
+        &phi_points,
+        cuts,
+        accuracy,
+    )
 }
 
 /// [`integrate_hemisphere_lobe`] for an integrand of (θ, φ) about +z, φ from +x.

@@ -19,22 +19,7 @@ use crate::geometry::Vec3;
 /// Elements per block: the temporaries live on the stack (5 × 64 doubles).
 const BLOCK: usize = 64;
 
-// musl `__sin` (k_sin.c) coefficients, bit patterns as in libm 0.2's `k_sin.rs`.
-const S1: f64 = f64::from_bits(0xbfc5_5555_5555_5549); // -1.66666666666666324348e-1
-const S2: f64 = f64::from_bits(0x3f81_1111_1110_f8a6); // 8.33333333332248946124e-3
-const S3: f64 = f64::from_bits(0xbf2a_01a0_19c1_61d5); // -1.98412698298579493134e-4
-const S4: f64 = f64::from_bits(0x3ec7_1de3_57b1_fe7d); // 2.75573137070700676789e-6
-const S5: f64 = f64::from_bits(0xbe5a_e5e6_8a2b_9ceb); // -2.50507602534068634195e-8
-const S6: f64 = f64::from_bits(0x3de5_d93a_5acf_d57c); // 1.58969099521155010221e-10
-                                                       // musl `__cos` (k_cos.c) coefficients, bit patterns as in libm 0.2's `k_cos.rs`.
-const C1: f64 = f64::from_bits(0x3fa5_5555_5555_554c); // 4.16666666666666019037e-2
-const C2: f64 = f64::from_bits(0xbf56_c16c_16c1_5177); // -1.38888888888741095749e-3
-const C3: f64 = f64::from_bits(0x3efa_01a0_19cb_1590); // 2.48015872894767294178e-5
-const C4: f64 = f64::from_bits(0xbe92_7e4f_809c_52ad); // -2.75573143513906633035e-7
-const C5: f64 = f64::from_bits(0x3e21_ee9e_bdb4_b1c4); // 2.08757232129817482790e-9
-const C6: f64 = f64::from_bits(0xbda8_fae9_be88_38d4); // -1.13596475577881948265e-11
-/// `libm::sincos` returns (x, 1) below this |x| (high word 0x3e46a09e: 2⁻²⁷·√2).
-const TINY: f64 = f64::from_bits(0x3e46_a09e_0000_0000);
+use crate::trig::{C1, C2, C3, C4, C5, C6, S1, S2, S3, S4, S5, S6, TINY};
 
 /// (sin 2πu, cos 2πu) of every u in [0, 1), as `geometry::sin_cos_turns` computes them: k =
 /// round(4u), r = u − k/4, x = 2πr ∈ [−π/4, π/4], musl's kernels at (x, 0), quadrant k.
