@@ -26,18 +26,18 @@
 
 /// musl `__sin` (k_sin.c) coefficients, bit patterns as in the `libm` crate's `k_sin.rs`.
 pub(crate) const S1: f64 = f64::from_bits(0xbfc5_5555_5555_5549); // -1.66666666666666324348e-1
-pub(crate) const S2: f64 = f64::from_bits(0x3f81_1111_1110_f8a6); // 8.33333333332248946124e-3
-pub(crate) const S3: f64 = f64::from_bits(0xbf2a_01a0_19c1_61d5); // -1.98412698298579493134e-4
-pub(crate) const S4: f64 = f64::from_bits(0x3ec7_1de3_57b1_fe7d); // 2.75573137070700676789e-6
-pub(crate) const S5: f64 = f64::from_bits(0xbe5a_e5e6_8a2b_9ceb); // -2.50507602534068634195e-8
-pub(crate) const S6: f64 = f64::from_bits(0x3de5_d93a_5acf_d57c); // 1.58969099521155010221e-10
+const S2: f64 = f64::from_bits(0x3f81_1111_1110_f8a6); // 8.33333333332248946124e-3
+const S3: f64 = f64::from_bits(0xbf2a_01a0_19c1_61d5); // -1.98412698298579493134e-4
+const S4: f64 = f64::from_bits(0x3ec7_1de3_57b1_fe7d); // 2.75573137070700676789e-6
+const S5: f64 = f64::from_bits(0xbe5a_e5e6_8a2b_9ceb); // -2.50507602534068634195e-8
+const S6: f64 = f64::from_bits(0x3de5_d93a_5acf_d57c); // 1.58969099521155010221e-10
 /// musl `__cos` (k_cos.c) coefficients, bit patterns as in the `libm` crate's `k_cos.rs`.
-pub(crate) const C1: f64 = f64::from_bits(0x3fa5_5555_5555_554c); // 4.16666666666666019037e-2
-pub(crate) const C2: f64 = f64::from_bits(0xbf56_c16c_16c1_5177); // -1.38888888888741095749e-3
-pub(crate) const C3: f64 = f64::from_bits(0x3efa_01a0_19cb_1590); // 2.48015872894767294178e-5
-pub(crate) const C4: f64 = f64::from_bits(0xbe92_7e4f_809c_52ad); // -2.75573143513906633035e-7
-pub(crate) const C5: f64 = f64::from_bits(0x3e21_ee9e_bdb4_b1c4); // 2.08757232129817482790e-9
-pub(crate) const C6: f64 = f64::from_bits(0xbda8_fae9_be88_38d4); // -1.13596475577881948265e-11
+const C1: f64 = f64::from_bits(0x3fa5_5555_5555_554c); // 4.16666666666666019037e-2
+const C2: f64 = f64::from_bits(0xbf56_c16c_16c1_5177); // -1.38888888888741095749e-3
+const C3: f64 = f64::from_bits(0x3efa_01a0_19cb_1590); // 2.48015872894767294178e-5
+const C4: f64 = f64::from_bits(0xbe92_7e4f_809c_52ad); // -2.75573143513906633035e-7
+const C5: f64 = f64::from_bits(0x3e21_ee9e_bdb4_b1c4); // 2.08757232129817482790e-9
+const C6: f64 = f64::from_bits(0xbda8_fae9_be88_38d4); // -1.13596475577881948265e-11
 /// `libm::sincos` returns (x, 1) below this |x| (high word 0x3e46a09e: 2⁻²⁷·√2).
 pub(crate) const TINY: f64 = f64::from_bits(0x3e46_a09e_0000_0000);
 
@@ -133,6 +133,16 @@ fn sin_cos_block_on(arch: pulp::Arch, x: &[f64], s: &mut [f64], c: &mut [f64]) {
     }
 }
 
+/// musl's k_sin and k_cos polynomials at z = x² (x ∈ [−π/4, π/4]): the r of `__sin`
+/// (x + x³(S1 + z r)) and of `__cos` (1 − z/2 + z r), with their operations in their order.
+#[inline(always)]
+pub(crate) fn kernel_polynomials(z: f64) -> (f64, f64) {
+    let w = z * z;
+    let rs = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6);
+    let rc = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
+    (rs, rc)
+}
+
 /// The fast path of [`sin_cos`] (|x| ≤ [`FAST_LIMIT`]): straight-line, so it vectorizes.
 #[inline(always)]
 fn reduced(x: f64) -> (f64, f64) {
@@ -150,17 +160,14 @@ fn reduced(x: f64) -> (f64, f64) {
     // without a renormalizing TwoSum on the critical path.
     let y0 = hi;
     let y1 = ((r1 - (hi - b)) + (p2 - b)) - k * PIO2_3 - k * PIO2_3T;
-    // k_sin(y0, y1, 1)
+    // k_sin(y0, y1, 1) and k_cos(y0, y1)
     let z = y0 * y0;
-    let w = z * z;
-    let r = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6);
+    let (rs, rc) = kernel_polynomials(z);
     let v = z * y0;
-    let sin = y0 - ((z * (0.5 * y1 - v * r) - y1) - v * S1);
-    // k_cos(y0, y1)
-    let r = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
+    let sin = y0 - ((z * (0.5 * y1 - v * rs) - y1) - v * S1);
     let hz = 0.5 * z;
     let w = 1.0 - hz;
-    let cos = w + (((1.0 - w) - hz) + (z * r - y0 * y1));
+    let cos = w + (((1.0 - w) - hz) + (z * rc - y0 * y1));
     // Quadrant k mod 4: 0 (s, c), 1 (c, −s), 2 (−s, −c), 3 (−c, s). `==` on the bits and
     // `if` on booleans: selects, not branches.
     let odd = quadrant & 1 == 1;

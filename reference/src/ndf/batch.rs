@@ -19,7 +19,7 @@ use crate::geometry::Vec3;
 /// Elements per block: the temporaries live on the stack (5 × 64 doubles).
 const BLOCK: usize = 64;
 
-use crate::trig::{C1, C2, C3, C4, C5, C6, S1, S2, S3, S4, S5, S6, TINY};
+use crate::trig::{kernel_polynomials, S1, TINY};
 
 /// (sin 2πu, cos 2πu) of every u in [0, 1), as `geometry::sin_cos_turns` computes them: k =
 /// round(4u), r = u − k/4, x = 2πr ∈ [−π/4, π/4], musl's kernels at (x, 0), quadrant k.
@@ -32,14 +32,11 @@ fn sin_cos_turns_block(u: &[f64], s: &mut [f64], c: &mut [f64]) {
         let k = (4.0 * u + 0.5).floor();
         let r = u - 0.25 * k;
         let x = std::f64::consts::TAU * r;
-        // k_sin(x, 0, 0)
+        // k_sin(x, 0, 0) and k_cos(x, 0)
         let z = x * x;
-        let w = z * z;
-        let rs = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6);
+        let (rs, rc) = kernel_polynomials(z);
         let v = z * x;
         let sin = x + v * (S1 + z * rs);
-        // k_cos(x, 0)
-        let rc = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
         let hz = 0.5 * z;
         let w1 = 1.0 - hz;
         let cos = w1 + (((1.0 - w1) - hz) + (z * rc - x * 0.0));
