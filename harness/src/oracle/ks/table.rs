@@ -217,6 +217,9 @@ impl CdfTable {
             Some(&x) if n > 0 => self.knots.partition_point(|&k| k <= x).saturating_sub(1),
             _ => 0,
         };
+        // The interval's limited slopes once per interval, not per value (the same bits:
+        // `Segment::at` is `hermite`'s evaluation).
+        let mut segment = (usize::MAX, Segment::default());
         for (j, &x) in xs.iter().enumerate() {
             if n < 2 || !(x > self.knots[0]) || x >= self.knots[n - 1] {
                 f(j, self.cdf(x));
@@ -225,16 +228,20 @@ impl CdfTable {
             while self.knots[i + 1] <= x {
                 i += 1;
             }
-            f(
-                j,
-                hermite(
-                    [self.knots[i], self.knots[i + 1]],
-                    [self.cdf[i], self.cdf[i + 1]],
-                    [self.density[i], self.density[i + 1]],
-                    x,
-                ),
-            );
+            if segment.0 != i {
+                segment = (i, self.segment(i));
+            }
+            f(j, segment.1.at(x));
         }
+    }
+
+    /// The interpolant on [knot i, knot i + 1].
+    fn segment(&self, i: usize) -> Segment {
+        Segment::new(
+            [self.knots[i], self.knots[i + 1]],
+            [self.cdf[i], self.cdf[i + 1]],
+            [self.density[i], self.density[i + 1]],
+        )
     }
 
     /// F(x), clamped to the table's range.
@@ -250,12 +257,7 @@ impl CdfTable {
             return self.cdf[n - 1];
         }
         let i = self.knots.partition_point(|&k| k <= x) - 1;
-        hermite(
-            [self.knots[i], self.knots[i + 1]],
-            [self.cdf[i], self.cdf[i + 1]],
-            [self.density[i], self.density[i + 1]],
-            x,
-        )
+        self.segment(i).at(x)
     }
 }
 
@@ -352,26 +354,62 @@ fn judge(s: &Span, q1: Node, q3: Node, share: f64, capped: bool) -> Judged {
 /// limited by Fritsch–Carlson (α² + β² ≤ 9 with α = f₀/Δ, β = f₁/Δ, Δ the secant slope), at x;
 /// clamped to [F₀, F₁].
 fn hermite(x: [f64; 2], f: [f64; 2], slope: [f64; 2], at: f64) -> f64 {
-    let h = x[1] - x[0];
-    let rise = f[1] - f[0];
-    if !(h > 0.0) || !(rise > 0.0) {
-        return f[0];
+    Segment::new(x, f, slope).at(at)
+}
+
+/// [`hermite`]'s interpolant on one interval, its slopes limited once.
+#[derive(Debug, Clone, Copy, Default)]
+struct Segment {
+    /// x₀ and h = x₁ − x₀.
+    x0: f64,
+    h: f64,
+    /// F₀, F₁ and F₁ − F₀.
+    f: [f64; 2],
+    rise: f64,
+    /// The limited slopes; `None` where the interval is empty or flat (the value is F₀).
+    slopes: Option<[f64; 2]>,
+}
+
+impl Segment {
+    fn new(x: [f64; 2], f: [f64; 2], slope: [f64; 2]) -> Self {
+        let h = x[1] - x[0];
+        let rise = f[1] - f[0];
+        let mut segment = Self {
+            x0: x[0],
+            h,
+            f,
+            rise,
+            slopes: None,
+        };
+        if !(h > 0.0) || !(rise > 0.0) {
+            return segment;
+        }
+        let secant = rise / h;
+        let (mut d0, mut d1) = (slope[0].max(0.0), slope[1].max(0.0));
+        let (a, b) = (d0 / secant, d1 / secant);
+        let r2 = a * a + b * b;
+        if r2 > 9.0 {
+            let tau = 3.0 / r2.sqrt();
+            d0 = tau * a * secant;
+            d1 = tau * b * secant;
+        }
+        segment.slopes = Some([d0, d1]);
+        segment
     }
-    let secant = rise / h;
-    let (mut d0, mut d1) = (slope[0].max(0.0), slope[1].max(0.0));
-    let (a, b) = (d0 / secant, d1 / secant);
-    let r2 = a * a + b * b;
-    if r2 > 9.0 {
-        let tau = 3.0 / r2.sqrt();
-        d0 = tau * a * secant;
-        d1 = tau * b * secant;
+
+    /// The interpolant at `at`, clamped to [F₀, F₁].
+    fn at(&self, at: f64) -> f64 {
+        let Some([d0, d1]) = self.slopes else {
+            return self.f[0];
+        };
+        let (h, f) = (self.h, self.f);
+        let t = (at - self.x0) / h;
+        let (t2, t3) = (t * t, t * t * t);
+        let h01 = -2.0 * t3 + 3.0 * t2;
+        let h10 = t3 - 2.0 * t2 + t;
+        let h11 = t3 - t2;
+        (f[0] + h01 * self.rise + h * (h10 * d0 + h11 * d1)).clamp(f[0], f[1])
     }
-    let t = (at - x[0]) / h;
-    let (t2, t3) = (t * t, t * t * t);
-    let h01 = -2.0 * t3 + 3.0 * t2;
-    let h10 = t3 - 2.0 * t2 + t;
-    let h11 = t3 - t2;
-    (f[0] + h01 * rise + h * (h10 * d0 + h11 * d1)).clamp(f[0], f[1])
 }
 
 /// sin θ and cos θ as `from_spherical` computes them (cos θ snapped to 0 at the horizon), so
