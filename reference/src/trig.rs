@@ -5,7 +5,7 @@
 //! glibc's scalar `sincos`, and the KS test's marginal angles of millions of samples.
 //!
 //! **Method.** x = kπ/2 + y with k = round(2x/π) and y as an unevaluated sum y₀ + y₁ (|y₁| ≤
-//! ½ ulp(y₀)): π/2 is split as musl's `__rem_pio2` splits it, into P₁ + P₂ + P₃ + P₃ₜ with P₁,
+//! ½ ulp(y₀) + 2e-21·|k|, far below |y₀| even at the doubles nearest kπ/2): π/2 is split as musl's `__rem_pio2` splits it, into P₁ + P₂ + P₃ + P₃ₜ with P₁,
 //! P₂, P₃ of 33 significant bits, so k·P₁, k·P₂ and k·P₃ are exact for |k| < 2²⁰; x − k·P₁ is
 //! exact (Sterbenz), the subtraction of k·P₂ is made exact by a TwoSum, and the rest is added
 //! to the low part: y is good to ~2⁻¹⁵⁰·|k| absolute, so even the doubles closest to a
@@ -75,7 +75,7 @@ const AT: [f64; 11] = [
     f64::from_bits(0xbfa2_b444_2c6a_6c2f),
     f64::from_bits(0x3f90_ad3a_e322_da11),
 ];
-/// π/2 and π in two parts (musl `pi_o_2`, `pi`, `pi_lo`).
+/// π/2 and π in two parts (musl s_atan.c `atanhi[3]`, `atanlo[3]`; e_atan2.c `pi`, `pi_lo`).
 const PIO2_HI: f64 = f64::from_bits(0x3ff9_21fb_5444_2d18);
 const PIO2_LO: f64 = f64::from_bits(0x3c91_a626_3314_5c07);
 const PI_HI: f64 = f64::from_bits(0x4009_21fb_5444_2d18);

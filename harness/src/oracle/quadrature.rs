@@ -419,10 +419,30 @@ pub fn integrate_cap(
     cuts: Option<Cuts<'_>>,
     accuracy: Accuracy,
 ) -> Estimate {
+    integrate_cap_batch(
+        &scalar_directions(f),
+        axis,
+        theta_max,
+        width,
+        cuts,
+        accuracy,
+    )
+}
+
+/// [`integrate_cap`] for a batch integrand (`f(m, out)` writes f(m[i]) into out[i]): the same
+/// value bit for bit, with the nodes of each step in one call.
+fn integrate_cap_batch(
+    f: &dyn Fn(&[Vec3], &mut [f64]),
+    axis: Vec3,
+    theta_max: f64,
+    width: f64,
+    cuts: Option<Cuts<'_>>,
+    accuracy: Accuracy,
+) -> Estimate {
     let frame = frame_about(axis);
     let (polar_cuts, phi_points) = width_cuts(width, theta_max);
-    cap_polar_batch(
-        CapIntegrand::Directions(&frame, &scalar_directions(f)),
+    cap_polar(
+        CapIntegrand::Directions(&frame, f),
         theta_max,
         &polar_cuts,
         &phi_points,
@@ -440,20 +460,6 @@ fn scalar_directions<'f>(f: &'f dyn Fn(Vec3) -> f64) -> impl Fn(&[Vec3], &mut [f
     }
 }
 
-/// [`integrate_cap`] for an integrand given in the cap's own polar coordinates (θ, φ), for
-/// integrands that are better computed from the angles than from the direction (e.g. w·m near
-/// its zero, as R sin(θ_t − θ) without the cancellation of a Cartesian dot product).
-pub fn integrate_cap_polar(
-    f: &dyn Fn(f64, f64) -> f64,
-    theta_max: f64,
-    width: f64,
-    cuts: Option<Cuts<'_>>,
-    accuracy: Accuracy,
-) -> Estimate {
-    let (polar_cuts, phi_points) = width_cuts(width, theta_max);
-    cap_polar(f, theta_max, &polar_cuts, &phi_points, cuts, accuracy)
-}
-
 /// The cuts of a cap quadrature for an integrand of angular width `width` about the axis: polar
 /// cuts at width·{10⁻³ … 10²} below `theta_max` (from 0), and the four quadrant azimuths.
 fn width_cuts(width: f64, theta_max: f64) -> (Vec<f64>, [f64; 5]) {
@@ -466,51 +472,6 @@ fn width_cuts(width: f64, theta_max: f64) -> (Vec<f64>, [f64; 5]) {
     }
     let tau = std::f64::consts::TAU;
     (polar_cuts, [0.0, 0.25 * tau, 0.5 * tau, 0.75 * tau, tau])
-}
-
-/// [`integrate_cap_polar`] with the polar and azimuthal cuts of a measured lobe
-/// ([`Lobe::polar_cuts`], [`Lobe::azimuth_cuts`]) instead of a width: the lobe's every scale,
-/// its anisotropy and an off-axis mode are cut at, so that its peak is resolved however narrow.
-pub fn integrate_cap_polar_lobe(
-    f: &dyn Fn(f64, f64) -> f64,
-    theta_max: f64,
-    lobe: &Lobe,
-    cuts: Option<Cuts<'_>>,
-    accuracy: Accuracy,
-) -> Estimate {
-    let polar = lobe.polar_cuts(theta_max);
-    cap_polar(
-        f,
-        theta_max,
-        &polar[..polar.len() - 1],
-        &lobe.azimuth_cuts(),
-        cuts,
-        accuracy,
-    )
-}
-
-/// ∫ over the cap with the polar cuts `polar_cuts` (from 0, without `theta_max`) and the
-/// azimuthal cuts `phi_cuts` (from 0 to 2π), plus the integrand's own `cuts`.
-fn cap_polar(
-    f: &dyn Fn(f64, f64) -> f64,
-    theta_max: f64,
-    polar_cuts: &[f64],
-    phi_cuts: &[f64],
-    cuts: Option<Cuts<'_>>,
-    accuracy: Accuracy,
-) -> Estimate {
-    cap_polar_batch(
-        CapIntegrand::Polar(&|tp: &[[f64; 2]], out: &mut [f64]| {
-            for (o, &[theta, phi]) in out.iter_mut().zip(tp) {
-                *o = f(theta, phi);
-            }
-        }),
-        theta_max,
-        polar_cuts,
-        phi_cuts,
-        cuts,
-        accuracy,
-    )
 }
 
 /// A batch integrand over a cap: writes f(θ[i], φ[i]) into out[i] for each `[θ, φ]`.
@@ -526,14 +487,18 @@ enum CapIntegrand<'a> {
     Directions(&'a [Vec3; 3], &'a dyn Fn(&[Vec3], &mut [f64])),
 }
 
-/// [`cap_polar`] for a batch integrand: the inner (polar) integrals of one step of the outer
-/// (azimuthal) rule run in lockstep ([`integrate_pieces_many`]), so each call of `f` carries
-/// the nodes of all of them. Values are those of the scalar form bit for bit (the summed inner
-/// error bounds may differ in the last bits: they are added in another order). The sines and
+/// ∫ over the cap within `theta_max` of the frame's axis, with the polar cuts `polar_cuts`
+/// (from 0, without `theta_max`) and the azimuthal cuts `phi_cuts` (from 0 to 2π), plus the
+/// integrand's own `cuts`: the one nested quadrature every cap and hemisphere integral here
+/// goes through. The inner (polar) integrals of one step of the outer (azimuthal) rule run in
+/// lockstep ([`integrate_pieces_many`]), so each call of `f` carries the nodes of all of them,
+/// each integral with the arithmetic of one alone (so a scalar integrand looped over a batch
+/// gives the same value bit for bit; the summed inner error bounds may differ in the last
+/// bits: they are added in another order). The sines and
 /// cosines of the polar nodes (the Jacobian sin θ, and the directions) are computed a step at
 /// a time by the vectorized [`sin_cos_block`], those of an inner integral's azimuth once per
 /// integral: the trigonometry of glibc's scalar `sincos` per node was a quarter of an audit.
-fn cap_polar_batch(
+fn cap_polar(
     f: CapIntegrand<'_>,
     theta_max: f64,
     polar_cuts: &[f64],
@@ -627,19 +592,10 @@ fn cap_polar_batch(
     }
 }
 
-/// [`integrate_hemisphere`] for an integrand of (θ, φ), the spherical coordinates of m about +z
-/// with φ measured from +x.
-pub fn integrate_hemisphere_polar(
-    f: &dyn Fn(f64, f64) -> f64,
-    width: f64,
-    cuts: Option<Cuts<'_>>,
-    accuracy: Accuracy,
-) -> Estimate {
-    integrate_cap_polar(f, std::f64::consts::FRAC_PI_2, width, cuts, accuracy)
-}
-
-/// ∫ f(m) dm over the upper hemisphere (n = +z), cut where the measured `lobe` varies
-/// ([`integrate_cap_polar_lobe`]): normalization and furnace integrals of a lobe of any width.
+/// ∫ f(m) dm over the upper hemisphere (n = +z), cut where the measured `lobe` varies (its
+/// polar and azimuthal cuts, [`Lobe::polar_cuts`], [`Lobe::azimuth_cuts`]: its every scale, its
+/// anisotropy and an off-axis mode, so that its peak is resolved however narrow):
+/// normalization and furnace integrals of a lobe of any width.
 pub fn integrate_hemisphere_lobe(
     f: &dyn Fn(Vec3) -> f64,
     lobe: &Lobe,
@@ -658,7 +614,7 @@ pub fn integrate_hemisphere_lobe_batch(
     accuracy: Accuracy,
 ) -> Estimate {
     let polar = lobe.polar_cuts(std::f64::consts::FRAC_PI_2);
-    cap_polar_batch(
+    cap_polar(
         CapIntegrand::Directions(&IDENTITY, f),
         std::f64::consts::FRAC_PI_2,
         &polar[..polar.len() - 1],
@@ -676,20 +632,20 @@ pub fn integrate_hemisphere_batch(
     cuts: Option<Cuts<'_>>,
     accuracy: Accuracy,
 ) -> Estimate {
-    let frame = frame_about([0.0, 0.0, 1.0]);
-    let (polar_cuts, phi_points) = width_cuts(width, std::f64::consts::FRAC_PI_2);
-    cap_polar_batch(
-        CapIntegrand::Directions(&frame, f),
+    integrate_cap_batch(
+        f,
+        [0.0, 0.0, 1.0],
         std::f64::consts::FRAC_PI_2,
-        &polar_cuts,
-        &phi_points,
+        width,
         cuts,
         accuracy,
     )
 }
 
-/// [`integrate_hemisphere_polar`] for a batch integrand of `[θ, φ]` pairs: the same value bit
-/// for bit, with the nodes of each step in one call.
+/// ∫ over the upper hemisphere of an integrand given in the polar angles (θ, φ) about +z (φ
+/// from +x), a batch of `[θ, φ]` pairs a call, cut as [`integrate_hemisphere`] cuts: for
+/// integrands better computed from the angles than from the direction (e.g. w·m near its
+/// zero, as R sin(θ_t − θ) without the cancellation of a Cartesian dot product).
 pub fn integrate_hemisphere_polar_batch(
     f: &PolarBatchFn<'_>,
     width: f64,
@@ -698,7 +654,7 @@ pub fn integrate_hemisphere_polar_batch(
 ) -> Estimate {
     let theta_max = std::f64::consts::FRAC_PI_2;
     let (polar_cuts, phi_points) = width_cuts(width, theta_max);
-    cap_polar_batch(
+    cap_polar(
         CapIntegrand::Polar(f),
         theta_max,
         &polar_cuts,
@@ -706,16 +662,6 @@ pub fn integrate_hemisphere_polar_batch(
         cuts,
         accuracy,
     )
-}
-
-/// [`integrate_hemisphere_lobe`] for an integrand of (θ, φ) about +z, φ from +x.
-pub fn integrate_hemisphere_polar_lobe(
-    f: &dyn Fn(f64, f64) -> f64,
-    lobe: &Lobe,
-    cuts: Option<Cuts<'_>>,
-    accuracy: Accuracy,
-) -> Estimate {
-    integrate_cap_polar_lobe(f, std::f64::consts::FRAC_PI_2, lobe, cuts, accuracy)
 }
 
 /// The frame about +z.
