@@ -419,18 +419,7 @@ fn ks_marginal_values_block_is_scalar_and_near_atan2() {
             assert_eq!(b.to_bits(), scalar.to_bits(), "{marginal:?} {m:?}");
             let glibc = match marginal {
                 Marginal::CosTheta => m[0].hypot(m[1]).atan2(m[2]),
-                Marginal::Phi => {
-                    let phi = m[1].atan2(m[0]);
-                    if m[0] == 0.0 && m[1] == 0.0 {
-                        0.0
-                    } else if phi >= 0.0 {
-                        phi
-                    } else if phi + TAU < TAU {
-                        phi + TAU
-                    } else {
-                        0.0
-                    }
-                }
+                Marginal::Phi => azimuth(m, m[1].atan2(m[0])),
             };
             assert!(
                 (b - glibc).abs() <= 4.0 * f64::EPSILON * glibc.abs().max(f64::MIN_POSITIVE),
