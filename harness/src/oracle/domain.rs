@@ -325,9 +325,13 @@ impl CellFinder {
                     -1.0
                 };
             }
-            // −1 or an integer in [0, 2³¹): the conversion is exact.
+            // −1 or an integer in [0, 2³¹), converted exactly by adding 1.5·2⁵² (the sum's
+            // low mantissa bits are then the integer, two's complement for −1): integer lanes,
+            // where Rust's saturating `as` conversion (NaN → 0) is done lane by lane, which
+            // made this loop a quarter of the pass under AVX-512. −1 becomes usize::MAX.
+            const MAGIC: f64 = 6_755_399_441_055_744.0;
             for (cell, &found) in cells.iter_mut().zip(&found[..n]) {
-                *cell = found as i32 as usize;
+                *cell = ((found + MAGIC).to_bits() as i64 - MAGIC.to_bits() as i64) as usize;
             }
             if found[..n].iter().fold(true, |all, &f| all & (f >= 0.0)) {
                 continue;
