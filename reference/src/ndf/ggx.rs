@@ -141,26 +141,82 @@ impl VisibleNormalSampler for Ggx {
     ///
     /// Exact (the density is `pdf_wm_visible`) for every α and wi_z > 0; NaN outside the domain.
     fn sample_wm_visible(&self, wi: Vec3, u: [f64; 2]) -> Vec3 {
-        if !visible_domain(wi) {
-            return [f64::NAN; 3];
+        match VisibleFrame::new(self.alpha_x, self.alpha_y, wi) {
+            Some(frame) => {
+                let (sp, cp) = crate::geometry::sin_cos_turns(u[1]);
+                frame.normal(u[0].sqrt(), sp, cp)
+            }
+            None => [f64::NAN; 3],
         }
-        let vh = normalize([self.alpha_x * wi[0], self.alpha_y * wi[1], wi[2]]);
+    }
+
+    /// `sample_wm_visible` over a batch at one incidence, vectorized (the frame once, then
+    /// √u₀, the sine and cosine of 2πu₁ and the lift in straight-line blocks); bit for bit the
+    /// scalar result (`ndf::batch`).
+    fn sample_wm_visible_batch(&self, wi: Vec3, u: &[[f64; 2]], out: &mut [Vec3]) {
+        assert_eq!(
+            u.len(),
+            out.len(),
+            "sample_wm_visible_batch: u and out differ in length"
+        );
+        match VisibleFrame::new(self.alpha_x, self.alpha_y, wi) {
+            Some(frame) => super::batch::sample_visible_batch(&frame, u, out, |u| {
+                self.sample_wm_visible(wi, u)
+            }),
+            None => out.fill([f64::NAN; 3]),
+        }
+    }
+}
+
+/// The part of Heitz's visible-normal sampler that depends only on the incidence (the
+/// stretched view V_h, its tangent frame T1, T2 and the warp s; the listing above), computed
+/// once per incidence by the scalar and the batch sampler alike.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct VisibleFrame {
+    alpha_x: f64,
+    alpha_y: f64,
+    vh: Vec3,
+    t1: Vec3,
+    t2: Vec3,
+    s: f64,
+}
+
+impl VisibleFrame {
+    /// The frame of incidence `wi`, or `None` outside the visible domain (non-unit, or at or
+    /// below the horizon).
+    pub(crate) fn new(alpha_x: f64, alpha_y: f64, wi: Vec3) -> Option<Self> {
+        if !visible_domain(wi) {
+            return None;
+        }
+        let vh = normalize([alpha_x * wi[0], alpha_y * wi[1], wi[2]]);
         let lensq = vh[0] * vh[0] + vh[1] * vh[1];
-        let t1v = if lensq > 0.0 {
+        let t1 = if lensq > 0.0 {
             let inv = 1.0 / lensq.sqrt();
             [-vh[1] * inv, vh[0] * inv, 0.0]
         } else {
             [1.0, 0.0, 0.0]
         };
-        let t2v = [
-            vh[1] * t1v[2] - vh[2] * t1v[1],
-            vh[2] * t1v[0] - vh[0] * t1v[2],
-            vh[0] * t1v[1] - vh[1] * t1v[0],
+        let t2 = [
+            vh[1] * t1[2] - vh[2] * t1[1],
+            vh[2] * t1[0] - vh[0] * t1[2],
+            vh[0] * t1[1] - vh[1] * t1[0],
         ];
-        let r = u[0].sqrt();
-        let (sp, cp) = crate::geometry::sin_cos_turns(u[1]);
+        Some(Self {
+            alpha_x,
+            alpha_y,
+            vh,
+            t1,
+            t2,
+            s: 0.5 * (1.0 + vh[2]),
+        })
+    }
+
+    /// The sampled normal from r = √u₀ and (sin, cos) of 2πu₁: the per-sample part of the
+    /// listing, without a branch (`max` and `sqrt` only), so that a loop over it vectorizes.
+    #[inline(always)]
+    pub(crate) fn normal(&self, r: f64, sp: f64, cp: f64) -> Vec3 {
+        let (vh, t1v, t2v, s) = (self.vh, self.t1, self.t2, self.s);
         let t1 = r * cp;
-        let s = 0.5 * (1.0 + vh[2]);
         let t2 = (1.0 - s) * (1.0 - t1 * t1).max(0.0).sqrt() + s * r * sp;
         let lift = (1.0 - t1 * t1 - t2 * t2).max(0.0).sqrt();
         let nh = [
@@ -173,6 +229,7 @@ impl VisibleNormalSampler for Ggx {
 }
 
 /// `v / |v|`.
+#[inline(always)]
 fn normalize(v: Vec3) -> Vec3 {
     let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     [v[0] / l, v[1] / l, v[2] / l]
