@@ -150,27 +150,62 @@ fn elliptic_loop(
     radius2_block: &impl Fn(&[f64], &mut [f64]),
     scalar: &impl Fn([f64; 2]) -> Vec3,
 ) {
-    let mut u0 = [0.0; BLOCK];
-    let mut u1 = [0.0; BLOCK];
-    let mut r = [0.0; BLOCK];
-    let mut s = [0.0; BLOCK];
-    let mut c = [0.0; BLOCK];
-    let mut fast = [false; BLOCK];
-    for (u, out) in u.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
-        let n = u.len();
-        for ((a, b), u) in u0.iter_mut().zip(u1.iter_mut()).zip(u) {
-            (*a, *b) = (u[0], u[1]);
-        }
-        radius2_block(&u1[..n], &mut r[..n]);
-        sin_cos_turns_block(&u0[..n], &mut s[..n], &mut c[..n]);
-        // Zipped slices of one length (no bounds checks, so the loop vectorizes); the normal
-        // goes back into (r, c, s) as (m_z, m_x, m_y) and is interleaved below.
-        for ((((r, s), c), fast), &u0) in r[..n]
+    let kernel = Elliptic {
+        sx,
+        sy,
+        radius2_block,
+    };
+    for_each_block(u, out, scalar, &kernel);
+}
+
+/// One block's computation for [`for_each_block`]: the normals' components of the pairs
+/// (u₀[i], u₁[i]) into (x, y, z), and whether each element is on the fast path. A trait with an
+/// `#[inline(always)]` method rather than a closure, which would be compiled for the baseline
+/// (without the dispatch target's features) unless the inliner chose to inline it: the
+/// closure form ran at half the speed under AVX-512.
+trait BlockKernel {
+    /// The computation; every slice has the block's length.
+    fn run(
+        &self,
+        u0: &[f64],
+        u1: &[f64],
+        x: &mut [f64],
+        y: &mut [f64],
+        z: &mut [f64],
+        fast: &mut [bool],
+    );
+}
+
+/// The elliptic samplers' block: squared slope radius, (cos, sin) 2πu₀ scaled by the axis
+/// scales, the normal of the slope.
+struct Elliptic<'a, R> {
+    sx: f64,
+    sy: f64,
+    radius2_block: &'a R,
+}
+
+impl<R: Fn(&[f64], &mut [f64])> BlockKernel for Elliptic<'_, R> {
+    #[inline(always)]
+    fn run(
+        &self,
+        u0: &[f64],
+        u1: &[f64],
+        x: &mut [f64],
+        y: &mut [f64],
+        z: &mut [f64],
+        fast: &mut [bool],
+    ) {
+        let (sx, sy) = (self.sx, self.sy);
+        // The squared slope radius into z, (sin, cos) 2πu₀ into (y, x).
+        (self.radius2_block)(u1, z);
+        sin_cos_turns_block(u0, y, x);
+        // Zipped slices of one length (no bounds checks, so the loop vectorizes).
+        for ((((c, s), r), fast), &u0) in x
             .iter_mut()
-            .zip(&mut s[..n])
-            .zip(&mut c[..n])
-            .zip(&mut fast[..n])
-            .zip(&u0[..n])
+            .zip(y.iter_mut())
+            .zip(z.iter_mut())
+            .zip(fast.iter_mut())
+            .zip(u0)
         {
             let radius = r.sqrt();
             // elliptic_direction, then normal_from_slopes' finite branch.
@@ -183,11 +218,70 @@ fn elliptic_loop(
             // m_y non-finite here or is flagged by u₀. (`&`, not `&&`: no branch.)
             *fast = (0.0..1.0).contains(&u0) & mx.is_finite() & my.is_finite();
         }
-        for (((m, &mx), &my), &mz) in out.iter_mut().zip(&c[..n]).zip(&s[..n]).zip(&r[..n]) {
+    }
+}
+
+/// GGX's visible-normal block: (sin, cos) 2πu₁, then [`VisibleFrame::normal`] at √u₀.
+struct Visible<'a>(&'a VisibleFrame);
+
+impl BlockKernel for Visible<'_> {
+    #[inline(always)]
+    fn run(
+        &self,
+        u0: &[f64],
+        u1: &[f64],
+        x: &mut [f64],
+        y: &mut [f64],
+        z: &mut [f64],
+        fast: &mut [bool],
+    ) {
+        // (sin, cos) 2πu₁ into (y, z), then the normal over them.
+        sin_cos_turns_block(u1, y, z);
+        for ((((x, s), c), fast), (&u0, &u1)) in x
+            .iter_mut()
+            .zip(y.iter_mut())
+            .zip(z.iter_mut())
+            .zip(fast.iter_mut())
+            .zip(u0.iter().zip(u1))
+        {
+            let m = self.0.normal(u0.sqrt(), *s, *c);
+            (*x, *s, *c) = (m[0], m[1], m[2]);
+            *fast = (0.0..1.0).contains(&u1);
+        }
+    }
+}
+
+/// The block structure both batch samplers share: per block of [`BLOCK`] pairs, u split into
+/// its components, the [`BlockKernel`] (straight-line loops writing the normals' components
+/// and whether each element is on the fast path), the components
+/// interleaved into `out`, and the elements off the fast path recomputed by `scalar` (rare:
+/// one predictable test per block, then the flagged elements).
+#[inline(always)]
+fn for_each_block(
+    u: &[[f64; 2]],
+    out: &mut [Vec3],
+    scalar: &impl Fn([f64; 2]) -> Vec3,
+    kernel: &impl BlockKernel,
+) {
+    let (mut u0, mut u1) = ([0.0; BLOCK], [0.0; BLOCK]);
+    let (mut x, mut y, mut z) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
+    let mut fast = [false; BLOCK];
+    for (u, out) in u.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+        let n = u.len();
+        for ((a, b), u) in u0.iter_mut().zip(u1.iter_mut()).zip(u) {
+            (*a, *b) = (u[0], u[1]);
+        }
+        kernel.run(
+            &u0[..n],
+            &u1[..n],
+            &mut x[..n],
+            &mut y[..n],
+            &mut z[..n],
+            &mut fast[..n],
+        );
+        for (((m, &mx), &my), &mz) in out.iter_mut().zip(&x[..n]).zip(&y[..n]).zip(&z[..n]) {
             *m = [mx, my, mz];
         }
-        // The other branches are rare (u₀ ∉ [0, 1), or u₁ = 1: never for the harness's
-        // uniforms in [0, 1)): one predictable test per block, then the flagged elements.
         if fast[..n].iter().fold(true, |all, &f| all & f) {
             continue;
         }
@@ -260,42 +354,7 @@ fn visible_loop(
     out: &mut [Vec3],
     scalar: &impl Fn([f64; 2]) -> Vec3,
 ) {
-    let mut u0 = [0.0; BLOCK];
-    let mut u1 = [0.0; BLOCK];
-    let mut s = [0.0; BLOCK];
-    let mut c = [0.0; BLOCK];
-    let mut x = [0.0; BLOCK];
-    let mut fast = [false; BLOCK];
-    for (u, out) in u.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
-        let n = u.len();
-        for ((a, b), u) in u0.iter_mut().zip(u1.iter_mut()).zip(u) {
-            (*a, *b) = (u[0], u[1]);
-        }
-        sin_cos_turns_block(&u1[..n], &mut s[..n], &mut c[..n]);
-        // The normal goes back into (x, s, c) as (m_x, m_y, m_z), interleaved below.
-        for ((((x, s), c), fast), (&u0, &u1)) in x[..n]
-            .iter_mut()
-            .zip(&mut s[..n])
-            .zip(&mut c[..n])
-            .zip(&mut fast[..n])
-            .zip(u0[..n].iter().zip(&u1[..n]))
-        {
-            let m = frame.normal(u0.sqrt(), *s, *c);
-            (*x, *s, *c) = (m[0], m[1], m[2]);
-            *fast = (0.0..1.0).contains(&u1);
-        }
-        for (((m, &mx), &my), &mz) in out.iter_mut().zip(&x[..n]).zip(&s[..n]).zip(&c[..n]) {
-            *m = [mx, my, mz];
-        }
-        if fast[..n].iter().fold(true, |all, &f| all & f) {
-            continue;
-        }
-        for ((m, &fast), &u) in out.iter_mut().zip(&fast[..n]).zip(u) {
-            if !fast {
-                *m = scalar(u);
-            }
-        }
-    }
+    for_each_block(u, out, scalar, &Visible(frame));
 }
 
 #[cfg(test)]
