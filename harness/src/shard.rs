@@ -22,6 +22,7 @@ use crate::plan::plan;
 use crate::record::SCHEMA_VERSION;
 use crate::scene::Scene;
 use crate::tolerance::STATISTICAL_ALPHA;
+use mfh_reference::registry::SamplerCost;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -85,40 +86,78 @@ pub struct ShardInfo {
     pub unsharded_command: String,
 }
 
-/// The estimated cost of a planned check, in seconds on one core — a model, not a
+/// The estimated cost of a planned check, in seconds of audit wall time — a model, not a
 /// measurement, used only to balance shards (a wrong estimate unbalances them; it cannot
-/// change a record):
-/// - sampling checks draw the profile's samples at ~0.1 µs each (`sampling.chi2*`: chi-square
-///   samples plus ~0.2 s of expected-count cubature; `sampling.ks_marginals`, the Monte Carlo
-///   Λ and the pseudo-VNIS bias: the profile's KS samples); slow samplers
-///   (the registry's `slow_sampler` families, ~30 µs a sample) cost 300× a sample;
-/// - quadrature-heavy checks (`precise.*`, `smith.*`, `ds.*`, errata demonstrations, claims)
-///   0.05 s; everything else 0.01 s.
+/// change a record). Fitted to the records of the default scene's thorough audit on a 2-core
+/// Zen 4 (2026-12-02), whose sampling checks are nine tenths of its time:
+/// - a sampling check costs its sample count (the case's `samples`, else the profile's) times
+///   the family's measured cost per sample (the registry's [`SamplerCost`]: 11 ns for GGX's
+///   normals, 634 ns for Beckmann's visible normals, 568 ns for the piecewise-linear sampler)
+///   plus what the check adds per sample: the KS tests' sort and CDF table 70 ns, the Monte
+///   Carlo Λ 10 ns, the pseudo-VNIS bias (a Λ per sample) 250 ns, its chi-square 25 ns; the
+///   chi-square checks add 0.2 s of expected-count cubature;
+/// - quadrature-heavy checks (`precise.*`, `smith.*`, `ds.*`, `sg.*`, `normalization.*`,
+///   errata demonstrations, claims) 0.05 s; everything else 0.01 s.
+///
+/// A family outside the registry (a user's model) is taken at [`UNKNOWN_SAMPLER`]. Splitting
+/// the default scene's plan into 4 shards by these estimates and summing its records' measured
+/// costs per shard, the longest shard is 1.09× the ideal (total / 4) for the thorough, standard
+/// and ci profiles alike (1.05× for ci); the previous model (one per-sample cost for every
+/// family, 300× for the slow sampler, the KS sample count for the Monte Carlo Λ) gave 1.74×,
+/// 1.38× and 1.23×.
 pub fn estimated_cost(planned: &PlannedCheck<'_>, profile: Profile) -> f64 {
     let family = planned
         .model
         .get("family")
         .and_then(|f| f.as_str())
         .unwrap_or("");
-    let slow = mfh_reference::registry::by_name(family).is_some_and(|f| f.slow_sampler);
-    let per_sample = if slow { 3e-5 } else { 1e-7 };
+    let info = mfh_reference::registry::by_name(family);
+    let slow = info.is_some_and(|f| f.slow_sampler);
+    let cost = info.map_or(UNKNOWN_SAMPLER, |f| f.sampler_cost);
     let id = planned.check.as_str();
-    if id.starts_with("sampling.chi2") {
-        0.2 + profile.chi2_samples() as f64 * per_sample
-    } else if id.starts_with("sampling.") && planned.statistical
-        || id == "sampling.lambda_monte_carlo"
-        || id == "sampling.pseudo_vnis"
-    {
-        profile.ks_samples(slow) as f64 * per_sample
-    } else if ["precise.", "smith.", "ds.", "errata.", "claims."]
+    let samples = |default: u64| {
+        planned
+            .case
+            .get("samples")
+            .and_then(|n| n.as_u64())
+            .unwrap_or(default) as f64
+    };
+    const NS: f64 = 1e-9;
+    match id {
+        "sampling.chi2" => 0.2 + samples(profile.chi2_samples()) * cost.normal_ns * NS,
+        "sampling.chi2_visible" => 0.2 + samples(profile.chi2_samples()) * cost.visible_ns * NS,
+        "sampling.chi2_pseudo_vnis" => {
+            0.2 + samples(profile.chi2_samples()) * (cost.normal_ns + 25.0) * NS
+        }
+        "sampling.ks_marginals" => samples(profile.ks_samples(slow)) * (cost.normal_ns + 70.0) * NS,
+        "sampling.lambda_monte_carlo" => {
+            samples(profile.ks_samples(slow)) * (cost.normal_ns + 10.0) * NS
+        }
+        "sampling.pseudo_vnis" => samples(profile.ks_samples(slow)) * (cost.normal_ns + 250.0) * NS,
+        _ if [
+            "precise.",
+            "smith.",
+            "ds.",
+            "sg.",
+            "normalization.",
+            "errata.",
+            "claims.",
+        ]
         .iter()
-        .any(|p| id.starts_with(p))
-    {
-        0.05
-    } else {
-        0.01
+        .any(|p| id.starts_with(p)) =>
+        {
+            0.05
+        }
+        _ => 0.01,
     }
 }
+
+/// The sampler cost assumed for a family the registry does not know (a user's model): that
+/// of the Student family's closed-form samplers, ~50 ns a sample.
+pub const UNKNOWN_SAMPLER: SamplerCost = SamplerCost {
+    normal_ns: 50.0,
+    visible_ns: 50.0,
+};
 
 /// The shard (0-based) of every planned check, by the greedy of the module doc.
 pub fn assign(plan: &[Planned], profile: Profile, count: usize) -> Vec<usize> {
@@ -223,6 +262,34 @@ mod tests {
             let e = bad.parse::<ShardSpec>().unwrap_err();
             assert!(e.contains("1 ≤ i ≤ n ≤ 10000"), "{bad}: {e}");
         }
+    }
+
+    /// The estimates follow the registry's sampler costs and the case's sample count: in the
+    /// default scene's thorough plan, Beckmann's visible chi-square (634 ns a sample) is
+    /// estimated 45× GGX's (14 ns), and the piecewise Monte Carlo Λ at its own 10⁸ samples (not
+    /// the KS checks' 10⁶ for a slow sampler).
+    #[test]
+    fn estimates_follow_the_registry_costs_and_the_sample_counts() {
+        let planned = plan(&Scene::default_scene(), Profile::Thorough);
+        let cost_of = |check: &str, family: &str| {
+            let costs: Vec<f64> = planned
+                .iter()
+                .filter(|p| p.check == check && p.model["family"] == family)
+                .map(|p| estimated_cost(p, Profile::Thorough))
+                .collect();
+            assert!(!costs.is_empty(), "no {check} for {family}");
+            costs[0]
+        };
+        let near = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b;
+        let beckmann = cost_of("sampling.chi2_visible", "beckmann");
+        let ggx = cost_of("sampling.chi2_visible", "ggx");
+        assert!(near(beckmann, 0.2 + 1e8 * 634e-9), "{beckmann}");
+        assert!(near(ggx, 0.2 + 1e8 * 14e-9), "{ggx}");
+        let mc = cost_of("sampling.lambda_monte_carlo", "piecewise_linear");
+        assert!(near(mc, 1e8 * 578e-9), "{mc}");
+        let ks = cost_of("sampling.ks_marginals", "piecewise_linear");
+        assert!(near(ks, 1e6 * 638e-9), "{ks}");
+        assert!(near(cost_of("smith.white_furnace", "ggx"), 0.05));
     }
 
     #[test]

@@ -34,9 +34,12 @@ pub struct FamilyInfo {
     /// Whether the default Λ is itself a numerical integral (its tolerance is the numerical
     /// route's, not the closed form's).
     pub lambda_numerical: bool,
-    /// Whether `sample_wm` inverts a CDF numerically (tens of µs a sample): statistical checks
-    /// that scale with the sample count take fewer samples.
+    /// Whether `sample_wm` inverts a CDF numerically (an iteration with libm calls per sample,
+    /// ~0.6 µs against 0.01–0.1 µs for the closed-form samplers): the KS checks take fewer
+    /// samples.
     pub slow_sampler: bool,
+    /// What the family's samplers cost, for balancing `mfh audit --shard` only.
+    pub sampler_cost: SamplerCost,
     /// Whether the family tends to Beckmann as γ → ∞ (seed 001 §4), which the limit check
     /// measures.
     pub beckmann_limit: bool,
@@ -53,6 +56,25 @@ pub struct FamilyInfo {
     /// with a mean, seed 002).
     pub mean_slope: fn(&ModelSpec) -> [f64; 2],
 }
+
+/// The measured cost of a family's samplers in an audit: wall-clock nanoseconds per sample of
+/// its 10⁸-sample chi-square checks in the default scene's thorough audit (sampling and binning
+/// on 2 cores while the audit runs other checks beside them; AMD EPYC Zen 4, 2026-12-02). Used
+/// only to balance shards (`harness/src/shard.rs`): a wrong figure unbalances them, it cannot
+/// change a record.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SamplerCost {
+    /// `sample_wm` (`sampling.chi2`); 0 where the family has no normal sampler.
+    pub normal_ns: f64,
+    /// `sample_wm_visible` (`sampling.chi2_visible`); 0 where the family has none.
+    pub visible_ns: f64,
+}
+
+/// No sampler.
+pub const NO_SAMPLER: SamplerCost = SamplerCost {
+    normal_ns: 0.0,
+    visible_ns: 0.0,
+};
 
 /// No tail exponent.
 pub fn no_tail(_: &ModelSpec) -> Option<f64> {
@@ -155,6 +177,24 @@ mod tests {
             assert!(names.insert(f.name), "{} twice", f.name);
             assert!(!f.examples.is_empty(), "{} has no example", f.name);
             assert!(!f.documents.is_empty(), "{} cites no document", f.name);
+            // A sampler cost where, and only where, the family has the sampler (shards are
+            // balanced by it).
+            let example: ModelSpec = serde_json::from_str(f.examples[0]).expect("example");
+            let model = example.build().expect("example builds");
+            assert_eq!(
+                model.as_sampler().is_some(),
+                f.sampler_cost.normal_ns > 0.0,
+                "{}: normal sampler cost {:?}",
+                f.name,
+                f.sampler_cost
+            );
+            assert_eq!(
+                model.as_visible_sampler().is_some(),
+                f.sampler_cost.visible_ns > 0.0,
+                "{}: visible sampler cost {:?}",
+                f.name,
+                f.sampler_cost
+            );
             for e in f
                 .examples
                 .iter()

@@ -194,6 +194,7 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     stress_specs: &[],
     lambda_numerical: true,
     slow_sampler: false,
+    sampler_cost: crate::registry::NO_SAMPLER,
     beckmann_limit: false,
     intrinsic_moments: false,
     tail_exponent: crate::registry::no_tail,

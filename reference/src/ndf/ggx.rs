@@ -306,6 +306,10 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     stress_specs: &[],
     lambda_numerical: false,
     slow_sampler: false,
+    sampler_cost: crate::registry::SamplerCost {
+        normal_ns: 11.0,
+        visible_ns: 14.0,
+    },
     beckmann_limit: false,
     intrinsic_moments: false,
     tail_exponent: crate::registry::no_tail,

@@ -353,6 +353,10 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     stress_specs: &[],
     lambda_numerical: true,
     slow_sampler: false,
+    sampler_cost: crate::registry::SamplerCost {
+        normal_ns: 84.0,
+        visible_ns: 0.0,
+    },
     beckmann_limit: false,
     intrinsic_moments: false,
     tail_exponent: crate::registry::no_tail,

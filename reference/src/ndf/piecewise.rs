@@ -696,6 +696,10 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     stress_specs: &[],
     lambda_numerical: true,
     slow_sampler: true,
+    sampler_cost: crate::registry::SamplerCost {
+        normal_ns: 568.0,
+        visible_ns: 0.0,
+    },
     beckmann_limit: false,
     intrinsic_moments: false,
     tail_exponent: crate::registry::no_tail,

@@ -464,6 +464,10 @@ pub const STD_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     stress_specs: &[],
     lambda_numerical: false,
     slow_sampler: false,
+    sampler_cost: crate::registry::SamplerCost {
+        normal_ns: 44.6,
+        visible_ns: 0.0,
+    },
     beckmann_limit: true,
     intrinsic_moments: false,
     tail_exponent: student_tail_exponent,
@@ -483,6 +487,10 @@ pub const HYPER_CAUCHY_INFO: crate::registry::FamilyInfo = crate::registry::Fami
     stress_specs: &[],
     lambda_numerical: false,
     slow_sampler: false,
+    sampler_cost: crate::registry::SamplerCost {
+        normal_ns: 46.1,
+        visible_ns: 0.0,
+    },
     beckmann_limit: false,
     intrinsic_moments: false,
     tail_exponent: student_tail_exponent,
@@ -502,6 +510,10 @@ pub const FIXED_VARIANCE_INFO: crate::registry::FamilyInfo = crate::registry::Fa
     stress_specs: &[],
     lambda_numerical: false,
     slow_sampler: false,
+    sampler_cost: crate::registry::SamplerCost {
+        normal_ns: 42.3,
+        visible_ns: 0.0,
+    },
     beckmann_limit: false,
     intrinsic_moments: false,
     tail_exponent: student_tail_exponent,
@@ -521,6 +533,10 @@ pub const GENERAL_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInf
     stress_specs: &[],
     lambda_numerical: false,
     slow_sampler: false,
+    sampler_cost: crate::registry::SamplerCost {
+        normal_ns: 43.3,
+        visible_ns: 0.0,
+    },
     beckmann_limit: false,
     intrinsic_moments: false,
     tail_exponent: student_tail_exponent,

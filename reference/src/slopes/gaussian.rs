@@ -634,6 +634,7 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     )],
     lambda_numerical: false,
     slow_sampler: false,
+    sampler_cost: crate::registry::NO_SAMPLER,
     beckmann_limit: false,
     intrinsic_moments: true,
     tail_exponent: crate::registry::no_tail,
