@@ -284,10 +284,7 @@ pub fn run_plan(
 ) -> (Vec<CheckRecord>, usize, f64) {
     let trace = std::env::var_os("MFH_TRACE").is_some();
     let (done, failures) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    let costs: Vec<f64> = plan
-        .iter()
-        .map(|p| crate::shard::estimated_cost(p, options.profile))
-        .collect();
+    let costs: Vec<f64> = plan.iter().map(crate::shard::estimated_cost).collect();
     let mut order: Vec<usize> = (0..plan.len()).collect();
     order.sort_by(|&a, &b| costs[b].total_cmp(&costs[a]));
     let next = AtomicUsize::new(0);

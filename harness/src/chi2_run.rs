@@ -4,7 +4,7 @@
 //! CLI (`cli/chi2.rs`) maps errors to exit codes and writes tables and heat maps.
 
 use crate::oracle::chi2::{
-    chi2_test_batch_cut, chi2_test_batch_in, Chi2Config, Chi2Result, CELL_RELATIVE_TOLERANCE,
+    chi2_test_batch_in, Chi2Config, Chi2Result, CELL_RELATIVE_TOLERANCE,
     KINKED_CELL_RELATIVE_TOLERANCE, MIN_EXPECTED,
 };
 use mfh_reference::{Model, ModelSpec, Vec3};
@@ -294,6 +294,7 @@ pub fn run(plan: &Chi2Plan, progress: Option<Arc<AtomicU64>>) -> Chi2Result {
                 &plan.config,
                 KINKED_CELL_RELATIVE_TOLERANCE,
                 None,
+                &[],
             )
         }
         _ => {
@@ -304,7 +305,7 @@ pub fn run(plan: &Chi2Plan, progress: Option<Arc<AtomicU64>>) -> Chi2Result {
             // Cut at the registry's kinks, as the audit's `sampling.chi2` does (the piecewise
             // material of the default scene: 15.4 s for the expected masses at R = 71 with its
             // breakpoints inside the cells).
-            chi2_test_batch_cut(
+            chi2_test_batch_in(
                 &|u: &[[f64; 2]], m: &mut [Vec3]| {
                     count(&progress, u.len());
                     s.sample_wm_batch(u, m)

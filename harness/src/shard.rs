@@ -4,8 +4,9 @@
 //!
 //! Partition: longest-processing-time-first greedy over [`estimated_cost`] — checks sorted by
 //! decreasing estimated cost (ties: plan order), each to the shard with the least estimated
-//! load so far (ties: the lowest shard). It depends only on the plan, the profile and n, so
-//! every machine computes the same partition without talking to the others. Per-check seeds
+//! load so far (ties: the lowest shard). It depends only on the plan (whose cases carry the
+//! profile's sample counts) and n, so every machine computes the same partition without
+//! talking to the others. Per-check seeds
 //! do not depend on plan order ([`crate::audit::check_seed`]), so a check's record is the same
 //! whichever shard runs it.
 //!
@@ -16,7 +17,7 @@
 use crate::audit::{
     fnv1a, judge_at, reproduce_command, run_plan, summarize, AuditOptions, AuditReport,
 };
-use crate::check::{Planned, PlannedCheck, Profile};
+use crate::check::{Planned, PlannedCheck};
 use crate::oracle::chi2::sidak_alpha;
 use crate::plan::plan;
 use crate::record::SCHEMA_VERSION;
@@ -90,7 +91,7 @@ pub struct ShardInfo {
 /// measurement, used only to balance shards (a wrong estimate unbalances them; it cannot
 /// change a record). Fitted to the records of the default scene's thorough audit on a 2-core
 /// Zen 4 (2026-12-02), whose sampling checks are nine tenths of its time:
-/// - a sampling check costs its sample count (the case's `samples`, else the profile's) times
+/// - a sampling check costs its sample count (its case's `samples`) times
 ///   the family's measured cost per sample (the registry's [`SamplerCost`]: 11 ns for GGX's
 ///   normals, 634 ns for Beckmann's visible normals, 568 ns for the piecewise-linear sampler)
 ///   plus what the check adds per sample: the KS tests' sort and CDF table 70 ns, the Monte
@@ -105,35 +106,28 @@ pub struct ShardInfo {
 /// and ci profiles alike (1.05× for ci); the previous model (one per-sample cost for every
 /// family, 300× for the slow sampler, the KS sample count for the Monte Carlo Λ) gave 1.74×,
 /// 1.38× and 1.23×.
-pub fn estimated_cost(planned: &PlannedCheck<'_>, profile: Profile) -> f64 {
+pub fn estimated_cost(planned: &PlannedCheck<'_>) -> f64 {
     let family = planned
         .model
         .get("family")
         .and_then(|f| f.as_str())
         .unwrap_or("");
-    let info = mfh_reference::registry::by_name(family);
-    let slow = info.is_some_and(|f| f.slow_sampler);
-    let cost = info.map_or(UNKNOWN_SAMPLER, |f| f.sampler_cost);
+    let cost = mfh_reference::registry::by_name(family).map_or(UNKNOWN_SAMPLER, |f| f.sampler_cost);
     let id = planned.check.as_str();
-    let samples = |default: u64| {
-        planned
-            .case
-            .get("samples")
-            .and_then(|n| n.as_u64())
-            .unwrap_or(default) as f64
-    };
-    const NS: f64 = 1e-9;
-    match id {
-        "sampling.chi2" => 0.2 + samples(profile.chi2_samples()) * cost.normal_ns * NS,
-        "sampling.chi2_visible" => 0.2 + samples(profile.chi2_samples()) * cost.visible_ns * NS,
-        "sampling.chi2_pseudo_vnis" => {
-            0.2 + samples(profile.chi2_samples()) * (cost.normal_ns + 25.0) * NS
-        }
-        "sampling.ks_marginals" => samples(profile.ks_samples(slow)) * (cost.normal_ns + 70.0) * NS,
-        "sampling.lambda_monte_carlo" => {
-            samples(profile.ks_samples(slow)) * (cost.normal_ns + 10.0) * NS
-        }
-        "sampling.pseudo_vnis" => samples(profile.ks_samples(slow)) * (cost.normal_ns + 250.0) * NS,
+    // Every sampling check states its sample count in its case (the test
+    // `every_sampling_check_states_its_samples`).
+    let samples = planned
+        .case
+        .get("samples")
+        .and_then(|n| n.as_u64())
+        .unwrap_or(0) as f64;
+    let per_sample_ns = match id {
+        "sampling.chi2" => cost.normal_ns,
+        "sampling.chi2_visible" => cost.visible_ns,
+        "sampling.chi2_pseudo_vnis" => cost.normal_ns + 25.0,
+        "sampling.ks_marginals" => cost.normal_ns + 70.0,
+        "sampling.lambda_monte_carlo" => cost.normal_ns + 10.0,
+        "sampling.pseudo_vnis" => cost.normal_ns + 250.0,
         _ if [
             "precise.",
             "smith.",
@@ -146,10 +140,16 @@ pub fn estimated_cost(planned: &PlannedCheck<'_>, profile: Profile) -> f64 {
         .iter()
         .any(|p| id.starts_with(p)) =>
         {
-            0.05
+            return 0.05;
         }
-        _ => 0.01,
-    }
+        _ => return 0.01,
+    };
+    let cubature = if id.starts_with("sampling.chi2") {
+        0.2
+    } else {
+        0.0
+    };
+    cubature + samples * per_sample_ns * 1e-9
 }
 
 /// The sampler cost assumed for a family the registry does not know (a user's model): that
@@ -160,8 +160,8 @@ pub const UNKNOWN_SAMPLER: SamplerCost = SamplerCost {
 };
 
 /// The shard (0-based) of every planned check, by the greedy of the module doc.
-pub fn assign(plan: &[Planned], profile: Profile, count: usize) -> Vec<usize> {
-    let costs: Vec<f64> = plan.iter().map(|p| estimated_cost(p, profile)).collect();
+pub fn assign(plan: &[Planned], count: usize) -> Vec<usize> {
+    let costs: Vec<f64> = plan.iter().map(estimated_cost).collect();
     let mut order: Vec<usize> = (0..plan.len()).collect();
     order.sort_by(|&a, &b| costs[b].total_cmp(&costs[a]).then(a.cmp(&b)));
     let mut load = vec![0.0f64; count.max(1)];
@@ -208,13 +208,13 @@ pub fn audit_shard(
     let plan_checks = planned.len();
     let planned_statistical = planned.iter().filter(|p| p.statistical).count();
     let plan_fingerprint = fingerprint(&planned);
-    let shard_of = assign(&planned, options.profile, spec.count);
+    let shard_of = assign(&planned, spec.count);
     let mut estimated_seconds = 0.0;
     let mut indices = Vec::new();
     let mut mine = Vec::new();
     for (i, p) in planned.into_iter().enumerate() {
         if shard_of[i] == spec.index - 1 {
-            estimated_seconds += estimated_cost(&p, options.profile);
+            estimated_seconds += estimated_cost(&p);
             indices.push(i);
             mine.push(p);
         }
@@ -251,6 +251,7 @@ pub fn audit_shard(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check::Profile;
 
     #[test]
     fn shard_specs_parse_and_refuse_with_the_limit() {
@@ -275,7 +276,7 @@ mod tests {
             let costs: Vec<f64> = planned
                 .iter()
                 .filter(|p| p.check == check && p.model["family"] == family)
-                .map(|p| estimated_cost(p, Profile::Thorough))
+                .map(estimated_cost)
                 .collect();
             assert!(!costs.is_empty(), "no {check} for {family}");
             costs[0]
@@ -292,23 +293,56 @@ mod tests {
         assert!(near(cost_of("smith.white_furnace", "ggx"), 0.05));
     }
 
+    /// The cost model reads a sampling check's sample count from its case: every sampling
+    /// check that draws samples states them, in every profile's plan of the default scene.
+    #[test]
+    fn every_sampling_check_states_its_samples() {
+        for profile in [
+            Profile::Ci,
+            Profile::Quick,
+            Profile::Standard,
+            Profile::Thorough,
+        ] {
+            for p in plan(&Scene::default_scene(), profile) {
+                let draws = [
+                    "sampling.chi2",
+                    "sampling.chi2_visible",
+                    "sampling.chi2_pseudo_vnis",
+                    "sampling.ks_marginals",
+                    "sampling.lambda_monte_carlo",
+                    "sampling.pseudo_vnis",
+                ]
+                .contains(&p.check.as_str());
+                if draws {
+                    assert!(
+                        p.case.get("samples").and_then(|n| n.as_u64()) > Some(0),
+                        "{profile:?} {} {}: {}",
+                        p.check,
+                        p.model,
+                        p.case
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn the_partition_covers_the_plan_once_and_balances_estimated_cost() {
         let scene = Scene::default_scene();
         let planned = plan(&scene, Profile::Quick);
         for n in [1, 3, 7] {
-            let shard = assign(&planned, Profile::Quick, n);
-            assert_eq!(shard, assign(&planned, Profile::Quick, n), "deterministic");
+            let shard = assign(&planned, n);
+            assert_eq!(shard, assign(&planned, n), "deterministic");
             let mut load = vec![0.0; n];
             for (i, p) in planned.iter().enumerate() {
                 assert!(shard[i] < n);
-                load[shard[i]] += estimated_cost(p, Profile::Quick);
+                load[shard[i]] += estimated_cost(p);
             }
             let total: f64 = load.iter().sum();
             let max = load.iter().cloned().fold(0.0, f64::max);
             let biggest = planned
                 .iter()
-                .map(|p| estimated_cost(p, Profile::Quick))
+                .map(|p| estimated_cost(p))
                 .fold(0.0, f64::max);
             // LPT: the heaviest shard is within one check of the mean.
             assert!(

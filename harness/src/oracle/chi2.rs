@@ -332,19 +332,12 @@ pub fn expected_mass<P>(pdf: &P, grid: HemisphereGrid) -> Expected
 where
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
-    expected_mass_to(pdf, grid, CELL_RELATIVE_TOLERANCE)
+    expected_mass_to(pdf, grid, CELL_RELATIVE_TOLERANCE, &[])
 }
 
-/// [`expected_mass`] with the per-cell relative tolerance `relative`.
-pub fn expected_mass_to<P>(pdf: &P, grid: HemisphereGrid, relative: f64) -> Expected
-where
-    P: Fn(Vec3) -> f64 + Sync + ?Sized,
-{
-    expected_mass_cut(pdf, grid, relative, &[])
-}
-
-/// [`expected_mass_to`] with the cells also cut at `theta_kinks` (see [`expected_mass_in`]).
-pub fn expected_mass_cut<P>(
+/// [`expected_mass`] with the per-cell relative tolerance `relative` and the cells also cut at
+/// `theta_kinks` (see [`expected_mass_in`]).
+pub fn expected_mass_to<P>(
     pdf: &P,
     grid: HemisphereGrid,
     relative: f64,
@@ -595,29 +588,16 @@ where
         config,
         cell_relative,
         lobe,
+        &[],
     )
 }
 
 /// [`chi2_test_in`] with a batch sampler (`sample(u, m)` sets `m[i]` to the normal of `u[i]`,
-/// as [`observe_batch`] takes it): the same result as the scalar form of the sampler.
+/// as [`observe_batch`] takes it): the same result as the scalar form of the sampler. The cells
+/// are also cut at `theta_kinks`, the polar angles where the density has a kink for every
+/// azimuth (a reference model's registry knows them, as for [`chi2_test_batches_cut`]): the
+/// same masses to the same tolerance, without the cubature subdividing the kinks.
 pub fn chi2_test_batch_in<S, P>(
-    sample: &S,
-    pdf: &P,
-    config: &Chi2Config,
-    cell_relative: f64,
-    lobe: Option<&Lobe>,
-) -> Chi2Result
-where
-    S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
-    P: Fn(Vec3) -> f64 + Sync + ?Sized,
-{
-    chi2_test_batch_cut(sample, pdf, config, cell_relative, lobe, &[])
-}
-
-/// [`chi2_test_batch_in`] with the cells also cut at `theta_kinks`, the polar angles where the
-/// density has a kink for every azimuth (as [`chi2_test_batches_cut`]): the same masses to the
-/// same tolerance, without the cubature subdividing the kinks.
-pub fn chi2_test_batch_cut<S, P>(
     sample: &S,
     pdf: &P,
     config: &Chi2Config,
@@ -634,7 +614,7 @@ where
         |grid| observe_batch(sample, grid, config.samples, config.seed),
         |grid| match lobe {
             Some(lobe) => expected_mass_in(pdf, grid, cell_relative, lobe, theta_kinks),
-            None => expected_mass_cut(pdf, grid, cell_relative, theta_kinks),
+            None => expected_mass_to(pdf, grid, cell_relative, theta_kinks),
         },
     )
 }
@@ -770,6 +750,7 @@ pub fn chi2_test_sampler(sampler: &dyn NormalSampler, config: &Chi2Config) -> Ch
         config,
         CELL_RELATIVE_TOLERANCE,
         None,
+        &[],
     )
 }
 

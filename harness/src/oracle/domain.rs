@@ -502,11 +502,8 @@ mod tests {
 
     #[test]
     fn cell_finder_agrees_with_atan2_binning() {
-        let mut state: u64 = 7;
-        let mut uniform = || {
-            state = crate::random::splitmix64(state);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::random::Stream::new(7, 0);
+        let mut uniform = || rng.uniform();
         for resolution in [1, 2, 3, 7, 64, 1000] {
             let grid = HemisphereGrid::new(resolution).unwrap();
             let finder = CellFinder::new(grid);
@@ -608,11 +605,8 @@ mod tests {
 
     #[test]
     fn cell_finder_matches_previous_finder_and_atan2_on_adversarial_directions() {
-        let mut state: u64 = 11;
-        let mut uniform = || {
-            state = crate::random::splitmix64(state);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::random::Stream::new(11, 0);
+        let mut uniform = || rng.uniform();
         // Debug text: errors carrying NaN compare unequal with ==.
         let same = |a: &Result<usize, DomainError>, b: &Result<usize, DomainError>| {
             format!("{a:?}") == format!("{b:?}")
@@ -765,11 +759,8 @@ mod tests {
     /// column margin (1e-4 rad) and the estimate's error (1.2e-5 rad) from every column edge.
     #[test]
     fn cells_of_is_the_same_on_the_dispatched_and_baseline_paths() {
-        let mut state: u64 = 13;
-        let mut uniform = || {
-            state = crate::random::splitmix64(state);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::random::Stream::new(13, 0);
+        let mut uniform = || rng.uniform();
         for resolution in [1, 2, 5, 64, 512] {
             let grid = HemisphereGrid::new(resolution).unwrap();
             let finder = CellFinder::new(grid);
@@ -804,11 +795,8 @@ mod tests {
 
     #[test]
     fn azimuth_estimate_is_within_its_stated_error() {
-        let mut state: u64 = 5;
-        let mut uniform = || {
-            state = crate::random::splitmix64(state);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::random::Stream::new(5, 0);
+        let mut uniform = || rng.uniform();
         let mut worst = 0.0f64;
         let mut directions: Vec<(f64, f64)> = (0..200_000)
             .map(|_| {

@@ -203,6 +203,7 @@ pub fn calibrate(
                     &config,
                     CELL_RELATIVE_TOLERANCE,
                     Some(&lobe),
+                    &kinks,
                 );
                 r.statistic.is_finite().then_some(r.p_value)
             })

@@ -1,7 +1,7 @@
 //! Batch forms of the reference normal samplers: GGX's visible-normal sampler
 //! ([`sample_visible_batch`]) and the elliptic normal samplers (GGX, Beckmann, Student), for
-//! which this module writes the steps every one of them shares — (cos 2πu₀, sin 2πu₀) scaled by the axis scales, times the slope radius, and
-//! the normal of the slope — written as straight-line loops over fixed blocks that the compiler
+//! which this module writes the steps every one of them shares — (cos 2πu₀, sin 2πu₀) scaled
+//! by the axis scales, times the slope radius, and the normal of the slope — written as straight-line loops over fixed blocks that the compiler
 //! vectorizes (no branch, no call per element; SSE2 two-lane f64 on the baseline x86-64 target,
 //! 4 or 8 lanes where the CPU has AVX2 or AVX-512, through `pulp`'s dispatch below).
 //!
@@ -97,65 +97,49 @@ fn sample_elliptic_batch_on<R, S>(
     R: Fn(&[f64], &mut [f64]),
     S: Fn([f64; 2]) -> Vec3,
 {
-    assert_eq!(
-        u.len(),
-        out.len(),
-        "sample_wm_batch: u and out differ in length"
-    );
-    /// The loop as a `pulp::WithSimd` operation: `with_simd` is instantiated once per
-    /// instruction set, with the loop inlined into it.
-    struct Op<'a, R, S> {
-        sx: f64,
-        sy: f64,
-        u: &'a [[f64; 2]],
-        out: &'a mut [Vec3],
-        radius2_block: R,
-        scalar: S,
-    }
-    impl<R, S> pulp::WithSimd for Op<'_, R, S>
-    where
-        R: Fn(&[f64], &mut [f64]),
-        S: Fn([f64; 2]) -> Vec3,
-    {
-        type Output = ();
-        #[inline(always)]
-        fn with_simd<Simd: pulp::Simd>(self, _simd: Simd) {
-            elliptic_loop(
-                self.sx,
-                self.sy,
-                self.u,
-                self.out,
-                &self.radius2_block,
-                &self.scalar,
-            )
-        }
-    }
-    arch.dispatch(Op {
-        sx,
-        sy,
-        u,
-        out,
-        radius2_block,
-        scalar,
-    })
-}
-
-/// The body of [`sample_elliptic_batch`], inlined into each dispatch target.
-#[inline(always)]
-fn elliptic_loop(
-    sx: f64,
-    sy: f64,
-    u: &[[f64; 2]],
-    out: &mut [Vec3],
-    radius2_block: &impl Fn(&[f64], &mut [f64]),
-    scalar: &impl Fn([f64; 2]) -> Vec3,
-) {
     let kernel = Elliptic {
         sx,
         sy,
-        radius2_block,
+        radius2_block: &radius2_block,
     };
-    for_each_block(u, out, scalar, &kernel);
+    dispatch_blocks(arch, "sample_wm_batch", u, out, &kernel, scalar)
+}
+
+/// [`for_each_block`] with `kernel` through `pulp::Arch::dispatch`: `with_simd` is
+/// instantiated once per instruction set, with the block loop and the kernel inlined into it.
+///
+/// # Panics
+/// If `u` and `out` differ in length (the message names `method`).
+#[inline(always)]
+fn dispatch_blocks<K: BlockKernel, S: Fn([f64; 2]) -> Vec3>(
+    arch: pulp::Arch,
+    method: &str,
+    u: &[[f64; 2]],
+    out: &mut [Vec3],
+    kernel: &K,
+    scalar: S,
+) {
+    assert_eq!(u.len(), out.len(), "{method}: u and out differ in length");
+    /// The loop as a `pulp::WithSimd` operation.
+    struct Op<'a, K, S> {
+        u: &'a [[f64; 2]],
+        out: &'a mut [Vec3],
+        kernel: &'a K,
+        scalar: S,
+    }
+    impl<K: BlockKernel, S: Fn([f64; 2]) -> Vec3> pulp::WithSimd for Op<'_, K, S> {
+        type Output = ();
+        #[inline(always)]
+        fn with_simd<Simd: pulp::Simd>(self, _simd: Simd) {
+            for_each_block(self.u, self.out, &self.scalar, self.kernel)
+        }
+    }
+    arch.dispatch(Op {
+        u,
+        out,
+        kernel,
+        scalar,
+    })
 }
 
 /// One block's computation for [`for_each_block`]: the normals' components of the pairs
@@ -253,8 +237,7 @@ impl BlockKernel for Visible<'_> {
 
 /// The block structure both batch samplers share: per block of [`BLOCK`] pairs, u split into
 /// its components, the [`BlockKernel`] (straight-line loops writing the normals' components
-/// and whether each element is on the fast path), the components
-/// interleaved into `out`, and the elements off the fast path recomputed by `scalar` (rare:
+/// and whether each element is on the fast path), the components interleaved into `out`, and the elements off the fast path recomputed by `scalar` (rare:
 /// one predictable test per block, then the flagged elements).
 #[inline(always)]
 fn for_each_block(
@@ -319,42 +302,14 @@ fn sample_visible_batch_on<S: Fn([f64; 2]) -> Vec3>(
     out: &mut [Vec3],
     scalar: S,
 ) {
-    assert_eq!(
-        u.len(),
-        out.len(),
-        "sample_wm_visible_batch: u and out differ in length"
-    );
-    /// The loop as a `pulp::WithSimd` operation, instantiated per instruction set.
-    struct Op<'a, S> {
-        frame: &'a VisibleFrame,
-        u: &'a [[f64; 2]],
-        out: &'a mut [Vec3],
-        scalar: S,
-    }
-    impl<S: Fn([f64; 2]) -> Vec3> pulp::WithSimd for Op<'_, S> {
-        type Output = ();
-        #[inline(always)]
-        fn with_simd<Simd: pulp::Simd>(self, _simd: Simd) {
-            visible_loop(self.frame, self.u, self.out, &self.scalar)
-        }
-    }
-    arch.dispatch(Op {
-        frame,
+    dispatch_blocks(
+        arch,
+        "sample_wm_visible_batch",
         u,
         out,
+        &Visible(frame),
         scalar,
-    })
-}
-
-/// The body of [`sample_visible_batch`], inlined into each dispatch target.
-#[inline(always)]
-fn visible_loop(
-    frame: &VisibleFrame,
-    u: &[[f64; 2]],
-    out: &mut [Vec3],
-    scalar: &impl Fn([f64; 2]) -> Vec3,
-) {
-    for_each_block(u, out, scalar, &Visible(frame));
+    )
 }
 
 #[cfg(test)]

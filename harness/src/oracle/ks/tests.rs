@@ -390,11 +390,8 @@ fn ks_sort_values_is_total_cmp_order() {
 /// (−1e-17 wraps to 0, not 2π), the horizon and near-pole radii where x² + y² underflows.
 #[test]
 fn ks_marginal_values_block_is_scalar_and_near_atan2() {
-    let mut state: u64 = 5;
-    let mut uniform = || {
-        state = crate::random::splitmix64(state);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = crate::random::Stream::new(5, 0);
+    let mut uniform = || rng.uniform();
     let mut m: Vec<Vec3> = (0..100_000)
         .map(|_| {
             let (phi, z) = (uniform() * TAU, uniform());
