@@ -5,8 +5,8 @@
 //! glibc's scalar `sincos`, and the KS test's marginal angles of millions of samples.
 //!
 //! **Method.** x = kπ/2 + y with k = round(2x/π) and y as an unevaluated sum y₀ + y₁ (|y₁| ≤
-//! ½ ulp(y₀) + 2e-21·|k|, far below |y₀| even at the doubles nearest kπ/2): π/2 is split as musl's `__rem_pio2` splits it, into P₁ + P₂ + P₃ + P₃ₜ with P₁,
-//! P₂, P₃ of 33 significant bits, so k·P₁, k·P₂ and k·P₃ are exact for |k| < 2²⁰; x − k·P₁ is
+//! ½ ulp(y₀) + 2e-21·|k|, far below |y₀| even at the doubles nearest kπ/2): π/2 is split as
+//! musl's `__rem_pio2` splits it, into P₁ + P₂ + P₃ + P₃ₜ with P₁, P₂, P₃ of 33 significant bits, so k·P₁, k·P₂ and k·P₃ are exact for |k| < 2²⁰; x − k·P₁ is
 //! exact (Sterbenz), the subtraction of k·P₂ is made exact by a TwoSum, and the rest is added
 //! to the low part: y is good to ~2⁻¹⁵⁰·|k| absolute, so even the doubles closest to a
 //! multiple of π/2 keep their relative accuracy. Then musl's kernels `__sin(y₀, y₁, 1)` and
