@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Samples per second through mfh's external protocol (README, "Audit an implementation in any
-language"), per example and protocol version: `mfh chi2 --cmd "python3 <example> --protocol P"`
+"""Samples per second through mfh's external protocol (docs/external-protocol.md; the last figures
+are in docs/performance.md), per example and protocol version: `mfh chi2 --cmd "python3 <example> --protocol P"`
 draws N samples in batches of 65 536 and reports sampling+binning samples/s; the bare child is
 timed on the same batches without mfh (request in, sample, answer out; the request is encoded
 once, the answer is read but not decoded) to show what the protocol costs the child.

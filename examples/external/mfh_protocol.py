@@ -3,7 +3,7 @@ its functions, `serve` does the rest (describe and version negotiation, decoding
 arrays, encoding the answers, one answer line per request line, shutdown). No dependencies;
 numpy only when `serve(..., numpy=True)`.
 
-Protocol (README, "Audit an implementation in any language"): one JSON object per line each
+Protocol (docs/external-protocol.md in the repository): one JSON object per line each
 way. mfh's `describe` request offers `"versions":[1,2]`; the answer's `"protocol"` chooses.
 - Version 1: arrays are JSON arrays, `[[x,y,z],...]` or `[[u1,u2],...]`.
 - Version 2: arrays are base64 (standard, padded) of little-endian float64, row-major, in the

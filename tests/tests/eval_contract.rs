@@ -429,12 +429,12 @@ fn the_issue_example_answers_the_library_lambda() {
     );
     // The exact text: one compact JSON object and a newline.
     assert_eq!(r.stdout, format!("{}\n", json!({ "value": lambda })));
-    // The README shows this very example with its answer.
-    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md"))
-        .expect("README.md");
+    // docs/eval.md shows this very example with its answer.
+    let page = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/eval.md"))
+        .expect("docs/eval.md");
     assert!(
-        readme.contains(&format!("echo '{line}' | mfh eval\n{}", r.stdout)),
-        "README.md's `mfh eval` example does not show today's answer {}",
+        page.contains(&format!("echo '{line}' | mfh eval\n{}", r.stdout)),
+        "docs/eval.md's `mfh eval` example does not show today's answer {}",
         r.stdout.trim()
     );
 }

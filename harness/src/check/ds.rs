@@ -320,7 +320,7 @@ mod dump {
     #[test]
     fn standard() {
         if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")");
+            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (docs/testing.md, \"The extensive tier\")");
             return;
         }
         let spec = ModelSpec::GaussianSlopes(mfh_reference::slopes::gaussian::GaussianSlopesSpec {

@@ -86,7 +86,7 @@ impl Profile {
             Profile::Quick => 200_000,
             Profile::Standard => 2_000_000,
             // 10⁸: a distortion √5 smaller than at 2·10⁷ is caught (issue 15's target: the
-            // default scene's thorough audit within 10 minutes on 2 cores; README, "Profiles").
+            // default scene's thorough audit within 10 minutes on 2 cores; docs/performance.md).
             Profile::Thorough => 100_000_000,
         }
     }
@@ -95,7 +95,7 @@ impl Profile {
     /// CDF numerically, ~30 µs a sample, a thousand times the closed-form samplers) gets a
     /// tenth. Quick's 2·10⁶ are sized by `mfh selftest --power`: the sampled tan²θ exponent
     /// off by 1 % (GGX, Beckmann, STD, Hyper-Cauchy, GTR) is caught at every one of 3 seeds,
-    /// where 2·10⁵ caught only 2 % (README, "Self-test"). Thorough stays at 10⁷ where its
+    /// where 2·10⁵ caught only 2 % (docs/selftest.md, "Last runs"). Thorough stays at 10⁷ where its
     /// chi-square draws 10⁸: the KS test holds and sorts every value (8 bytes each, 800 MB per
     /// record at 10⁸, two records at a time), its resolution 1/√N is already 3e-4, and at 10⁸
     /// the two KS records of every sampler would cost about as much as the rest of the audit.

@@ -99,8 +99,7 @@ pub enum Command {
     /// bad input.
     Audit(audit::AuditArgs),
     /// Audit an implementation in any language: start `--cmd` (with `sh -c`), speak the
-    /// external protocol with it over stdin / stdout (README, "Audit an implementation in any
-    /// language"), and run the checks its declared capabilities call for.
+    /// external protocol with it over stdin / stdout (docs/external-protocol.md), and run the checks its declared capabilities call for.
     ///
     /// Exit status 0 if every check passes, 1 if one fails (a protocol error during the audit
     /// is an `external.protocol` error record), 2 if the child cannot start or describe itself.

@@ -1,5 +1,5 @@
-//! The external protocol: JSON lines over a child's stdin / stdout (README, "Audit an
-//! implementation in any language"), in two versions that differ only in how arrays travel.
+//! The external protocol: JSON lines over a child's stdin / stdout (docs/external-protocol.md),
+//! in two versions that differ only in how arrays travel.
 //!
 //! Every request is one line `{"v":V,"id":N,"op":"…", …arrays…}`; every answer is one line
 //! carrying the same `id` and either the result (`values` or `m`) or `{"error":"…"}`. The
@@ -570,7 +570,7 @@ mod tests {
         assert!(Request::Shutdown
             .to_line(5, 2)
             .contains(r#""op":"shutdown""#));
-        // README's example line: u = (0.25, 0.5).
+        // The example line of docs/external-protocol.md: u = (0.25, 0.5).
         let line = Request::SampleWm { u: &[[0.25, 0.5]] }.to_line(3, 2);
         assert!(line.contains(r#""u":"AAAAAAAA0D8AAAAAAADgPw==""#), "{line}");
     }

@@ -799,7 +799,7 @@ mod accuracy_table {
     #[test]
     fn accuracy_table_gtr() {
         if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")");
+            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (docs/testing.md, \"The extensive tier\")");
             return;
         }
         let mut out = ReportTable::new("seed004");

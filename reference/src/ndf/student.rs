@@ -914,7 +914,7 @@ mod accuracy_table {
     #[test]
     fn accuracy_table() {
         if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")");
+            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (docs/testing.md, \"The extensive tier\")");
             return;
         }
         let gammas = [1.6, 2.0, 2.5, 3.0, 3.5, 4.0, 7.5, 20.0, 100.0, 1e4];

@@ -738,7 +738,7 @@ pub(crate) mod tests {
     fn convolution_l2_error_sweep() {
         // The extensive tier: the whole grid behind ERRATA.md, E5.
         if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")");
+            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (docs/testing.md, \"The extensive tier\")");
             return;
         }
         let pieces = [0.0, 0.25 * PI, FRAC_PI_2, 0.75 * PI, PI];

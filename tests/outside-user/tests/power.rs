@@ -1,5 +1,5 @@
 //! The power of `Profile::Ci`, measured: the smallest defects it catches, at several seeds.
-//! README states these figures; this test keeps them true.
+//! docs/gate.md ("What the ci profile catches") states these figures; this test keeps them true.
 
 use mfh_harness::model::{Ndf, NormalSampler, Vec3};
 use mfh_harness::{Audit, Profile};

@@ -83,7 +83,7 @@ mod dump {
     #[test]
     fn standard() {
         if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")");
+            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (docs/testing.md, \"The extensive tier\")");
             return;
         }
         let ctx = crate::check::RunContext { seed: 1 };
