@@ -1,5 +1,6 @@
 //! The one table of tolerances, each with its reason, and the table of expected failures (known
-//! errata and known numerical limits of printed routes), each with its reason (ARCHITECTURE.md, style 5).
+//! errata and known numerical limits of printed routes), each with its reason (ARCHITECTURE.md,
+//! "Tolerances and expected failures").
 //!
 //! The tolerances are here; the expected-failure types (`Bound`, `Domain`, `ExpectedFailure`)
 //! and their table are in `tolerance/expected.rs`, re-exported here.
