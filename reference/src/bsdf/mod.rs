@@ -63,6 +63,8 @@ pub mod microfacet;
 pub mod spec;
 
 #[cfg(test)]
+mod golden_tests;
+#[cfg(test)]
 mod tests;
 
 pub use conductor::Conductor;
