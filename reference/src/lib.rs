@@ -5,6 +5,7 @@
 //! see ARCHITECTURE.md). This crate holds closed forms only: no oracles, no I/O, no randomness.
 //! Every closed form is checked by the harness (`mfh-harness`) against independent oracles.
 
+pub mod bsdf;
 pub mod errata;
 pub mod error;
 pub mod geometry;
@@ -19,6 +20,7 @@ pub mod special;
 mod test_support;
 pub mod trig;
 
+pub use bsdf::{Bsdf, BsdfSample, BsdfSpec, Transport};
 pub use error::{ParamError, QueryError};
 pub use geometry::Vec3;
 pub use model::{

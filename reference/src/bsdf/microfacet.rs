@@ -1,0 +1,294 @@
+//! The microfacet part shared by the reference BSDFs: D, the Smith G1 and G2 of directions in
+//! either hemisphere, and the sampler of microfacet normals with its density.
+//!
+//! **Directions below the surface.** The NDF describes the normals m of the interface (m_z > 0,
+//! pointing outside). A direction w with w_z < 0 sees the same microsurface from below: flipping
+//! the height field (z → −z) turns it into a microsurface seen from above whose slopes are
+//! negated, so that its Λ at the flipped direction is the original Λ at −w. So every Λ and every
+//! visible-normal query here is made at
+//!
+//! ```text
+//! w⁺ = w if w_z > 0, −w if w_z < 0
+//! ```
+//!
+//! (the point reflection, which equals the mirror (w_x, w_y, −w_z) for the centrally symmetric
+//! NDFs — all elliptic ones — and is the right one for those with a mean slope). With it
+//! (Walter 2007 eq 23, and the Smith G1 and G2 of Heitz 2014, "Understanding the
+//! masking-shadowing function in microfacet-based BRDFs", JCGT 3(2), §5 and §6, as seed 001
+//! eq 16, 22 and 23 print them for reflection):
+//!
+//! ```text
+//! G1(w, m)         = χ⁺((w·m)/(w·n)) / (1 + Λ(w⁺))
+//! G2 uncorrelated  = G1(wi, m) G1(wo, m)              (Walter eq 23; seed 001 eq 22)
+//! G2 height-corr.  = χ⁺((wi·m)/(wi·n)) χ⁺((wo·m)/(wo·n)) / (1 + Λ(wi⁺) + Λ(wo⁺))
+//!                                                      (Heitz 2014 §6; seed 001 eq 23)
+//! ```
+//!
+//! The height-correlated form is used for refraction too, as pbrt-v4 does. Heitz 2014 §6.2
+//! derives a different height-correlated G2 for transmission, B(1 + Λ(wi⁺), 1 + Λ(wo⁺)) (the
+//! Beta function: one ray must escape above the facet's height, the other below); that form is
+//! not implemented here.
+//!
+//! **Sampling** of m, for an incidence `wi` from either side (the density is that of m; the
+//! BSDFs turn it into a density of wo by Walter's Jacobians):
+//!
+//! - [`Sampling::Normals`]: m ∼ D(m)(m·n) (the NDF's `sample_wm`; Walter §5.3); a sampled m with
+//!   wi⁺·m ≤ 0 (back-facing, which no refraction or reflection of wi can use) fails.
+//! - [`Sampling::VisibleNormals`]: m ∼ D_{wi⁺}(m) = G1(wi⁺, m)⟨wi⁺·m⟩ D(m)/(wi⁺·n) (Heitz &
+//!   d'Eon 2014, eq 2; the NDF's `sample_wm_visible` at wi⁺).
+//! - [`Sampling::PseudoVnis`]: seed 001 §7.2's pseudo-VNIS for the STD (Algorithm 1 picks GGX's
+//!   or Beckmann's visible normals, or the STD's own normals, with the STD's roughness;
+//!   `ndf::student_vnis`), with the density of the proxy it picked in closed form, so that the
+//!   BSDF's weight eval/pdf is unbiased (not eq 43's printed G2/G1, which assumes the STD's own
+//!   visible normals).
+
+use std::sync::Arc;
+
+use super::{finite, scale, BsdfError};
+use crate::geometry::{dot, Vec3};
+use crate::model::{Masking, Ndf};
+use crate::ndf::student_vnis::PseudoVnis;
+
+/// How a BSDF samples microfacet normals.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Sampling {
+    /// m ∼ D(m)(m·n).
+    Normals,
+    /// m ∼ the distribution of normals visible from wi⁺ (Heitz & d'Eon 2014).
+    #[default]
+    VisibleNormals,
+    /// Seed 001 §7.2's pseudo-VNIS (STD only).
+    PseudoVnis,
+}
+
+impl Sampling {
+    /// The name used in specs (`normals`, `visible_normals`, `pseudo_vnis`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Sampling::Normals => "normals",
+            Sampling::VisibleNormals => "visible_normals",
+            Sampling::PseudoVnis => "pseudo_vnis",
+        }
+    }
+}
+
+/// An NDF with a Smith Λ, a masking form and a sampler of normals: the microfacet part of a
+/// reference BSDF. See the module documentation for the formulas.
+#[derive(Clone)]
+pub struct Microfacet {
+    ndf: Arc<dyn Ndf>,
+    label: String,
+    masking: Masking,
+    sampling: Sampling,
+    pseudo: Option<Arc<PseudoVnis>>,
+}
+
+impl std::fmt::Debug for Microfacet {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Microfacet")
+            .field("ndf", &self.label)
+            .field("masking", &self.masking)
+            .field("sampling", &self.sampling)
+            .finish()
+    }
+}
+
+/// w⁺: `w`, or −w below the horizon (see the module documentation).
+#[inline]
+pub fn upper(w: Vec3) -> Vec3 {
+    if w[2] < 0.0 {
+        scale(-1.0, w)
+    } else {
+        w
+    }
+}
+
+impl Microfacet {
+    /// The microfacet part of a BSDF on `ndf` (called `label` in errors, e.g. its family), with
+    /// G2 in the form `masking`, sampling normals by `sampling`. Errors: the NDF has no Smith Λ
+    /// ([`BsdfError::NoSmith`]), or not the sampler asked for ([`BsdfError::NoSampler`];
+    /// [`Sampling::PseudoVnis`] is built by [`Microfacet::pseudo_vnis`] only).
+    pub fn new(
+        ndf: Arc<dyn Ndf>,
+        label: &str,
+        masking: Masking,
+        sampling: Sampling,
+    ) -> Result<Self, BsdfError> {
+        if ndf.as_smith().is_none() {
+            return Err(BsdfError::NoSmith {
+                family: label.to_string(),
+                reason: "the model has no Smith capability".to_string(),
+            });
+        }
+        let missing = match sampling {
+            Sampling::Normals => ndf
+                .as_sampler()
+                .is_none()
+                .then_some("a normal sampler (sample_wm)"),
+            Sampling::VisibleNormals => ndf
+                .as_visible_sampler()
+                .is_none()
+                .then_some("a visible-normal sampler (sample_wm_visible)"),
+            Sampling::PseudoVnis => {
+                Some("to be the STD (seed 001 §7.2's pseudo-VNIS is for the STD)")
+            }
+        };
+        if let Some(needs) = missing {
+            return Err(BsdfError::NoSampler {
+                sampling: sampling.name(),
+                family: label.to_string(),
+                needs,
+            });
+        }
+        Ok(Self {
+            ndf,
+            label: label.to_string(),
+            masking,
+            sampling,
+            pseudo: None,
+        })
+    }
+
+    /// The microfacet part on the STD of the pseudo-VNIS `pv` (its target), sampling by the
+    /// pseudo-VNIS.
+    pub fn pseudo_vnis(pv: PseudoVnis, masking: Masking) -> Self {
+        Self {
+            ndf: Arc::new(pv.target().clone()),
+            label: "std".to_string(),
+            masking,
+            sampling: Sampling::PseudoVnis,
+            pseudo: Some(Arc::new(pv)),
+        }
+    }
+
+    /// The NDF.
+    pub fn ndf(&self) -> &dyn Ndf {
+        &*self.ndf
+    }
+
+    /// The label given at construction (the family of a reference NDF).
+    pub fn label(&self) -> &str {
+        &self.label
+    }
+
+    /// The masking form of G2.
+    pub fn masking(&self) -> Masking {
+        self.masking
+    }
+
+    /// How normals are sampled.
+    pub fn sampling(&self) -> Sampling {
+        self.sampling
+    }
+
+    /// The pseudo-VNIS, when sampling by it.
+    pub fn pseudo(&self) -> Option<&PseudoVnis> {
+        self.pseudo.as_deref()
+    }
+
+    /// D(m) (0 for m_z ≤ 0).
+    #[inline]
+    pub fn d(&self, m: Vec3) -> f64 {
+        self.ndf.d(m)
+    }
+
+    /// Λ(w⁺) (∞ for a grazing or non-finite w).
+    pub fn lambda(&self, w: Vec3) -> f64 {
+        if !(w[2] != 0.0) {
+            return f64::INFINITY;
+        }
+        match self.ndf.as_smith() {
+            Some(s) => s.lambda(upper(w)),
+            None => f64::INFINITY,
+        }
+    }
+
+    /// G1(w, m) = χ⁺((w·m)/(w·n)) / (1 + Λ(w⁺)), for w in either hemisphere.
+    pub fn g1(&self, w: Vec3, m: Vec3) -> f64 {
+        if !(dot(w, m) * w[2] > 0.0) {
+            return 0.0;
+        }
+        1.0 / (1.0 + self.lambda(w))
+    }
+
+    /// G2(wi, wo, m) in this BSDF's masking form (module documentation).
+    pub fn g2(&self, wi: Vec3, wo: Vec3, m: Vec3) -> f64 {
+        match self.masking {
+            Masking::Uncorrelated => self.g1(wi, m) * self.g1(wo, m),
+            Masking::HeightCorrelated => {
+                if !(dot(wi, m) * wi[2] > 0.0) || !(dot(wo, m) * wo[2] > 0.0) {
+                    0.0
+                } else {
+                    1.0 / (1.0 + self.lambda(wi) + self.lambda(wo))
+                }
+            }
+        }
+    }
+
+    /// The density (solid angle, over m) of [`Microfacet::sample_m`] for incidence `wi`:
+    /// D(m)(m·n), D_{wi⁺}(m) or the pseudo-VNIS proxy's, and 0 where wi⁺·m ≤ 0 or m_z ≤ 0.
+    pub fn pdf_m(&self, wi: Vec3, m: Vec3) -> f64 {
+        let v = upper(wi);
+        if !(v[2] > 0.0) || !(m[2] > 0.0) || !(dot(v, m) > 0.0) {
+            return 0.0;
+        }
+        let p = match self.sampling {
+            Sampling::Normals => self.ndf.as_sampler().map_or(0.0, |s| s.pdf_wm(m)),
+            Sampling::VisibleNormals => self
+                .ndf
+                .as_visible_sampler()
+                .map_or(0.0, |s| s.pdf_wm_visible(v, m)),
+            Sampling::PseudoVnis => self.pseudo.as_ref().map_or(0.0, |p| p.pdf_wm(v, m)),
+        };
+        if p.is_finite() {
+            p
+        } else {
+            0.0
+        }
+    }
+
+    /// A microfacet normal for incidence `wi` (either side) from `u ∈ [0, 1)²`, or `None`
+    /// where the sampler gives none usable: wi grazing or non-finite, a non-finite normal, or
+    /// one with m_z ≤ 0 or wi⁺·m ≤ 0.
+    pub fn sample_m(&self, wi: Vec3, u: [f64; 2]) -> Option<Vec3> {
+        let v = upper(wi);
+        if !(v[2] > 0.0) || !finite(v) {
+            return None;
+        }
+        let m = match self.sampling {
+            Sampling::Normals => self.ndf.as_sampler()?.sample_wm(u),
+            Sampling::VisibleNormals => self.ndf.as_visible_sampler()?.sample_wm_visible(v, u),
+            Sampling::PseudoVnis => self.pseudo.as_ref()?.sample_wm(v, u),
+        };
+        (finite(m) && m[2] > 0.0 && dot(v, m) > 0.0).then_some(m)
+    }
+}
+
+/// The mirror direction of `wi` about `m`: 2(wi·m)m − wi.
+#[inline]
+pub fn reflect(wi: Vec3, m: Vec3) -> Vec3 {
+    let c = 2.0 * dot(wi, m);
+    [c * m[0] - wi[0], c * m[1] - wi[1], c * m[2] - wi[2]]
+}
+
+/// The direction refracted from `wi` through the facet `m` into the far side, whose index over
+/// wi's is `eta` (η_t/η_i), given the refracted cosine `cos_t` (from
+/// [`super::fresnel::dielectric`]): with s = sign(wi·m) and e = 1/η,
+///
+/// ```text
+/// t = −e wi + (e |wi·m| − cos_t) s m
+/// ```
+///
+/// (tangential part −e times wi's, Snell's law; t·(s m) = −cos_t; |t| = 1).
+#[inline]
+pub fn refract(wi: Vec3, m: Vec3, eta: f64, cos_t: f64) -> Vec3 {
+    let c = dot(wi, m);
+    let e = 1.0 / eta;
+    let k = (e * c.abs() - cos_t) * 1.0f64.copysign(c);
+    [
+        -e * wi[0] + k * m[0],
+        -e * wi[1] + k * m[1],
+        -e * wi[2] + k * m[2],
+    ]
+}

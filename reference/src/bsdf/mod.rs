@@ -1,0 +1,262 @@
+//! Reference microfacet BSDFs: a rough conductor (reflection only) and a rough dielectric
+//! (reflection and refraction) after Walter, Marschner, Li & Torrance 2007, "Microfacet models
+//! for refraction through rough surfaces" (EGSR 2007; seed 001 cites it as [13]; "Walter" below),
+//! built on any NDF that has a Smith Λ, and the [`Bsdf`] capability a renderer's own BSDF
+//! implements to be audited the same way.
+//!
+//! # Conventions
+//!
+//! - **Frame.** Local shading frame, macro-normal n = +z pointing to the *outside* medium;
+//!   directions are unit vectors pointing *away* from the surface; monochrome (one channel).
+//! - **Arguments.** `wi` is the direction the query comes from (the camera side of a path traced
+//!   from the camera, Mitsuba's and Falcor's `wi`), `wo` the other one (toward the light for a
+//!   camera path). Both may lie in either hemisphere; `wi_z = 0` or `wo_z = 0` (exactly grazing)
+//!   evaluates to 0.
+//! - **`eval(wi, wo)`** = f(wi, wo) · |cos θo|, the BSDF times the cosine at `wo` (Mitsuba's
+//!   and Falcor's `eval`), so that ∫ eval dωo is the albedo and `weight = eval / pdf`.
+//! - **`pdf(wi, wo)`** is the solid-angle density of the `wo` that `sample(wi, ·)` returns.
+//!   Where `sample` fails (a reflected or refracted direction on the wrong side of the surface, a
+//!   back-facing sampled normal, a non-finite input) no direction is returned, so
+//!   ∫ pdf dωo = 1 − (probability of failure) ≤ 1.
+//! - **Relative index.** `eta()` = η_inside / η_outside (`None`: reflection only). The index on
+//!   `wi`'s side is η_i (1 if wi_z > 0, else η), the one on `wo`'s side η_o.
+//!
+//! # Transport convention
+//!
+//! Walter's BTDF (eq 21), written with i = wi and o = wo,
+//!
+//! ```text
+//! W(wi, wo) = |wi·h||wo·h| / (|wi·n||wo·n|)
+//!             · η_o² (1 − F(wi, h)) G(wi, wo, h) D(h) / (η_i(wi·h) + η_o(wo·h))²
+//! ```
+//!
+//! obeys W(wi, wo)/η_o² = W(wo, wi)/η_i² (the numerator other than η_o² and the denominator are
+//! symmetric in (wi, η_i) ↔ (wo, η_o), and so is F's transmittance). Two conventions are in use:
+//!
+//! - [`Transport::Importance`]: f(wi, wo) = W(wi, wo), Walter's eq 21 exactly as printed. It
+//!   transports importance from the camera side (or radiance in the direction wi → wo): no η²
+//!   factor in the sampling weight, and ∫ eval dωo ≤ 1 from both sides.
+//!   Reciprocity: f(wi, wo)/η_o² = f(wo, wi)/η_i².
+//! - [`Transport::Radiance`]: f(wi, wo) = W(wi, wo) · (η_i/η_o)² = W(wo, wi): the BTDF that
+//!   carries radiance arriving along `wo` to `wi` (light from the other medium is compressed
+//!   into the smaller solid angle of the denser one), as pbrt-v4 and Mitsuba 3 evaluate in their
+//!   radiance mode (Veach 1997, §5.2: radiance scales as η²). Reciprocity:
+//!   f(wi, wo)/η_i² = f(wo, wi)/η_o². ∫ eval dωo may exceed 1 when η_i > η_o.
+//!
+//! Reflection (Walter eq 20) is the same in both conventions and reciprocal:
+//! f(wi, wo) = f(wo, wi).
+//!
+//! # What is built where
+//!
+//! - [`fresnel`]: exact dielectric Fresnel (Walter eq 22), exact conductor Fresnel of a complex
+//!   index, Schlick's approximation.
+//! - [`microfacet`]: D, the Smith G1/G2 of both hemispheres, and the samplers of microfacet
+//!   normals (by normals, by visible normals, seed 001's pseudo-VNIS) with their densities.
+//! - [`conductor`] and [`dielectric`]: the BSDFs.
+//! - [`spec`]: the serde description `{"bsdf": "dielectric", "eta": 1.5, "ndf": {...}, …}`,
+//!   validated with typed errors, built into `Arc<dyn Bsdf>`.
+
+pub mod conductor;
+pub mod dielectric;
+pub mod fresnel;
+pub mod microfacet;
+pub mod spec;
+
+#[cfg(test)]
+mod golden_tests;
+#[cfg(test)]
+mod tests;
+
+pub use conductor::Conductor;
+pub use dielectric::Dielectric;
+pub use fresnel::FresnelModel;
+pub use microfacet::{Microfacet, Sampling};
+pub use spec::{BsdfError, BsdfSpec, ConductorSpec, DielectricSpec};
+
+use crate::geometry::Vec3;
+
+/// A sampled direction: `wo`, its density `pdf` = [`Bsdf::pdf`]`(wi, wo)` (> 0) and
+/// `weight` = [`Bsdf::eval`]`(wi, wo) / pdf`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BsdfSample {
+    /// The sampled direction (unit, either hemisphere).
+    pub wo: Vec3,
+    /// The solid-angle density of `wo`.
+    pub pdf: f64,
+    /// eval(wi, wo) / pdf(wi, wo).
+    pub weight: f64,
+}
+
+/// The transport convention of a transmitting BSDF (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Transport {
+    /// f(wi, wo) = Walter's eq 21 with i = wi, o = wo: f(wi, wo)/η_o² = f(wo, wi)/η_i².
+    Importance,
+    /// Walter's eq 21 times (η_i/η_o)², η_i the index on wi's side (pbrt-v4, Mitsuba 3):
+    /// f(wi, wo)/η_i² = f(wo, wi)/η_o².
+    #[default]
+    Radiance,
+}
+
+impl Transport {
+    /// The name used in specs and in the external protocol (`radiance`, `importance`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Transport::Importance => "importance",
+            Transport::Radiance => "radiance",
+        }
+    }
+
+    /// The factor by which this convention multiplies Walter's eq 21 (W(wi, wo)) for the
+    /// indices `eta_i` on wi's side and `eta_o` on wo's side: 1 or (η_i/η_o)².
+    pub fn factor(self, eta_i: f64, eta_o: f64) -> f64 {
+        match self {
+            Transport::Importance => 1.0,
+            Transport::Radiance => (eta_i / eta_o).powi(2),
+        }
+    }
+}
+
+/// A BSDF in the local shading frame (normal +z, pointing outside), monochrome: the capability
+/// a renderer's BSDF implements to be audited, and what the reference BSDFs implement. See the
+/// module documentation for the conventions (which direction is which, the cosine in `eval`,
+/// the relative index, the transport convention).
+///
+/// ```
+/// use mfh_reference::bsdf::{Bsdf, BsdfSpec};
+/// let spec: BsdfSpec = serde_json::from_str(
+///     r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3},
+///         "masking":"height_correlated","sampling":"visible_normals"}"#,
+/// ).unwrap();
+/// let b = spec.build().unwrap();
+/// let wi = [0.6, 0.0, 0.8];
+/// let s = b.sample(wi, [0.7, 0.3, 0.6]).unwrap();
+/// assert!((s.pdf - b.pdf(wi, s.wo)).abs() <= 1e-12 * s.pdf);
+/// assert!((s.weight - b.eval(wi, s.wo) / s.pdf).abs() <= 1e-12 * s.weight);
+/// assert_eq!(b.eta(), Some(1.5));
+/// ```
+pub trait Bsdf: Send + Sync {
+    /// f(wi, wo) · |cos θo| (0 where the BSDF is 0, for non-finite or exactly grazing
+    /// directions; never NaN).
+    fn eval(&self, wi: Vec3, wo: Vec3) -> f64;
+
+    /// The solid-angle density of the `wo` that [`Bsdf::sample`] returns for `wi` (0 where it
+    /// never returns one).
+    fn pdf(&self, wi: Vec3, wo: Vec3) -> f64;
+
+    /// A direction `wo` for `wi` from `u ∈ [0, 1)³`: `u[0]` chooses the lobe, `u[1..]` the
+    /// microfacet normal. `None` for a failed sample (no direction; its probability is
+    /// 1 − ∫ pdf dωo).
+    fn sample(&self, wi: Vec3, u: [f64; 3]) -> Option<BsdfSample>;
+
+    /// `(eval(wi, wo), pdf(wi, wo))` in one call (the reference BSDFs share the half vector,
+    /// D, Λ and Fresnel between the two).
+    fn eval_pdf(&self, wi: Vec3, wo: Vec3) -> (f64, f64) {
+        (self.eval(wi, wo), self.pdf(wi, wo))
+    }
+
+    /// The relative index η = η_inside / η_outside of a transmitting BSDF; `None` for a
+    /// reflection-only one (the default).
+    fn eta(&self) -> Option<f64> {
+        None
+    }
+
+    /// The transport convention of the transmission lobe (default [`Transport::Radiance`];
+    /// without transmission it changes nothing).
+    fn transport(&self) -> Transport {
+        Transport::Radiance
+    }
+
+    /// `out[k] = self.eval(wi[k], wo[k])` (the default loops over [`Bsdf::eval`]).
+    ///
+    /// # Panics
+    /// If `wi`, `wo` and `out` differ in length.
+    fn eval_batch(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
+        assert!(
+            wi.len() == wo.len() && wo.len() == out.len(),
+            "eval_batch: wi, wo and out differ in length"
+        );
+        for ((o, &a), &b) in out.iter_mut().zip(wi).zip(wo) {
+            *o = self.eval(a, b);
+        }
+    }
+
+    /// `out[k] = self.pdf(wi[k], wo[k])` (the default loops over [`Bsdf::pdf`]).
+    ///
+    /// # Panics
+    /// If `wi`, `wo` and `out` differ in length.
+    fn pdf_batch(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
+        assert!(
+            wi.len() == wo.len() && wo.len() == out.len(),
+            "pdf_batch: wi, wo and out differ in length"
+        );
+        for ((o, &a), &b) in out.iter_mut().zip(wi).zip(wo) {
+            *o = self.pdf(a, b);
+        }
+    }
+
+    /// `out[k] = self.sample(wi, u[k])` at one incidence (the default loops over
+    /// [`Bsdf::sample`]).
+    ///
+    /// # Panics
+    /// If `u` and `out` differ in length.
+    fn sample_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<BsdfSample>]) {
+        assert_eq!(
+            u.len(),
+            out.len(),
+            "sample_batch: u and out differ in length"
+        );
+        for (o, &u) in out.iter_mut().zip(u) {
+            *o = self.sample(wi, u);
+        }
+    }
+}
+
+/// A reference to a BSDF is the BSDF (so `Arc<dyn Bsdf>`, `Box<T>` and `&T` audit as `T`).
+macro_rules! delegate_bsdf {
+    ($($ptr:ty),*) => {$(
+        impl<T: Bsdf + ?Sized> Bsdf for $ptr {
+            fn eval(&self, wi: Vec3, wo: Vec3) -> f64 {
+                (**self).eval(wi, wo)
+            }
+            fn pdf(&self, wi: Vec3, wo: Vec3) -> f64 {
+                (**self).pdf(wi, wo)
+            }
+            fn sample(&self, wi: Vec3, u: [f64; 3]) -> Option<BsdfSample> {
+                (**self).sample(wi, u)
+            }
+            fn eval_pdf(&self, wi: Vec3, wo: Vec3) -> (f64, f64) {
+                (**self).eval_pdf(wi, wo)
+            }
+            fn eta(&self) -> Option<f64> {
+                (**self).eta()
+            }
+            fn transport(&self) -> Transport {
+                (**self).transport()
+            }
+            fn eval_batch(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
+                (**self).eval_batch(wi, wo, out)
+            }
+            fn pdf_batch(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
+                (**self).pdf_batch(wi, wo, out)
+            }
+            fn sample_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<BsdfSample>]) {
+                (**self).sample_batch(wi, u, out)
+            }
+        }
+    )*};
+}
+delegate_bsdf!(&T, Box<T>, std::sync::Arc<T>);
+
+/// Whether every component is finite.
+#[inline]
+pub(crate) fn finite(w: Vec3) -> bool {
+    w.iter().all(|c| c.is_finite())
+}
+
+/// `s · v`.
+#[inline]
+pub(crate) fn scale(s: f64, v: Vec3) -> Vec3 {
+    [s * v[0], s * v[1], s * v[2]]
+}
