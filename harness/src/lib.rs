@@ -1,13 +1,14 @@
 //! mfh-harness: the verification harness for microfacet BSDF mathematics — evaluation of
 //! closed forms (`mfh eval`), and, as the project grows, oracles, checks, audits and reports.
 //!
-//! The binary `mfh` is a thin layer over [`cli::run`]. A renderer's own tests use [`Audit`]
+//! The binary `mfh` is a thin layer over `cli::run` (feature `cli`). A renderer's own tests use [`Audit`]
 //! on their models, which implement the traits of [`model`].
 
 pub mod audit;
 pub mod baseline;
 pub mod check;
 pub mod chi2_run;
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod cost;
 pub mod eval;
@@ -15,6 +16,7 @@ pub mod external;
 pub mod gate;
 pub mod merge;
 pub mod messages;
+#[cfg(feature = "mitsuba")]
 pub mod mitsuba;
 pub mod oracle;
 pub mod plan;

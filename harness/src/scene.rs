@@ -150,6 +150,14 @@ pub enum SceneError {
         /// The I/O error.
         message: String,
     },
+    /// The scene needs a cargo feature this build of the library was made without.
+    #[error("cannot read scene {path}: this build of mfh-harness has no `{feature}` feature")]
+    FeatureOff {
+        /// The path.
+        path: String,
+        /// The feature (`mitsuba` for XML scenes).
+        feature: &'static str,
+    },
     /// The JSON is malformed or has unknown or missing keys.
     #[error("{origin}:{line}:{column}: {message}")]
     Syntax {
@@ -352,7 +360,13 @@ impl Scene {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
         if is_xml {
+            #[cfg(feature = "mitsuba")]
             return crate::mitsuba::parse(&text, &path.display().to_string());
+            #[cfg(not(feature = "mitsuba"))]
+            return Err(SceneError::FeatureOff {
+                path: path.display().to_string(),
+                feature: "mitsuba",
+            });
         }
         Scene::parse(&text, &path.display().to_string())
     }

@@ -4,6 +4,7 @@
 //! marginal curves in `out/ks/<model and case>/ks_marginal.json`. The same functions serve
 //! `mfh audit` and `mfh chi2 --out`.
 
+#[cfg(feature = "html")]
 use super::plot::{heat_map_svg, ColourScale, HeatMap, PlotError};
 use crate::record::{CheckRecord, RecordData};
 use serde_json::{json, Value};
@@ -82,14 +83,18 @@ pub fn relative_folder(record: &CheckRecord) -> Option<PathBuf> {
     Some(Path::new(kind).join(folder_name(&record.model, &record.case)))
 }
 
-/// The file names a record's data is written to (in [`relative_folder`]).
+/// The file names a record's data is written to (in [`relative_folder`]); the heat maps
+/// only with the `html` feature (they are drawn with plotters).
 pub fn file_names(data: &RecordData) -> &'static [&'static str] {
     match data {
         RecordData::Chi2Table { .. } => &[
             "chi2_observed.json",
             "chi2_expected.json",
+            #[cfg(feature = "html")]
             "chi2_observed.svg",
+            #[cfg(feature = "html")]
             "chi2_expected.svg",
+            #[cfg(feature = "html")]
             "chi2_difference.svg",
         ],
         RecordData::KsMarginal { .. } => &["ks_marginal.json"],
@@ -101,6 +106,7 @@ pub fn file_names(data: &RecordData) -> &'static [&'static str] {
 /// `title` plus what each shows. Observed and expected share one linear scale (0 to the
 /// largest count of either); the difference is diverging, ±max(4, largest |residual|), grey
 /// where E = O = 0, magenta where samples fell in a cell of zero expected count.
+#[cfg(feature = "html")]
 pub fn chi2_heat_maps(
     title: &str,
     rows: usize,
@@ -208,6 +214,7 @@ pub fn chi2_tables(
 #[derive(Debug, thiserror::Error)]
 pub enum ArtefactError {
     /// A plot could not be drawn.
+    #[cfg(feature = "html")]
     #[error(transparent)]
     Plot(#[from] PlotError),
     /// A file or folder could not be written.
@@ -261,7 +268,10 @@ pub fn write_record_data(
                 observed,
                 expected,
             ));
+            #[cfg(feature = "html")]
             files.extend(chi2_heat_maps(title, *rows, *columns, observed, expected)?);
+            #[cfg(not(feature = "html"))]
+            let _ = title;
         }
         RecordData::KsMarginal { .. } => {
             files.push(("ks_marginal.json", format!("{:#}\n", json!(data))));

@@ -5,7 +5,7 @@
 //! section is machine-dependent and never compared.
 
 use super::ReportError;
-use crate::cost::{CostReport, Quantity, RouteCost};
+use crate::cost::{CostReport, RouteCost};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -64,7 +64,8 @@ pub fn slug(name: &str) -> String {
 }
 
 /// The Pareto plot of a quantity (routes that were refused or not timed are left out).
-pub fn pareto_svg(q: &Quantity) -> String {
+#[cfg(feature = "html")]
+pub fn pareto_svg(q: &crate::cost::Quantity) -> String {
     let points: Vec<(String, f64, f64)> = q
         .routes
         .iter()
@@ -222,8 +223,8 @@ pub fn errors_section(text: &str) -> Option<&str> {
     Some(&text[start..end])
 }
 
-/// Writes `cost.json` (first), the Pareto plots into `cost/` and `cost.html` into `dir`
-/// (created if needed). Returns the paths written.
+/// Writes `cost.json` (first), then (feature `html`) the Pareto plots into `cost/` and
+/// `cost.html` into `dir` (created if needed). Returns the paths written.
 pub fn write_all(report: &CostReport, dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
     std::fs::create_dir_all(dir).map_err(|source| ReportError::CreateFolder {
         path: dir.to_path_buf(),
@@ -235,7 +236,21 @@ pub fn write_all(report: &CostReport, dir: &Path) -> Result<Vec<PathBuf>, Report
             .map_err(|source| ReportError::Write { path, source })
     };
     let json = serde_json::to_string_pretty(report).expect("a cost report serializes") + "\n";
-    let mut written = vec![write(dir.join("cost.json"), &json)?];
+    let written = vec![write(dir.join("cost.json"), &json)?];
+    #[cfg(feature = "html")]
+    let written = [written, write_plots(report, dir, &json)?].concat();
+    Ok(written)
+}
+
+/// The Pareto plots (`cost/<quantity>.svg`) and `cost.html` (feature `html`: plotters).
+#[cfg(feature = "html")]
+fn write_plots(report: &CostReport, dir: &Path, json: &str) -> Result<Vec<PathBuf>, ReportError> {
+    let write = |path: PathBuf, text: &str| {
+        std::fs::write(&path, text)
+            .map(|_| path.clone())
+            .map_err(|source| ReportError::Write { path, source })
+    };
+    let mut written = Vec::new();
     let plots = dir.join("cost");
     std::fs::create_dir_all(&plots).map_err(|source| ReportError::CreateFolder {
         path: plots.clone(),
@@ -249,7 +264,7 @@ pub fn write_all(report: &CostReport, dir: &Path) -> Result<Vec<PathBuf>, Report
     }
     written.push(write(
         dir.join("cost.html"),
-        &super::cost_html::cost_page(&json),
+        &super::cost_html::cost_page(json),
     )?);
     Ok(written)
 }

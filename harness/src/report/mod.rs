@@ -4,11 +4,15 @@
 
 pub mod artefacts;
 pub mod cost;
+#[cfg(feature = "html")]
 pub mod cost_html;
+#[cfg(feature = "html")]
 pub mod html;
 pub mod json;
 pub mod junit;
+#[cfg(feature = "html")]
 pub mod plot;
+#[cfg(feature = "html")]
 pub mod selftest_html;
 pub mod terminal;
 
@@ -43,6 +47,7 @@ pub enum ReportError {
         source: artefacts::ArtefactError,
     },
     /// The HTML report could not be rendered (report.json was written before).
+    #[cfg(feature = "html")]
     #[error("cannot render report.html: {0}")]
     Render(#[from] plot::PlotError),
 }
@@ -108,8 +113,12 @@ pub fn write_all(report: &AuditReport, dir: &Path) -> Result<Vec<PathBuf>, Repor
             }
         }
     }
-    let cost = std::fs::read_to_string(dir.join("cost.json")).ok();
-    let page = html::render(report, cost.as_deref())?;
-    written.push(write(dir.join("report.html"), page)?);
+    // report.html (and cost.json shown in it) only with the `html` feature (plotters).
+    #[cfg(feature = "html")]
+    {
+        let cost = std::fs::read_to_string(dir.join("cost.json")).ok();
+        let page = html::render(report, cost.as_deref())?;
+        written.push(write(dir.join("report.html"), page)?);
+    }
     Ok(written)
 }
