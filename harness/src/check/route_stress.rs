@@ -1,7 +1,7 @@
 //! Stress cases for the Λ routes of the Student family (issue 12): every route at γ ∈ {20, 50,
 //! 90, 171.8, 10³, 10⁶} and θ near normal incidence, at the two incidences of the issue's
 //! defects (0.5, 1.2) and near grazing (π/2 − 10⁻⁶), against the oracle the Smith checks use
-//! (`smith::lambda_oracle`: quadrature of (q − μ)P2, or the Student-t partial expectation).
+//! (`oracle::smith_lambda::lambda_oracle`: quadrature of (q − μ)P2, or the Student-t partial expectation).
 //!
 //! Each case passes; or the route answers a typed `route` error naming its domain (never the
 //! default route, which must answer and pass) — and then, where the route's own a-priori
@@ -11,9 +11,10 @@
 //! expected failure of the table (`tolerance::EXPECTED_FAILURES`) within its bound and domain.
 
 use super::{apply_expected, compare, covers, need, Check, Outcome, Planned};
-use crate::check::smith::lambda_oracle;
+use crate::oracle::smith_lambda::lambda_oracle;
 use crate::oracle::Estimate;
 use crate::record::{CheckRecord, Verdict};
+use crate::subject::Subject;
 use crate::tolerance::CLOSED_FORM;
 use mfh_reference::geometry::from_spherical;
 use mfh_reference::ndf::student_lambda::{self, p2_norm, term_magnitude, ROUTES};
@@ -115,7 +116,7 @@ fn run_case(
         .unwrap_or(f64::NAN);
     match smith.lambda_route(w, route) {
         Ok(v) => {
-            let oracle = *oracle.get_or_init(|| lambda_oracle(m, w));
+            let oracle = *oracle.get_or_init(|| lambda_oracle(&Subject::borrowed(m), w));
             compare(r, v, oracle, &CLOSED_FORM);
             apply_expected(r, family, route);
         }
@@ -143,7 +144,7 @@ fn run_case(
                 let value = student_lambda::route(route, c)
                     .map(|f| f(c, x, sigma))
                     .unwrap_or(f64::NAN);
-                let oracle = *oracle.get_or_init(|| lambda_oracle(m, w));
+                let oracle = *oracle.get_or_init(|| lambda_oracle(&Subject::borrowed(m), w));
                 r.check = "smith.lambda_route_loss".into();
                 compare(r, value, oracle, &CLOSED_FORM);
                 apply_expected(r, family, route);
