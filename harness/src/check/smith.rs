@@ -12,7 +12,7 @@ use crate::subject::Subject;
 use crate::tolerance::{Tolerance, CLOSED_FORM, IDENTITY, NUMERICAL_ROUTE};
 use mfh_reference::geometry::{dot, from_spherical};
 use mfh_reference::trig::{sin_cos, sin_cos_block};
-use mfh_reference::{Masking, Smith, Vec3};
+use mfh_reference::{Masking, QueryError, Smith, Vec3};
 use serde_json::json;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::sync::{Arc, OnceLock};
@@ -126,7 +126,10 @@ pub fn plan<'a>(
 
 /// `smith.lambda_route`: Λ by each route at the profile's directions against the oracle. A
 /// user's model is audited through the method a renderer calls; the other routes of a
-/// reference model are the reference's own business (each against the same oracle).
+/// reference model are the reference's own business (each against the same oracle), planned
+/// only where they apply: the planner asks the route ([`route_answer`]), a refusal is not
+/// planned (`route_domain` states where a route does not apply), and an answer is the value
+/// the check judges.
 pub fn plan_lambda_routes<'a>(
     subject: &Arc<Subject<'a>>,
     profile: Profile,
@@ -144,14 +147,12 @@ pub fn plan_lambda_routes<'a>(
             .into_iter()
             .map(|d| (d, Arc::new(OnceLock::new())))
             .collect();
-    let routes = if subject.reference.is_some() {
-        smith.lambda_routes()
-    } else {
-        vec!["default"]
-    };
     let mut out = Vec::new();
-    for route in routes {
+    for route in lambda_routes(subject) {
         for ((theta, phi), memo) in oracles.iter().cloned() {
+            let Ok(answer) = route_answer(smith, route, theta, phi) else {
+                continue;
+            };
             let case = json!({"route": route, "theta": theta, "phi": phi});
             let m = subject.clone();
             out.push(
@@ -167,20 +168,7 @@ pub fn plan_lambda_routes<'a>(
                     let w = from_spherical(theta, phi);
                     let smith = need(m.model.as_smith(), "Smith masking")?;
                     // The default route is the method a renderer calls (and G1, G2 use).
-                    let value = if route == "default" {
-                        Ok(smith.lambda(w))
-                    } else {
-                        smith.lambda_route(w, route)
-                    };
-                    let value = match value {
-                        Ok(v) => v,
-                        Err(e) => {
-                            r.verdict = Verdict::Skipped {
-                                reason: format!("route does not apply: {e}"),
-                            };
-                            return Ok(());
-                        }
-                    };
+                    let value = answer.unwrap_or_else(|| smith.lambda(w));
                     let oracle = *memo.get_or_init(|| lambda_oracle(m.as_ref(), w));
                     let tol = if m.lambda_numerical() && matches!(route, "default" | "exact") {
                         &NUMERICAL_ROUTE
@@ -195,6 +183,33 @@ pub fn plan_lambda_routes<'a>(
         }
     }
     out
+}
+
+/// The Λ routes audited for a subject: every route of a reference model, the default (the
+/// method a renderer calls) of a user's model.
+pub fn lambda_routes(subject: &Subject) -> Vec<&'static str> {
+    match subject.model.as_smith() {
+        Some(smith) if subject.reference.is_some() => smith.lambda_routes(),
+        Some(_) => vec!["default"],
+        None => Vec::new(),
+    }
+}
+
+/// Whether `route` applies at (θ, φ), asked of the route itself: its answer Λ, `None` for the
+/// default route (not asked: it applies everywhere, and the check evaluates it), or the error
+/// with which the route refuses.
+pub fn route_answer(
+    smith: &dyn Smith,
+    route: &str,
+    theta: f64,
+    phi: f64,
+) -> Result<Option<f64>, QueryError> {
+    if route == "default" {
+        return Ok(None);
+    }
+    smith
+        .lambda_route(from_spherical(theta, phi), route)
+        .map(Some)
 }
 
 /// The tolerance of a quantity computed from the default Λ: the numerical route's where that Λ
@@ -490,6 +505,49 @@ fn worst_identity_violation(smith: &dyn Smith) -> (f64, String) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check::RunContext;
+    use mfh_reference::ModelSpec;
+
+    /// A reference route is planned exactly where it answers, every planned case judged (none
+    /// skipped); the default route of a user's model is always planned.
+    #[test]
+    fn reference_routes_are_planned_only_where_they_apply() {
+        let spec: ModelSpec =
+            serde_json::from_value(json!({"family": "std", "gamma": 3.0, "alpha": 0.2})).unwrap();
+        let subject = Subject::reference(&spec).unwrap();
+        let smith = subject.model.as_smith().unwrap();
+        let planned = plan_lambda_routes(&subject, Profile::Quick, FRAC_PI_2, "t");
+        let mut applies = 0;
+        let mut refuses = 0;
+        for route in lambda_routes(&subject) {
+            for (theta, phi) in directions(false, Profile::Quick, FRAC_PI_2) {
+                let answers = route_answer(smith, route, theta, phi).is_ok();
+                let is_planned = planned
+                    .iter()
+                    .any(|p| p.case == json!({"route": route, "theta": theta, "phi": phi}));
+                assert_eq!(answers, is_planned, "{route} {theta}");
+                applies += usize::from(answers);
+                refuses += usize::from(!answers);
+            }
+        }
+        assert_eq!(planned.len(), applies);
+        assert!(refuses > 0, "the half-integer routes refuse at γ = 3");
+        let ctx = RunContext { seed: 1 };
+        for p in &planned {
+            let r = (p.run)(&ctx);
+            assert!(
+                matches!(r.verdict, Verdict::Pass | Verdict::ExpectedFailure { .. }),
+                "{r:?}"
+            );
+        }
+        let user = Subject::user(subject.model.clone(), "user", Default::default());
+        let planned = plan_lambda_routes(&user, Profile::Quick, FRAC_PI_2, "t");
+        assert_eq!(
+            planned.len(),
+            directions(true, Profile::Quick, FRAC_PI_2).len()
+        );
+        assert!(planned.iter().all(|p| p.case["route"] == "default"));
+    }
 
     /// The hoisted form of the white furnace's directions is `from_spherical` bit for bit
     /// when given the sines and cosines `from_spherical` computes, the horizon snap included.
