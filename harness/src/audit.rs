@@ -3,7 +3,6 @@
 //! call as a CI gate (`audit_scene(..)?.assert_pass()`).
 
 use crate::check::{PlannedCheck, Profile, RunContext};
-use crate::oracle::chi2::{sidak_alpha, DEFAULT_SEED};
 use crate::plan::plan;
 use crate::random::splitmix64;
 use crate::record::{CheckRecord, Measured, Verdict, SCHEMA_VERSION};
@@ -15,6 +14,19 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 use std::time::Instant;
+
+/// The default audit seed (overridable everywhere a seed is taken: `--seed`, `MFH_SEED`, the
+/// options): every check's random stream derives from it and the check's id, model and case.
+pub const DEFAULT_SEED: u64 = 0x6d66_6800_0000_0001;
+
+/// The Šidák-corrected level for each of `k` independent tests so that the family-wise level
+/// is `alpha`: 1 − (1 − α)^{1/k} (computed as −expm1(ln(1 − α)/k), exact for small α).
+pub fn sidak_alpha(alpha: f64, k: usize) -> f64 {
+    if k <= 1 {
+        return alpha;
+    }
+    -((-alpha).ln_1p() / k as f64).exp_m1()
+}
 
 /// How to run an audit.
 #[derive(Debug, Clone)]
@@ -479,4 +491,17 @@ pub fn audit_scene(scene: &Scene, scene_path: Option<&str>, options: &AuditOptio
     );
     report.not_audited = scene.not_audited.clone();
     report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One test keeps its level; k tests share it so that the family-wise level is α.
+    #[test]
+    fn sidak_alpha_keeps_the_family_wise_level() {
+        assert_eq!(sidak_alpha(0.01, 1), 0.01);
+        let a = sidak_alpha(0.01, 10);
+        assert!((1.0 - (1.0 - a).powi(10) - 0.01).abs() < 1e-15);
+    }
 }

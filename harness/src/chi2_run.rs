@@ -3,10 +3,8 @@
 //! run, and the record it makes (a JSON object). No exit codes and no file writing here: the
 //! CLI (`cli/chi2.rs`) maps errors to exit codes and writes tables and heat maps.
 
-use crate::oracle::chi2::{
-    chi2_test_batch_in, Chi2Config, Chi2Result, CELL_RELATIVE_TOLERANCE,
-    KINKED_CELL_RELATIVE_TOLERANCE, MIN_EXPECTED,
-};
+use crate::oracle::chi2::{chi2_test_batch_in, Chi2Config, Chi2Result};
+use crate::tolerance::{CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE, MIN_EXPECTED};
 use mfh_reference::{Model, ModelSpec, Vec3};
 use serde_json::{json, Value};
 use std::f64::consts::FRAC_PI_2;

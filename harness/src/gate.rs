@@ -13,9 +13,9 @@
 //!     .assert_pass();
 //! ```
 
+use crate::audit::DEFAULT_SEED;
 use crate::audit::{run_plan, AuditOptions, AuditReport};
 use crate::check::{against, PlannedCheck, Profile};
-use crate::oracle::chi2::DEFAULT_SEED;
 use crate::plan::{plan_model, Effects};
 use crate::record::{CheckRecord, Verdict};
 use crate::scene::Sampling;

@@ -2,8 +2,8 @@
 //! planned; nothing the scene does not use is simulated (ARCHITECTURE.md, "Scenes").
 
 use crate::check::{
-    claims, ds, errata, limits, moments, normalization, precise, sampling, sg, smith, stability,
-    Planned, PlannedCheck, Profile,
+    claims, ds, errata, limits, moments, normalization, precise, route_domain, sampling, sg, smith,
+    stability, Planned, PlannedCheck, Profile,
 };
 use crate::scene::{Sampling, Scene};
 use crate::subject::Subject;
@@ -69,6 +69,7 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
     let mut out = Vec::new();
     let mut documents = BTreeSet::new();
     let mut std_alphas: Vec<f64> = Vec::new();
+    let mut masked = Vec::new();
     for material in &scene.materials {
         let Ok(model) = material.model.build() else {
             continue; // Scene::parse has rejected invalid models already.
@@ -110,6 +111,7 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
                 model.as_ref(),
                 &format!("{why} masks"),
             ));
+            masked.push((subject.clone(), material.name.clone()));
         }
         if scene.filtering.gaussian_slopes {
             out.extend(ds::plan(
@@ -129,6 +131,8 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
             }
         }
     }
+    let domains = route_domain::plan(&masked, &out, profile, theta_max);
+    out.extend(domains);
     if scene.filtering.gaussian_slopes {
         documents.insert("002");
     }

@@ -14,11 +14,11 @@
 //! statistical checks (at least as strict as the final level, which counts only those that
 //! produced a p-value); `mfh merge` re-judges over the whole family.
 
+use crate::audit::sidak_alpha;
 use crate::audit::{
     fnv1a, judge_at, reproduce_command, run_plan, summarize, AuditOptions, AuditReport,
 };
 use crate::check::{Planned, PlannedCheck};
-use crate::oracle::chi2::sidak_alpha;
 use crate::plan::plan;
 use crate::record::SCHEMA_VERSION;
 use crate::scene::Scene;

@@ -4,6 +4,7 @@
 //! measure from D itself. Checks never ask a subject for a family name to decide what to do.
 
 use crate::oracle::lobe::{self, Lobe, Options};
+use crate::oracle::smith_lambda::LambdaSubject;
 use mfh_reference::registry::{self, FamilyInfo};
 use mfh_reference::{Model, ModelSpec, Ndf, ParamError, Vec3};
 use serde_json::{json, Value};
@@ -163,6 +164,22 @@ impl<'a> Subject<'a> {
     /// Whether the sampler is slow (registry).
     pub fn slow_sampler(&self) -> bool {
         self.info().is_some_and(|i| i.slow_sampler)
+    }
+}
+
+/// The Λ oracle's questions, answered from the registry, the hints and the measured lobe.
+impl LambdaSubject for Subject<'_> {
+    fn ndf(&self) -> &dyn Ndf {
+        self.model.as_ref()
+    }
+    fn tail_exponent(&self) -> Option<f64> {
+        Subject::tail_exponent(self)
+    }
+    fn lobe_width(&self) -> f64 {
+        self.lobe().width()
+    }
+    fn theta_kinks(&self) -> Vec<f64> {
+        Subject::theta_kinks(self)
     }
 }
 

@@ -3,10 +3,16 @@
 //! "Tolerances and expected failures").
 //!
 //! The tolerances are here; the expected-failure types (`Bound`, `Domain`, `ExpectedFailure`)
-//! and their table are in `tolerance/expected.rs`, re-exported here.
+//! and their table are in `tolerance/expected.rs`, and the chi-square oracle's numeric
+//! tolerances in `tolerance/chi2.rs`, both re-exported here.
 
+mod chi2;
 mod expected;
 
+pub use chi2::{
+    CELL_ABSOLUTE_TOLERANCE, CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE,
+    MASS_TOLERANCE, MIN_EXPECTED, REMOTE_CELL_ABSOLUTE_TOLERANCE,
+};
 pub use expected::{expected_failures, Bound, Domain, ExpectedFailure, EXPECTED_FAILURES};
 
 /// A named tolerance.

@@ -7,13 +7,13 @@
 //! Each claim declares what it concerns ([`Concern`]); a scene plans only those it uses.
 
 use super::errata::{Concern, Effect, Scope, STUDENT};
-use super::smith::{lambda_oracle, lambda_oracle_many, lambda_oracle_to};
 use super::{applied, covers, Planned};
 use crate::check::Check;
 use crate::oracle::gtr::g1_gamma0;
 use crate::oracle::quadrature::{
     integrate, integrate_hemisphere, integrate_line, integrate_pieces, integrate_upper, Accuracy,
 };
+use crate::oracle::smith_lambda::{lambda_oracle, lambda_oracle_many, lambda_oracle_to};
 use crate::oracle::Estimate;
 use crate::record::{Measured, Verdict};
 use crate::subject::Subject;
@@ -158,7 +158,7 @@ pub fn plan(scope: &Scope, why: &str) -> Vec<Planned> {
 /// the spline claim the longest record of the quick audit (10 s) for digits no verdict reads.
 const GTR_CLAIM_RELATIVE: f64 = 1e-8;
 
-/// G1 of GTR by the harness oracle of Λ (`check::smith::lambda_oracle_to`: one quadrature of the
+/// G1 of GTR by the harness oracle of Λ (`oracle::smith_lambda::lambda_oracle_to`: one quadrature of the
 /// model's P2 to [`GTR_CLAIM_RELATIVE`]; the nested quadrature of `oracle::gtr`, which owes
 /// nothing to the model, costs ~10⁵ evaluations per Λ, too many for the 600 points of the
 /// spline grid).
@@ -323,7 +323,7 @@ fn trapezoid_error() -> Result<Measurement, String> {
         let lam = smith
             .lambda_route(w, "domain_split")
             .map_err(|e| e.to_string())?;
-        let o = lambda_oracle(m.as_ref(), w).value;
+        let o = lambda_oracle(&Subject::borrowed(m.as_ref()), w).value;
         let e = ((1.0 + o) / (1.0 + lam) - 1.0).abs();
         max = max.max(e);
     }

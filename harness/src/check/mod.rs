@@ -11,6 +11,7 @@ pub mod limits;
 pub mod moments;
 pub mod normalization;
 pub mod precise;
+pub mod route_domain;
 pub mod route_stress;
 pub mod run;
 pub mod sampling;

@@ -19,15 +19,15 @@ pub use visible::{plan_visible, terminator_azimuths, visible_kinks, VISIBLE_INCI
 
 use super::{applied, compare_exact, covers, Planned, PlannedCheck, Profile};
 use crate::check::{need, Check};
-use crate::oracle::chi2::{
-    chi2_test_batches_cut, BatchPdf, BatchSampler, Chi2Config, CELL_ABSOLUTE_TOLERANCE,
-    CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE, REMOTE_CELL_ABSOLUTE_TOLERANCE,
-};
+use crate::oracle::chi2::{chi2_test_batches_cut, BatchPdf, BatchSampler, Chi2Config};
 use crate::oracle::ks::Marginal;
 use crate::oracle::monte_carlo::{estimate_batch, two_sided_p};
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
 use crate::subject::Subject;
-use crate::tolerance::{PDF_CONSISTENCY, STATISTICAL_ALPHA};
+use crate::tolerance::{
+    CELL_ABSOLUTE_TOLERANCE, CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE,
+    PDF_CONSISTENCY, REMOTE_CELL_ABSOLUTE_TOLERANCE, STATISTICAL_ALPHA,
+};
 use mfh_reference::geometry::{dot, from_spherical, Vec3};
 use mfh_reference::Ndf;
 use serde_json::{json, Value};

@@ -5,9 +5,9 @@
 //! γ = 1.5 + 1e-9 and 1e8 for the Student family, γ → 0 and 10 for GTR, a near-singular
 //! covariance), plus Λ against the oracle at one interior incidence.
 
-use super::smith::lambda_oracle_for;
 use super::{compare, covers, Planned, PlannedCheck};
 use crate::check::Check;
+use crate::oracle::smith_lambda::lambda_oracle;
 use crate::record::Verdict;
 use crate::subject::Subject;
 use crate::tolerance::{CLOSED_FORM, IDENTITY, NUMERICAL_ROUTE};
@@ -210,7 +210,7 @@ pub fn plan(spec: &ModelSpec, why: &str) -> Vec<Planned> {
                 if let Some(s) = subject.model.as_smith() {
                     let w = from_spherical(1.0, 0.4);
                     let value = s.lambda(w);
-                    let oracle = lambda_oracle_for(&subject, w);
+                    let oracle = lambda_oracle(subject.as_ref(), w);
                     let tol = if subject.lambda_numerical() {
                         &NUMERICAL_ROUTE
                     } else {

@@ -157,8 +157,8 @@ fn run_external(
                 &|m: &[mfh_reference::Vec3], out: &mut [f64]| v.pdf_wm_visible_batch(wi, m, out),
                 &plan.config,
                 (
-                    crate::oracle::chi2::KINKED_CELL_RELATIVE_TOLERANCE,
-                    crate::oracle::chi2::REMOTE_CELL_ABSOLUTE_TOLERANCE,
+                    crate::tolerance::KINKED_CELL_RELATIVE_TOLERANCE,
+                    crate::tolerance::REMOTE_CELL_ABSOLUTE_TOLERANCE,
                 ),
                 None,
             )
@@ -178,8 +178,8 @@ fn run_external(
                 &|m: &[mfh_reference::Vec3], out: &mut [f64]| s.pdf_wm_batch(m, out),
                 &plan.config,
                 (
-                    crate::oracle::chi2::CELL_RELATIVE_TOLERANCE,
-                    crate::oracle::chi2::CELL_ABSOLUTE_TOLERANCE,
+                    crate::tolerance::CELL_RELATIVE_TOLERANCE,
+                    crate::tolerance::CELL_ABSOLUTE_TOLERANCE,
                 ),
                 None,
             )

@@ -213,6 +213,6 @@ pub fn resolve_seed(seed: Option<u64>) -> Result<u64, String> {
             .trim()
             .parse()
             .map_err(|_| format!("MFH_SEED={text:?} is not an unsigned integer")),
-        Err(_) => Ok(crate::oracle::chi2::DEFAULT_SEED),
+        Err(_) => Ok(crate::audit::DEFAULT_SEED),
     }
 }

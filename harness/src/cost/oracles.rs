@@ -185,7 +185,7 @@ pub fn chi2_power(quick: bool, seed: u64, timed: bool) -> Quantity {
                 &|u| sampler.sample_wm(u),
                 &pdf,
                 &config,
-                crate::oracle::chi2::CELL_RELATIVE_TOLERANCE,
+                crate::tolerance::CELL_RELATIVE_TOLERANCE,
                 Some(&lobe),
             );
             (r, start.elapsed().as_secs_f64())

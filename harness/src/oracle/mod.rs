@@ -11,6 +11,7 @@ pub mod lobe;
 pub mod monte_carlo;
 pub mod precise;
 pub mod quadrature;
+pub mod smith_lambda;
 pub mod student_t;
 pub mod visible_moments;
 

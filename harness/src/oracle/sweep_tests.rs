@@ -4,10 +4,11 @@
 //! ([`lobe::measure`]); a sampler of α off by 5 % still fails. The CI subset is the extremes
 //! (α = 1e-4 and 2 isotropic, and GGX 1e-4 : 1e-2); `MFH_EXTENSIVE=1` runs all 36.
 
-use super::chi2::{chi2_test_in, Chi2Config, Verdict, CELL_RELATIVE_TOLERANCE};
+use super::chi2::{chi2_test_in, Chi2Config, Verdict};
 use super::ks::{ks_test_lobe, KsConfig, Marginal};
 use super::lobe::{self, Lobe};
 use super::quadrature::{integrate_hemisphere_lobe, Accuracy};
+use crate::tolerance::CELL_RELATIVE_TOLERANCE;
 use mfh_reference::{Model, ModelSpec};
 use rayon::prelude::*;
 use std::time::Instant;

@@ -6,10 +6,11 @@
 //! (at level [`UNIFORMITY_LEVEL`]).
 
 use crate::check::Profile;
-use crate::oracle::chi2::{chi2_test_batch_in, Chi2Config, CELL_RELATIVE_TOLERANCE};
+use crate::oracle::chi2::{chi2_test_batch_in, Chi2Config};
 use crate::oracle::ks::ks_p_value;
 use crate::oracle::ks::{ks_statistic, ks_test_lobe, KsConfig, Marginal};
 use crate::oracle::lobe;
+use crate::tolerance::CELL_RELATIVE_TOLERANCE;
 use mfh_reference::{ModelSpec, Vec3};
 use rayon::prelude::*;
 use serde::Serialize;

@@ -17,10 +17,10 @@ pub mod catalog;
 pub mod mutant;
 pub mod power;
 
+use crate::audit::DEFAULT_SEED;
 use crate::audit::{run_plan, AuditOptions};
 use crate::check::Profile;
 use crate::gate::Audit;
-use crate::oracle::chi2::DEFAULT_SEED;
 use crate::record::{CheckRecord, Verdict};
 use crate::subject::{spec_width, Hints};
 use catalog::{Entry, Route, CATALOG};

@@ -22,15 +22,16 @@ mod seed004;
 
 pub use scope::{Concern, Effect, Scope, STUDENT};
 
-use super::smith::lambda_oracle;
 use super::{applied, covers, Planned};
 use crate::check::Check;
 use crate::oracle::quadrature::{
     integrate, integrate_cap, integrate_hemisphere, integrate_line, integrate_pieces,
     integrate_upper, Accuracy,
 };
+use crate::oracle::smith_lambda::lambda_oracle;
 use crate::oracle::Estimate;
 use crate::record::{relative_error, CheckRecord, Measured, OracleValue, Verdict};
+use crate::subject::Subject;
 use crate::tolerance::{Tolerance, ERRATUM, ERRATUM_ASYMPTOTIC, ERRATUM_VISIBLE_MOMENTS};
 use mfh_reference::geometry::{dot, from_spherical};
 use mfh_reference::ndf::gtr::Gtr;

@@ -123,7 +123,7 @@ fn e000_5() -> Result<Shown, String> {
 fn pl_lambda_oracle(w: Vec3) -> Result<(Box<dyn Model>, Estimate), String> {
     let spec = pl_spec();
     let m = build(spec.clone())?;
-    let o = lambda_oracle(m.as_ref(), w);
+    let o = lambda_oracle(&Subject::borrowed(m.as_ref()), w);
     Ok((m, o))
 }
 

@@ -48,12 +48,8 @@ fn std_route(route: &'static str, gamma: f64) -> Result<Shown, String> {
     let corrected = smith
         .lambda_route(w, corrected_route)
         .map_err(|e| e.to_string())?;
-    Ok(Shown::new(
-        printed,
-        corrected,
-        lambda_oracle(m.as_ref(), w),
-        &ERRATUM,
-    ))
+    let oracle = lambda_oracle(&Subject::borrowed(m.as_ref()), w);
+    Ok(Shown::new(printed, corrected, oracle, &ERRATUM))
 }
 
 /// 001-3: the fraction of sampled normals with m_x < 0 over a midpoint grid of u (the NDF is

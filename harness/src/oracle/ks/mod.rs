@@ -53,11 +53,12 @@ pub use table::{
     marginal_cdf, marginal_cdf_batch, marginal_cdf_lobe, marginal_cdf_lobe_batch, CdfTable,
 };
 
-use crate::oracle::chi2::{BatchSampler, OutsideDomain, Verdict, CHUNK, MASS_TOLERANCE};
+use crate::oracle::chi2::{BatchSampler, OutsideDomain, Verdict, CHUNK};
 use crate::oracle::domain::{validate, DomainError};
 use crate::oracle::lobe::{self, Lobe};
 use crate::oracle::quadrature::Accuracy;
 use crate::random::stream;
+use crate::tolerance::MASS_TOLERANCE;
 use mfh_reference::geometry::Vec3;
 use mfh_reference::trig;
 use mfh_reference::NormalSampler;

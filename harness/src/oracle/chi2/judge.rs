@@ -1,0 +1,126 @@
+//! The verdict of the chi-square test from its observed and expected counts: the sanity
+//! failures first, then the pooled statistic and its p-value against α.
+
+use super::{Chi2Config, Chi2Result, Expected, Failure, Observed, OutsideDomain, Verdict};
+use crate::oracle::domain::{DomainError, HemisphereGrid};
+use crate::tolerance::{MASS_TOLERANCE, MIN_EXPECTED};
+
+/// The verdict from the observed and expected counts.
+pub(super) fn judge(
+    config: &Chi2Config,
+    grid: HemisphereGrid,
+    observed: Observed,
+    expected: Expected,
+    sampling_seconds: f64,
+    integration_seconds: f64,
+) -> Chi2Result {
+    let n = config.samples as f64;
+    let mut result = Chi2Result {
+        resolution: grid.rows(),
+        statistic: f64::NAN,
+        dof: 0,
+        p_value: 0.0,
+        alpha: config.alpha,
+        pooled_cells: 0,
+        samples: config.samples,
+        seed: config.seed,
+        verdict: Verdict::Fail,
+        reason: None,
+        expected_mass: expected.total,
+        expected_error_bound: expected.error_bound * n,
+        sampling_seconds,
+        integration_seconds,
+        expected: expected.mass.iter().map(|m| m * n).collect(),
+        observed: observed.counts,
+    };
+    result.reason = sanity(&result, &expected, observed.outside, observed.first_outside);
+    if result.reason.is_some() {
+        return result;
+    }
+    let (statistic, bins, pooled) = pooled_statistic(&result.observed, &result.expected);
+    result.pooled_cells = pooled;
+    if bins < 2 {
+        result.reason = Some(Failure::TooFewBins { bins });
+        return result;
+    }
+    result.statistic = statistic;
+    result.dof = bins - 1;
+    result.p_value =
+        statrs::function::gamma::checked_gamma_ur(0.5 * result.dof as f64, 0.5 * statistic)
+            .unwrap_or(f64::NAN);
+    if result.p_value >= config.alpha {
+        result.verdict = Verdict::Pass;
+    } else {
+        result.reason = Some(Failure::Rejected {
+            p_value: result.p_value,
+            alpha: config.alpha,
+        });
+    }
+    result
+}
+
+/// The sanity failures, in order: samples outside the domain, invalid or off mass, samples in
+/// zero-pdf cells.
+fn sanity(
+    result: &Chi2Result,
+    expected: &Expected,
+    outside: u64,
+    first_outside: Option<(u64, DomainError)>,
+) -> Option<Failure> {
+    if let Some((index, error)) = first_outside {
+        return Some(Failure::OutsideDomain(OutsideDomain {
+            index,
+            error,
+            count: outside,
+        }));
+    }
+    if let Some((cell, &mass)) = expected
+        .mass
+        .iter()
+        .enumerate()
+        .find(|(_, m)| !(m.is_finite() && **m >= 0.0))
+    {
+        return Some(Failure::InvalidMass { cell, mass });
+    }
+    if !((expected.total - 1.0).abs() <= MASS_TOLERANCE) {
+        return Some(Failure::MassOff {
+            mass: expected.total,
+            error_bound: expected.error_bound,
+            tolerance: MASS_TOLERANCE,
+        });
+    }
+    result
+        .observed
+        .iter()
+        .zip(&expected.mass)
+        .enumerate()
+        .find(|(_, (&o, &m))| m == 0.0 && o > 0)
+        .map(|(cell, (&observed, _))| Failure::ZeroPdfCell { cell, observed })
+}
+
+/// Σ (O − E)² / E over the pooled bins; returns (statistic, bins, pooled cells).
+pub(super) fn pooled_statistic(observed: &[u64], expected: &[f64]) -> (f64, usize, usize) {
+    let mut bins: Vec<(f64, f64)> = Vec::with_capacity(expected.len());
+    let (mut pool_o, mut pool_e, mut pooled) = (0.0, 0.0, 0);
+    for (&o, &e) in observed.iter().zip(expected) {
+        if e < MIN_EXPECTED {
+            pool_o += o as f64;
+            pool_e += e;
+            pooled += 1;
+        } else {
+            bins.push((o as f64, e));
+        }
+    }
+    if pool_e >= MIN_EXPECTED || (bins.is_empty() && pool_e > 0.0) {
+        bins.push((pool_o, pool_e));
+    } else if pool_e > 0.0 {
+        let smallest = bins
+            .iter_mut()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("bins is not empty");
+        smallest.0 += pool_o;
+        smallest.1 += pool_e;
+    }
+    let statistic = bins.iter().map(|(o, e)| (o - e) * (o - e) / e).sum();
+    (statistic, bins.len(), pooled)
+}

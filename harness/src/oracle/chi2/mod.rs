@@ -1,0 +1,333 @@
+//! Chi-square goodness-of-fit test of a normal sampler against its pdf over the (φ, cos θ)
+//! grid of the upper hemisphere (ARCHITECTURE.md, "Checks and records"): the test entry points
+//! and their result types here; the binning in `binning.rs`, the expected masses in
+//! `expected.rs`, the verdict in `judge.rs`; the numeric tolerances in `tolerance/chi2.rs`.
+//!
+//! Procedure:
+//!
+//! 1. **Observed counts.** `samples` normals are drawn with `u` from the counter-based stream
+//!    ([`crate::random`]: ChaCha8 keyed by the seed, stream id = chunk index) of each fixed
+//!    chunk of [`CHUNK`] sample indices, in blocks (uniforms → the model's batch sampler →
+//!    cells), and binned into the [`HemisphereGrid`] of the given resolution (R z-rows × 2R
+//!    φ-columns) by a [`CellFinder`] (no atan2 per sample), in parallel (rayon). Counts are
+//!    integers summed per chunk, so they are identical whatever the thread count or
+//!    scheduling, and the batch path counts what the scalar path counts.
+//! 2. **Expected counts.** The pdf's lobe is measured from the pdf alone
+//!    ([`crate::oracle::lobe`]); every cell is integrated in (φ, θ), cut where the lobe varies,
+//!    by adaptive G7/K15 product cubature ([`crate::oracle::cubature`]) with a per-cell error
+//!    bound ([`expected_mass_in`]); the total mass and the summed error bound are reported.
+//! 3. **Sanity failures first** (no p-value): a sample outside the domain (non-finite, non-unit,
+//!    below the horizon), a total pdf mass off from 1 by more than [`MASS_TOLERANCE`], a
+//!    non-finite or negative cell mass, a sample in a cell of zero expected count.
+//! 4. **Pooling.** Cells with expected count < [`MIN_EXPECTED`] are pooled into one bin; if that
+//!    bin's expected count is itself < [`MIN_EXPECTED`], it is merged into the regular bin of
+//!    least expected count (so a remainder of, say, 0.01 expected cannot dominate the
+//!    statistic). dof = bins − 1.
+//! 5. **p-value** Q(dof/2, χ²/2), the upper regularized incomplete gamma function (accurate in
+//!    the far tail, unlike 1 − CDF); the test rejects when p < α.
+//!
+//! [`MASS_TOLERANCE`]: crate::tolerance::MASS_TOLERANCE
+//! [`MIN_EXPECTED`]: crate::tolerance::MIN_EXPECTED
+//! [`CellFinder`]: crate::oracle::domain::CellFinder
+//! [`KINKED_CELL_RELATIVE_TOLERANCE`]: crate::tolerance::KINKED_CELL_RELATIVE_TOLERANCE
+//! [`CELL_RELATIVE_TOLERANCE`]: crate::tolerance::CELL_RELATIVE_TOLERANCE
+//! [`CELL_ABSOLUTE_TOLERANCE`]: crate::tolerance::CELL_ABSOLUTE_TOLERANCE
+
+mod binning;
+mod expected;
+mod judge;
+
+pub use binning::{observe, observe_batch, observe_blocks, Observed, CHUNK};
+pub use expected::{
+    expected_mass, expected_mass_in, expected_mass_in_batch, expected_mass_to, Expected,
+};
+
+use crate::oracle::domain::{DomainError, HemisphereGrid};
+use crate::oracle::lobe::{self, Lobe};
+use crate::tolerance::CELL_RELATIVE_TOLERANCE;
+use binning::scalar_batch;
+use judge::judge;
+#[cfg(test)]
+use judge::pooled_statistic;
+use mfh_reference::geometry::Vec3;
+use mfh_reference::NormalSampler;
+use std::time::Instant;
+
+/// The parameters of one chi-square test.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Chi2Config {
+    /// R: the grid has R z-rows and 2R φ-columns.
+    pub resolution: usize,
+    /// The number of samples drawn.
+    pub samples: u64,
+    /// The seed of the random streams.
+    pub seed: u64,
+    /// The significance level: the test fails when p < `alpha`.
+    pub alpha: f64,
+}
+
+/// The outcome of a test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// Consistent with the pdf at level α.
+    Pass,
+    /// A sanity failure, or p < α.
+    Fail,
+}
+
+/// Samples outside the upper hemisphere (a sanity failure of the chi-square and KS tests):
+/// how many, and the first of them (in the seeded sequence) with what is wrong with it.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("{count} samples outside the domain; the first, sample {index}: {error}")]
+pub struct OutsideDomain {
+    /// Index of the first offending sample (in the seeded sequence).
+    pub index: u64,
+    /// What is wrong with it.
+    pub error: DomainError,
+    /// How many samples were outside.
+    pub count: u64,
+}
+
+/// Why a test failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Failure {
+    /// Samples lie outside the upper hemisphere.
+    #[error(transparent)]
+    OutsideDomain(OutsideDomain),
+    /// The pdf does not integrate to 1 over the hemisphere.
+    #[error("pdf mass {mass} (± {error_bound:.1e}) differs from 1 by more than {tolerance}")]
+    MassOff {
+        /// The integrated mass.
+        mass: f64,
+        /// Its error bound.
+        error_bound: f64,
+        /// The allowed difference.
+        tolerance: f64,
+    },
+    /// The pdf integrates to a negative or non-finite mass over a cell.
+    #[error("pdf mass over cell {cell} is {mass}")]
+    InvalidMass {
+        /// The cell (row-major, row 0 at the horizon).
+        cell: usize,
+        /// Its mass.
+        mass: f64,
+    },
+    /// Samples landed in a cell where the pdf is zero.
+    #[error("{observed} samples in cell {cell}, where the pdf is zero")]
+    ZeroPdfCell {
+        /// The first such cell.
+        cell: usize,
+        /// The samples in it.
+        observed: u64,
+    },
+    /// Fewer than two bins after pooling: nothing to test.
+    #[error("only {bins} bin(s) after pooling; more samples or a finer grid are needed")]
+    TooFewBins {
+        /// Bins after pooling.
+        bins: usize,
+    },
+    /// The distribution of samples differs from the pdf.
+    #[error("p-value {p_value:.3e} below α = {alpha:.3e}")]
+    Rejected {
+        /// The p-value.
+        p_value: f64,
+        /// The level.
+        alpha: f64,
+    },
+}
+
+/// A batch sampler: writes the normal of u[i] into m[i].
+pub type BatchSampler<'a> = dyn Fn(&[[f64; 2]], &mut [Vec3]) + Sync + 'a;
+
+/// A batch density: writes pdf(m[i]) into out[i].
+pub type BatchPdf<'a> = dyn Fn(&[Vec3], &mut [f64]) + Sync + 'a;
+
+/// The result of a chi-square test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Chi2Result {
+    /// The grid resolution R (R z-rows × 2R φ-columns).
+    pub resolution: usize,
+    /// The χ² statistic (NaN after a sanity failure).
+    pub statistic: f64,
+    /// Degrees of freedom: bins − 1 (0 after a sanity failure).
+    pub dof: usize,
+    /// Q(dof/2, χ²/2) (0 after a sanity failure).
+    pub p_value: f64,
+    /// The level the verdict was taken at.
+    pub alpha: f64,
+    /// Cells pooled because their expected count was < [`MIN_EXPECTED`].
+    pub pooled_cells: usize,
+    /// Samples drawn.
+    pub samples: u64,
+    /// The seed of the random streams.
+    pub seed: u64,
+    /// Pass or fail.
+    pub verdict: Verdict,
+    /// Why it failed, if it did.
+    pub reason: Option<Failure>,
+    /// The integrated pdf mass over the hemisphere.
+    pub expected_mass: f64,
+    /// The error bound of the expected counts (mass bound × samples).
+    pub expected_error_bound: f64,
+    /// Wall time of sampling and binning, seconds.
+    pub sampling_seconds: f64,
+    /// Wall time of the expected-count integration, seconds.
+    pub integration_seconds: f64,
+    /// Observed counts per cell (row-major, row 0 at the horizon).
+    pub observed: Vec<u64>,
+    /// Expected counts per cell (mass × samples).
+    pub expected: Vec<f64>,
+}
+
+impl Chi2Result {
+    /// Samples per second of sampling and binning.
+    pub fn samples_per_second(&self) -> f64 {
+        self.samples as f64 / self.sampling_seconds
+    }
+}
+
+/// Tests the sampler `sample` against the density `pdf` (with respect to solid angle).
+/// `config.resolution` of 0 is treated as 1.
+pub fn chi2_test<S, P>(sample: &S, pdf: &P, config: &Chi2Config) -> Chi2Result
+where
+    S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
+    P: Fn(Vec3) -> f64 + Sync + ?Sized,
+{
+    chi2_test_in(sample, pdf, config, CELL_RELATIVE_TOLERANCE, None)
+}
+
+/// [`chi2_test`] with the expected counts integrated to the per-cell relative tolerance
+/// `cell_relative` (e.g. [`KINKED_CELL_RELATIVE_TOLERANCE`]) about a given lobe (e.g. measured
+/// once from the model's D by [`lobe::measure`]); `None` measures it from `pdf`.
+pub fn chi2_test_in<S, P>(
+    sample: &S,
+    pdf: &P,
+    config: &Chi2Config,
+    cell_relative: f64,
+    lobe: Option<&Lobe>,
+) -> Chi2Result
+where
+    S: Fn([f64; 2]) -> Vec3 + Sync + ?Sized,
+    P: Fn(Vec3) -> f64 + Sync + ?Sized,
+{
+    chi2_test_batch_in(
+        &|u: &[[f64; 2]], m: &mut [Vec3]| scalar_batch(sample, u, m),
+        pdf,
+        config,
+        cell_relative,
+        lobe,
+        &[],
+    )
+}
+
+/// [`chi2_test_in`] with a batch sampler (`sample(u, m)` sets `m[i]` to the normal of `u[i]`,
+/// as [`observe_batch`] takes it): the same result as the scalar form of the sampler. The cells
+/// are also cut at `theta_kinks`, the polar angles where the density has a kink for every
+/// azimuth (a reference model's registry knows them, as for [`chi2_test_batches_cut`]): the
+/// same masses to the same tolerance, without the cubature subdividing the kinks.
+pub fn chi2_test_batch_in<S, P>(
+    sample: &S,
+    pdf: &P,
+    config: &Chi2Config,
+    cell_relative: f64,
+    lobe: Option<&Lobe>,
+    theta_kinks: &[f64],
+) -> Chi2Result
+where
+    S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
+    P: Fn(Vec3) -> f64 + Sync + ?Sized,
+{
+    timed(
+        config,
+        |grid| observe_batch(sample, grid, config.samples, config.seed),
+        |grid| match lobe {
+            Some(lobe) => expected_mass_in(pdf, grid, cell_relative, lobe, theta_kinks),
+            None => expected_mass_to(pdf, grid, cell_relative, theta_kinks),
+        },
+    )
+}
+
+/// The test on `config`'s grid: the observed counts (`observe`), then the expected masses
+/// (`expect`), each timed, judged by [`judge`].
+fn timed(
+    config: &Chi2Config,
+    observe: impl FnOnce(HemisphereGrid) -> Observed,
+    expect: impl FnOnce(HemisphereGrid) -> Expected,
+) -> Chi2Result {
+    let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
+    let t = Instant::now();
+    let observed = observe(grid);
+    let sampling_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let expected = expect(grid);
+    let integration_seconds = t.elapsed().as_secs_f64();
+    judge(
+        config,
+        grid,
+        observed,
+        expected,
+        sampling_seconds,
+        integration_seconds,
+    )
+}
+
+/// The chi-square test with a batch sampler and a batch density (an external model: a round
+/// trip per batch), the expected masses integrated to the per-cell (relative, absolute)
+/// `cell_tolerance`: with ([`CELL_RELATIVE_TOLERANCE`] or the kinked one,
+/// [`CELL_ABSOLUTE_TOLERANCE`]) the same result as [`chi2_test_batch_in`] with the scalar
+/// density. With no
+/// `lobe`, it is measured from the density ([`lobe::measure_with_batch`]).
+pub fn chi2_test_batches_in(
+    sample: &BatchSampler<'_>,
+    pdf: &BatchPdf<'_>,
+    config: &Chi2Config,
+    cell_tolerance: (f64, f64),
+    lobe: Option<&Lobe>,
+) -> Chi2Result {
+    chi2_test_batches_cut(sample, pdf, config, cell_tolerance, lobe, &[])
+}
+
+/// [`chi2_test_batches_in`] with the cells also cut at `theta_kinks`, the polar angles where
+/// the density has a kink for every azimuth (a reference model's registry knows them, e.g. a
+/// piecewise-linear profile's breakpoints): the same masses to the same tolerance, at a
+/// fraction of the cost (the cubature no longer subdivides the kinks).
+pub fn chi2_test_batches_cut(
+    sample: &BatchSampler<'_>,
+    pdf: &BatchPdf<'_>,
+    config: &Chi2Config,
+    cell_tolerance: (f64, f64),
+    lobe: Option<&Lobe>,
+    theta_kinks: &[f64],
+) -> Chi2Result {
+    timed(
+        config,
+        |grid| observe_blocks(sample, grid, config.samples, config.seed, CHUNK as usize),
+        |grid| match lobe {
+            Some(lobe) => expected_mass_in_batch(pdf, grid, cell_tolerance, lobe, theta_kinks),
+            None => {
+                let lobe = lobe::measure_with_batch(pdf, &lobe::Options::default());
+                let mut e = expected_mass_in_batch(pdf, grid, cell_tolerance, &lobe, theta_kinks);
+                e.evaluations += lobe.evaluations;
+                e
+            }
+        },
+    )
+}
+
+/// Tests a model's `sample_wm` against its own `pdf_wm`.
+/// Draws through [`NormalSampler::sample_wm_batch`] (the scalar method for models that do not
+/// override it): the same counts as through `sample_wm`.
+pub fn chi2_test_sampler(sampler: &dyn NormalSampler, config: &Chi2Config) -> Chi2Result {
+    chi2_test_batch_in(
+        &|u: &[[f64; 2]], m: &mut [Vec3]| sampler.sample_wm_batch(u, m),
+        &|m| sampler.pdf_wm(m),
+        config,
+        CELL_RELATIVE_TOLERANCE,
+        None,
+        &[],
+    )
+}
+
+#[cfg(test)]
+mod tests;
