@@ -110,12 +110,12 @@ pub struct AuditReport {
     /// The record schema version.
     pub schema_version: u32,
     /// mfh's version.
-    #[serde(deserialize_with = "crate::readback::interned")]
-    pub mfh_version: crate::readback::StaticStr,
+    #[serde(deserialize_with = "crate::record_serde::interned")]
+    pub mfh_version: crate::record_serde::StaticStr,
     /// The scene's name.
     pub scene: String,
     /// The profile.
-    #[serde(deserialize_with = "crate::readback::profile")]
+    #[serde(deserialize_with = "crate::check::deserialize_profile")]
     pub profile: Profile,
     /// The audit seed.
     pub seed: u64,
@@ -285,7 +285,7 @@ pub fn check_seed(seed: u64, planned: &PlannedCheck<'_>) -> u64 {
 /// to standard error with its time), records in plan order, statistical verdicts at the
 /// Šidák-corrected level.
 ///
-/// Scheduling: the checks are started longest first by [`crate::shard::estimated_cost`]
+/// Scheduling: the checks are started longest first by [`crate::estimate::estimated_cost`]
 /// (ties in plan order), each thread taking the next from one queue, so that a long check does
 /// not start last and run alone while the other threads are idle (rayon's split of the plan
 /// into contiguous halves did that). Records do not depend on the order: each check has its
@@ -296,7 +296,7 @@ pub fn run_plan(
 ) -> (Vec<CheckRecord>, usize, f64) {
     let trace = std::env::var_os("MFH_TRACE").is_some();
     let (done, failures) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    let costs: Vec<f64> = plan.iter().map(crate::shard::estimated_cost).collect();
+    let costs: Vec<f64> = plan.iter().map(crate::estimate::estimated_cost).collect();
     let mut order: Vec<usize> = (0..plan.len()).collect();
     order.sort_by(|&a, &b| costs[b].total_cmp(&costs[a]));
     let next = AtomicUsize::new(0);

@@ -11,6 +11,7 @@ pub mod chi2_run;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod cost;
+pub mod estimate;
 pub mod eval;
 pub mod external;
 pub mod gate;
@@ -27,6 +28,7 @@ pub mod record;
 pub mod record_serde;
 pub mod report;
 pub mod scene;
+pub mod scene_file;
 pub mod selftest;
 pub mod shard;
 pub mod subject;

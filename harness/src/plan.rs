@@ -147,10 +147,49 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
     }
     let documents: Vec<&str> = documents.into_iter().collect();
     let used = format!("the scene uses seed(s) {}", documents.join(", "));
-    let scope = errata::Scope::of_scene(scene);
+    let scope = errata_scope(scene);
     out.extend(errata::plan(&scope, &used));
     out.extend(claims::plan(&scope, &used));
     out
+}
+
+/// The errata scope of a scene: its materials' families and what they and the scene do (the
+/// errata and claims planned are those that concern it).
+pub fn errata_scope(scene: &Scene) -> errata::Scope {
+    let mut s = errata::Scope::default();
+    for material in &scene.materials {
+        if let Ok(model) = material.model.build() {
+            s.families.insert(model.family());
+        }
+        if material.masking.is_some() {
+            s.effects.insert(errata::Effect::Masking);
+        }
+        match material.sampling {
+            Some(Sampling::Normals) => {
+                s.effects.insert(errata::Effect::SampleNormals);
+            }
+            Some(Sampling::VisibleNormals) => {
+                s.effects.insert(errata::Effect::SampleVisible);
+            }
+            Some(Sampling::PseudoVnis) => {
+                // Algorithm 1 of §7.2 samples normals (§6) on some branches.
+                s.effects.insert(errata::Effect::PseudoVnis);
+                s.effects.insert(errata::Effect::SampleNormals);
+            }
+            None => {}
+        }
+    }
+    if scene.filtering.gaussian_slopes {
+        s.effects.insert(errata::Effect::GaussianSlopes);
+    }
+    if scene.lighting.spherical_gaussians {
+        s.effects.insert(errata::Effect::SphericalGaussians);
+    }
+    if scene.lighting.anisotropic_spherical_gaussians {
+        s.effects
+            .insert(errata::Effect::AnisotropicSphericalGaussians);
+    }
+    s
 }
 
 /// One line per planned check: id, model, case and why (for `mfh plan`).

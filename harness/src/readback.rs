@@ -1,21 +1,10 @@
 //! Reading `report.json` back (for `mfh merge` and `--baseline`): the schema-version gate and
-//! the two serde helpers the record types need to deserialize what they serialize.
-//!
-//! - Non-finite numbers: serde_json writes NaN and ±∞ as `null`; [`nullable_f64`] reads `null`
-//!   back as NaN, which serializes to `null` again, so a report read back and written again is
-//!   byte-identical (the sign of an infinite error is lost; both are "not finite").
-//! - `&'static str` fields (tolerance names and reasons, the oracle's uncertainty kind, the
-//!   mfh version) are built from constants by the checks; [`interned`] maps a read string to a
-//!   `&'static str` through a process-wide interner, so each distinct string is allocated once
-//!   (bounded by the distinct strings of the reports read, a few hundred), instead of changing
-//!   the field types every check constructs.
+//! the parse into an `AuditReport` (the serde helpers the record types need to read back what
+//! they write are in `record_serde.rs`).
 
 use crate::audit::AuditReport;
 use crate::record::SCHEMA_VERSION;
-use serde::{Deserialize, Deserializer};
 use std::path::Path;
-
-pub use crate::record_serde::{intern, interned, nullable_f64, StaticStr};
 
 /// Why a report could not be read back.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -90,24 +79,14 @@ pub fn parse_report(text: &str, origin: &str) -> Result<AuditReport, ReadError> 
     })
 }
 
-/// Deserializes a profile from its command-line name.
-pub fn profile<'de, D: Deserializer<'de>>(d: D) -> Result<crate::check::Profile, D::Error> {
-    let name = String::deserialize(d)?;
-    crate::check::Profile::from_name(&name).ok_or_else(|| {
-        serde::de::Error::custom(format!(
-            "profile `{name}` is not one of ci, quick, standard, thorough"
-        ))
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn interning_returns_one_allocation_per_string() {
-        let a = intern(&String::from("closed_form"));
-        let b = intern("closed_form");
+        let a = crate::record_serde::intern(&String::from("closed_form"));
+        let b = crate::record_serde::intern("closed_form");
         assert!(std::ptr::eq(a, b));
         assert_eq!(a, "closed_form");
     }

@@ -1,6 +1,15 @@
 //! The serde helpers the record types need to read back what they write (`report.json`,
 //! `mfh merge`, `--baseline`): `null` for non-finite numbers, and `&'static str` fields read
-//! through a process-wide interner (see `readback.rs` for the reasons).
+//! through a process-wide interner.
+//!
+//! - Non-finite numbers: serde_json writes NaN and ±∞ as `null`; [`nullable_f64`] reads `null`
+//!   back as NaN, which serializes to `null` again, so a report read back and written again is
+//!   byte-identical (the sign of an infinite error is lost; both are "not finite").
+//! - `&'static str` fields (tolerance names and reasons, the oracle's uncertainty kind, the
+//!   mfh version) are built from constants by the checks; [`interned`] maps a read string to a
+//!   `&'static str` through a process-wide interner, so each distinct string is allocated once
+//!   (bounded by the distinct strings of the reports read, a few hundred), instead of changing
+//!   the field types every check constructs.
 
 use serde::{Deserialize, Deserializer};
 use std::collections::BTreeSet;

@@ -5,7 +5,6 @@
 use mfh_reference::{Masking, ModelSpec};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
-use std::path::Path;
 
 /// The embedded default scene: every model of the five source documents, every effect on.
 pub const DEFAULT_SCENE: &str = include_str!("../scenes/default.json");
@@ -329,48 +328,6 @@ impl Scene {
         Ok(scene)
     }
 
-    /// Reads a scene file of at most [`MAX_SCENE_BYTES`] (read bounded: a larger file or an
-    /// endless stream is refused after the limit): `.xml` is a Mitsuba 3 scene
-    /// ([`crate::mitsuba`]), anything else mfh's JSON.
-    pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        use std::io::Read;
-        let unreadable = |e: std::io::Error| SceneError::Unreadable {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        };
-        let file = std::fs::File::open(path).map_err(unreadable)?;
-        let mut bytes = Vec::new();
-        file.take(MAX_SCENE_BYTES + 1)
-            .read_to_end(&mut bytes)
-            .map_err(unreadable)?;
-        if bytes.len() as u64 > MAX_SCENE_BYTES {
-            return Err(SceneError::TooLarge {
-                path: path.display().to_string(),
-                limit: MAX_SCENE_BYTES,
-            });
-        }
-        let text = String::from_utf8(bytes).map_err(|e| SceneError::Unreadable {
-            path: path.display().to_string(),
-            message: format!(
-                "not UTF-8 text (invalid byte at offset {})",
-                e.utf8_error().valid_up_to()
-            ),
-        })?;
-        let is_xml = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
-        if is_xml {
-            #[cfg(feature = "mitsuba")]
-            return crate::mitsuba::parse(&text, &path.display().to_string());
-            #[cfg(not(feature = "mitsuba"))]
-            return Err(SceneError::FeatureOff {
-                path: path.display().to_string(),
-                feature: "mitsuba",
-            });
-        }
-        Scene::parse(&text, &path.display().to_string())
-    }
-
     /// Checks the size of a plan of this scene against [`MAX_PLAN_CHECKS`]; `origin` names the
     /// scene and `profile` the profile in the message.
     pub fn check_plan_size(checks: usize, origin: &str, profile: &str) -> Result<(), SceneError> {
@@ -419,6 +376,7 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::Path;
 
     #[test]
     fn the_default_scene_parses_and_covers_every_family() {

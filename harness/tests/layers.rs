@@ -1,22 +1,54 @@
 //! The layering of ARCHITECTURE.md, enforced: data flows models → oracles → checks → records →
-//! sinks, and no module imports a layer above its own. Also: only the CLI knows clap, and
-//! checks and oracles do no file I/O.
+//! sinks, and no module imports a layer above its own. Also: every module named here exists and
+//! every module has a layer; no circle of imports between top-level modules or between the
+//! sinks of `report/`; only the CLI knows clap; checks and oracles do no file I/O.
+//!
+//! Every non-test line of every file is read: `#[cfg(test)]` items (brace-matched) and
+//! comments are dropped, nothing else.
 
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-/// The layer of each top-level module of the harness (lower imports nothing higher).
+/// The layers of ARCHITECTURE.md ("Data flows one way"), lowest first.
+const LAYERS: &[(u32, &[&str])] = &[
+    (
+        0,
+        &["record", "record_serde", "tolerance", "random", "messages"],
+    ),
+    (1, &["oracle"]),
+    (2, &["check", "subject"]),
+    (
+        3,
+        &[
+            "scene",
+            "scene_file",
+            "mitsuba",
+            "plan",
+            "plan_table",
+            "estimate",
+        ],
+    ),
+    (
+        4,
+        &[
+            "audit", "gate", "external", "shard", "merge", "baseline", "cost", "chi2_run",
+            "readback", "selftest",
+        ],
+    ),
+    (5, &["report"]),
+    (6, &["cli", "eval", "main", "lib"]),
+];
+
+/// The layer of a top-level module of the harness.
 fn layer(module: &str) -> Option<u32> {
-    Some(match module {
-        "record" | "record_serde" | "tolerance" | "random" | "messages" => 0,
-        "oracle" => 1,
-        "check" | "subject" | "scene" | "mitsuba" => 2,
-        "plan" | "plan_table" => 3,
-        "audit" | "gate" | "external" | "shard" | "merge" | "baseline" | "cost" | "chi2_run"
-        | "readback" | "selftest" => 4,
-        "report" | "heatmap" => 5,
-        "cli" | "chi2_command" | "eval" | "main" | "lib" => 6,
-        _ => return None,
-    })
+    LAYERS
+        .iter()
+        .find(|(_, modules)| modules.contains(&module))
+        .map(|(l, _)| *l)
+}
+
+fn src() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
 }
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -30,9 +62,21 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// The non-test source files (test modules kept in their own files may reach anywhere).
+fn source_files() -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    rust_files(&src(), &mut files);
+    files.retain(|f| {
+        let name = f.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        name != "tests.rs" && !name.ends_with("_tests.rs")
+    });
+    files.sort();
+    files
+}
+
 /// The top-level module a source file belongs to.
-fn module_of(src: &Path, file: &Path) -> String {
-    let rel = file.strip_prefix(src).expect("under src");
+fn module_of(file: &Path) -> String {
+    let rel = file.strip_prefix(src()).expect("under src");
     let first = rel.components().next().expect("non-empty");
     first
         .as_os_str()
@@ -41,29 +85,136 @@ fn module_of(src: &Path, file: &Path) -> String {
         .to_string()
 }
 
-/// The source without `#[cfg(test)]` modules (tests may reach anywhere) and comments.
+/// The source without comments and without `#[cfg(test)]` items: after the attribute, the
+/// item runs to its matching closing brace (or to its `;` if it has no body). Braces in
+/// string and character literals are not counted.
 fn code(text: &str) -> String {
-    let cut = text.find("#[cfg(test)]").unwrap_or(text.len());
-    text[..cut]
+    let lines: Vec<&str> = text
         .lines()
-        .filter(|l| !l.trim_start().starts_with("//"))
-        .collect::<Vec<_>>()
-        .join("\n")
+        .map(|l| {
+            let t = l.trim_start();
+            if t.starts_with("//") {
+                ""
+            } else {
+                l
+            }
+        })
+        .collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < lines.len() {
+        if lines[i].trim() == "#[cfg(test)]" {
+            i += 1;
+            let mut depth = 0i64;
+            let mut opened = false;
+            while i < lines.len() {
+                let l = strip_literals(lines[i]);
+                depth += l.matches('{').count() as i64 - l.matches('}').count() as i64;
+                opened |= l.contains('{');
+                i += 1;
+                if (opened && depth <= 0) || (!opened && l.trim_end().ends_with(';')) {
+                    break;
+                }
+            }
+            continue;
+        }
+        out.push(lines[i]);
+        i += 1;
+    }
+    out.join("\n")
+}
+
+/// A line without its string and char literals and its trailing comment.
+fn strip_literals(line: &str) -> String {
+    let mut out = String::new();
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' => {
+                while let Some(d) = chars.next() {
+                    if d == '\\' {
+                        chars.next();
+                    } else if d == '"' {
+                        break;
+                    }
+                }
+            }
+            '\'' if matches!(chars.clone().nth(1), Some('\'')) => {
+                chars.next();
+                chars.next();
+            }
+            '/' if chars.peek() == Some(&'/') => break,
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+/// The identifiers that follow each occurrence of `prefix` in `text`.
+fn targets<'a>(text: &'a str, prefix: &'a str) -> impl Iterator<Item = String> + 'a {
+    text.match_indices(prefix).map(move |(i, _)| {
+        text[i + prefix.len()..]
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect()
+    })
+}
+
+/// The top-level modules a file imports (through `crate::`), its own excluded.
+fn imports(file: &Path) -> BTreeSet<String> {
+    let own = module_of(file);
+    let text = code(&std::fs::read_to_string(file).expect("readable"));
+    targets(&text, "crate::")
+        .filter(|t| *t != own && !t.is_empty())
+        .collect()
+}
+
+/// A circle in a directed graph, if there is one (depth-first search).
+fn find_cycle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
+    fn visit(
+        node: &str,
+        graph: &BTreeMap<String, BTreeSet<String>>,
+        state: &mut BTreeMap<String, u8>,
+        path: &mut Vec<String>,
+    ) -> Option<Vec<String>> {
+        state.insert(node.to_string(), 1);
+        path.push(node.to_string());
+        for next in graph.get(node).into_iter().flatten() {
+            match state.get(next.as_str()).copied().unwrap_or(0) {
+                1 => {
+                    let start = path.iter().position(|p| p == next).expect("on the path");
+                    let mut circle = path[start..].to_vec();
+                    circle.push(next.clone());
+                    return Some(circle);
+                }
+                0 => {
+                    if let Some(c) = visit(next, graph, state, path) {
+                        return Some(c);
+                    }
+                }
+                _ => {}
+            }
+        }
+        path.pop();
+        state.insert(node.to_string(), 2);
+        None
+    }
+    let mut state = BTreeMap::new();
+    for node in graph.keys() {
+        if state.get(node.as_str()).copied().unwrap_or(0) == 0 {
+            if let Some(c) = visit(node, graph, &mut state, &mut Vec::new()) {
+                return Some(c);
+            }
+        }
+    }
+    None
 }
 
 #[test]
 fn no_module_imports_a_layer_above_its_own() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
     let mut violations = Vec::new();
-    for file in &files {
-        // Test modules kept in their own files may reach anywhere, like `#[cfg(test)]` ones.
-        let name = file.file_name().and_then(|n| n.to_str()).unwrap_or("");
-        if name == "tests.rs" || name.ends_with("_tests.rs") {
-            continue;
-        }
-        let module = module_of(&src, file);
+    for file in &source_files() {
+        let module = module_of(file);
         let Some(own) = layer(&module) else {
             violations.push(format!(
                 "{}: module `{module}` has no layer",
@@ -71,13 +222,7 @@ fn no_module_imports_a_layer_above_its_own() {
             ));
             continue;
         };
-        let text = code(&std::fs::read_to_string(file).expect("readable"));
-        for (i, _) in text.match_indices("crate::") {
-            let rest = &text[i + "crate::".len()..];
-            let target: String = rest
-                .chars()
-                .take_while(|c| c.is_alphanumeric() || *c == '_')
-                .collect();
+        for target in imports(file) {
             if let Some(t) = layer(&target) {
                 if t > own {
                     violations.push(format!(
@@ -87,6 +232,7 @@ fn no_module_imports_a_layer_above_its_own() {
                 }
             }
         }
+        let text = code(&std::fs::read_to_string(file).expect("readable"));
         if own < 6 && text.contains("clap") {
             violations.push(format!("{}: only the CLI may use clap", file.display()));
         }
@@ -101,4 +247,84 @@ fn no_module_imports_a_layer_above_its_own() {
     violations.sort();
     violations.dedup();
     assert!(violations.is_empty(), "{violations:#?}");
+}
+
+#[test]
+fn every_module_of_the_table_exists_and_every_module_has_a_layer() {
+    let src = src();
+    for (_, modules) in LAYERS {
+        for m in *modules {
+            assert!(
+                src.join(format!("{m}.rs")).is_file() || src.join(m).is_dir(),
+                "the layer table names `{m}`, which is not a module of the harness"
+            );
+        }
+    }
+    for entry in std::fs::read_dir(&src).expect("src") {
+        let path = entry.expect("entry").path();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        if path.is_dir() || name.ends_with(".rs") {
+            let m = name.trim_end_matches(".rs");
+            assert!(layer(m).is_some(), "module `{m}` has no layer in layers.rs");
+        }
+    }
+}
+
+#[test]
+fn no_circle_of_imports_between_top_level_modules() {
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for file in &source_files() {
+        let module = module_of(file);
+        let entry = graph.entry(module).or_default();
+        entry.extend(imports(file).into_iter().filter(|t| layer(t).is_some()));
+    }
+    assert_eq!(
+        find_cycle(&graph),
+        None,
+        "a circle of imports between modules"
+    );
+}
+
+#[test]
+fn no_circle_of_imports_between_the_sinks() {
+    let report = src().join("report");
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    let mut files = Vec::new();
+    rust_files(&report, &mut files);
+    let names: BTreeSet<String> = files
+        .iter()
+        .map(|f| f.file_stem().unwrap().to_string_lossy().to_string())
+        .collect();
+    for file in &files {
+        let name = file.file_stem().unwrap().to_string_lossy().to_string();
+        if name == "mod" || name == "tests" || name.ends_with("_tests") {
+            continue;
+        }
+        let text = code(&std::fs::read_to_string(file).expect("readable"));
+        let used: BTreeSet<String> = targets(&text, "super::")
+            .chain(targets(&text, "crate::report::"))
+            .filter(|t| *t != name && t != "mod" && names.contains(t))
+            .collect();
+        graph.entry(name).or_default().extend(used);
+    }
+    assert_eq!(
+        find_cycle(&graph),
+        None,
+        "a circle of imports inside report/"
+    );
+}
+
+#[test]
+fn the_reader_drops_test_items_and_comments_only() {
+    let text = "use crate::a;\n#[cfg(test)]\nmod tests {\n    fn f() { let s = \"}\"; }\n    use crate::b;\n}\n// crate::c\nuse crate::d;\n#[cfg(test)]\nuse crate::e;\nfn g() {}\n";
+    let c = code(text);
+    assert!(c.contains("crate::a") && c.contains("crate::d") && c.contains("fn g"));
+    assert!(!c.contains("crate::b") && !c.contains("crate::c") && !c.contains("crate::e"));
+    let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    g.entry("a".into()).or_default().insert("b".into());
+    g.entry("b".into()).or_default().insert("a".into());
+    assert_eq!(
+        find_cycle(&g),
+        Some(vec!["a".to_string(), "b".into(), "a".into()])
+    );
 }

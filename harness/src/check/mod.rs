@@ -24,7 +24,7 @@ use crate::record::{
     relative_error, AppliedTolerance, CheckRecord, Measured, OracleValue, Verdict,
 };
 use crate::tolerance::Tolerance;
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 use serde_json::Value;
 
 pub use run::{need, Check, Missing, Outcome};
@@ -48,6 +48,16 @@ pub enum Profile {
 
 /// The incidence closest to grazing every profile checks: π/2 − 1e-6.
 pub const NEAR_GRAZING: f64 = std::f64::consts::FRAC_PI_2 - 1e-6;
+
+/// Deserializes a profile from its command-line name (`report.json` stores it so).
+pub fn deserialize_profile<'de, D: Deserializer<'de>>(d: D) -> Result<Profile, D::Error> {
+    let name = String::deserialize(d)?;
+    Profile::from_name(&name).ok_or_else(|| {
+        serde::de::Error::custom(format!(
+            "profile `{name}` is not one of ci, quick, standard, thorough"
+        ))
+    })
+}
 
 impl Profile {
     /// Incidence angles θ (radians) at which direction-dependent properties are checked,

@@ -1,7 +1,7 @@
 //! The accuracy-versus-time section of the HTML report and `cost.html` (rendered from
 //! cost.json): one Pareto plot and one table per quantity.
 
-use super::html::{escape, fmt_num, img, STYLE};
+use super::page::{escape, fmt_num, img, STYLE};
 use serde_json::Value;
 use std::fmt::Write as _;
 

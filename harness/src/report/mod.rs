@@ -11,7 +11,11 @@ pub mod html;
 pub mod json;
 pub mod junit;
 #[cfg(feature = "html")]
+pub mod page;
+#[cfg(feature = "html")]
 pub mod plot;
+#[cfg(feature = "html")]
+pub mod record_plots;
 #[cfg(feature = "html")]
 pub mod selftest_html;
 pub mod terminal;

@@ -575,7 +575,7 @@ pub fn pareto_svg(title: &str, points: &[(String, f64, f64)]) -> String {
                 svg,
                 "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{WIDTH}\" height=\"40\">\
                  <text x=\"8\" y=\"24\" font-family=\"sans-serif\" font-size=\"13\">{}</text></svg>",
-                super::html::escape(&e.to_string())
+                super::page::escape(&e.to_string())
             );
             svg
         }

@@ -3,7 +3,7 @@
 //! the detectable sampler distortion. Shares the audit page's style and helpers.
 
 use super::artefacts::model_name;
-use super::html::{escape, fmt_num, img, STYLE};
+use super::page::{escape, fmt_num, img, STYLE};
 use super::plot::{line_svg, Corner, LinePlot, PlotError, Series};
 use std::fmt::Write as _;
 

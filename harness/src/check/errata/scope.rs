@@ -1,10 +1,10 @@
 //! What a scene uses, for planning only the errata and claims that concern it (issue 13, "a
 //! scene plans only what its materials call for"): the model families of its materials and
-//! the effects it exercises. Each erratum and claim declares a [`Concern`]; it is planned when
+//! the effects it exercises (built from a scene by the planner, `plan::errata_scope`: checks
+//! know nothing of scenes). Each erratum and claim declares a [`Concern`]; it is planned when
 //! the scene uses one of its families (or it names none) and one of its effects (or it names
 //! none), and its reason says which.
 
-use crate::scene::{Sampling, Scene};
 use std::collections::BTreeSet;
 
 /// An effect a scene exercises.
@@ -100,43 +100,6 @@ impl Scope {
         .into_iter()
         .collect();
         Self { families, effects }
-    }
-
-    /// The scope of a scene: its materials' families and what they and the scene do.
-    pub fn of_scene(scene: &Scene) -> Self {
-        let mut s = Self::default();
-        for material in &scene.materials {
-            if let Ok(model) = material.model.build() {
-                s.families.insert(model.family());
-            }
-            if material.masking.is_some() {
-                s.effects.insert(Effect::Masking);
-            }
-            match material.sampling {
-                Some(Sampling::Normals) => {
-                    s.effects.insert(Effect::SampleNormals);
-                }
-                Some(Sampling::VisibleNormals) => {
-                    s.effects.insert(Effect::SampleVisible);
-                }
-                Some(Sampling::PseudoVnis) => {
-                    // Algorithm 1 of §7.2 samples normals (§6) on some branches.
-                    s.effects.insert(Effect::PseudoVnis);
-                    s.effects.insert(Effect::SampleNormals);
-                }
-                None => {}
-            }
-        }
-        if scene.filtering.gaussian_slopes {
-            s.effects.insert(Effect::GaussianSlopes);
-        }
-        if scene.lighting.spherical_gaussians {
-            s.effects.insert(Effect::SphericalGaussians);
-        }
-        if scene.lighting.anisotropic_spherical_gaussians {
-            s.effects.insert(Effect::AnisotropicSphericalGaussians);
-        }
-        s
     }
 
     /// Whether the scope uses what `concern` is about; if so, the reason (which families and

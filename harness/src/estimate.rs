@@ -1,0 +1,78 @@
+//! The estimated cost in seconds of a planned check, before it runs: the runner starts the
+//! longest checks first by it, and shards balance their loads by it. Below both (the planner's
+//! layer), so that neither imports the other for it.
+
+use crate::check::PlannedCheck;
+use mfh_reference::registry::SamplerCost;
+
+/// The estimated cost of a planned check, in seconds of audit wall time — a model, not a
+/// measurement, used only to balance shards (a wrong estimate unbalances them; it cannot
+/// change a record). Fitted to the records of the default scene's thorough audit on a 2-core
+/// Zen 4 (2026-12-02), whose sampling checks are nine tenths of its time:
+/// - a sampling check costs its sample count (its case's `samples`) times
+///   the family's measured cost per sample (the registry's [`SamplerCost`]: 11 ns for GGX's
+///   normals, 634 ns for Beckmann's visible normals, 568 ns for the piecewise-linear sampler)
+///   plus what the check adds per sample: the KS tests' sort and CDF table 70 ns, the Monte
+///   Carlo Λ 10 ns, the pseudo-VNIS bias (a Λ per sample) 250 ns, its chi-square 25 ns; the
+///   chi-square checks add 0.2 s of expected-count cubature;
+/// - quadrature-heavy checks (`precise.*`, `smith.*`, `ds.*`, `sg.*`, `normalization.*`,
+///   errata demonstrations, claims) 0.05 s; everything else 0.01 s.
+///
+/// A family outside the registry (a user's model) is taken at [`UNKNOWN_SAMPLER`]. Splitting
+/// the default scene's plan into 4 shards by these estimates and summing its records' measured
+/// costs per shard, the longest shard is 1.09× the ideal (total / 4) for the thorough, standard
+/// and ci profiles alike (1.05× for ci); the previous model (one per-sample cost for every
+/// family, 300× for the slow sampler, the KS sample count for the Monte Carlo Λ) gave 1.74×,
+/// 1.38× and 1.23×.
+pub fn estimated_cost(planned: &PlannedCheck<'_>) -> f64 {
+    let family = planned
+        .model
+        .get("family")
+        .and_then(|f| f.as_str())
+        .unwrap_or("");
+    let cost = mfh_reference::registry::by_name(family).map_or(UNKNOWN_SAMPLER, |f| f.sampler_cost);
+    let id = planned.check.as_str();
+    // Every sampling check states its sample count in its case (the test
+    // `every_sampling_check_states_its_samples`).
+    let samples = planned
+        .case
+        .get("samples")
+        .and_then(|n| n.as_u64())
+        .unwrap_or(0) as f64;
+    let per_sample_ns = match id {
+        "sampling.chi2" => cost.normal_ns,
+        "sampling.chi2_visible" => cost.visible_ns,
+        "sampling.chi2_pseudo_vnis" => cost.normal_ns + 25.0,
+        "sampling.ks_marginals" => cost.normal_ns + 70.0,
+        "sampling.lambda_monte_carlo" => cost.normal_ns + 10.0,
+        "sampling.pseudo_vnis" => cost.normal_ns + 250.0,
+        _ if [
+            "precise.",
+            "smith.",
+            "ds.",
+            "sg.",
+            "normalization.",
+            "errata.",
+            "claims.",
+        ]
+        .iter()
+        .any(|p| id.starts_with(p)) =>
+        {
+            return 0.05;
+        }
+        _ => return 0.01,
+    };
+    let cubature = if id.starts_with("sampling.chi2") {
+        0.2
+    } else {
+        0.0
+    };
+    cubature + samples * per_sample_ns * 1e-9
+}
+
+/// The sampler cost assumed for a family the registry does not know (a user's model): that
+/// of the Student family's closed-form samplers, ~50 ns a sample.
+pub const UNKNOWN_SAMPLER: SamplerCost = SamplerCost {
+    normal_ns: 50.0,
+    visible_ns: 50.0,
+};
