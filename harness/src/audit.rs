@@ -1,507 +1,215 @@
-//! The audit: runs a plan in parallel with per-check seeds, applies the Šidák correction across
-//! its statistical checks, and summarizes. This is also the public API a renderer's own tests
-//! call as a CI gate (`audit_scene(..)?.assert_pass()`).
+//! The CI gate for a renderer's own model: `Audit::of(&model)` plans the checks its
+//! capabilities and declared effects call for, optionally compares it value by value with a
+//! reference spec, runs them, and returns the same report as `mfh audit`.
+//!
+//! ```
+//! use mfh_harness::{Audit, Profile};
+//! use mfh_reference::ndf::Ggx;
+//! let ggx = Ggx::new(0.3, 0.3).unwrap();
+//! Audit::of(&ggx)
+//!     .profile(Profile::Ci)
+//!     .against(r#"{"family":"ggx","alpha":0.3}"#)
+//!     .run()
+//!     .assert_pass();
+//! ```
 
-use crate::check::{PlannedCheck, Profile, RunContext};
-use crate::plan::plan;
-use crate::random::splitmix64;
-use crate::record::{CheckRecord, Measured, Verdict, SCHEMA_VERSION};
-use crate::scene::Scene;
-use crate::tolerance::STATISTICAL_ALPHA;
-use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
+use crate::check::{against, PlannedCheck, Profile};
+use crate::plan::{plan_model, Effects};
+use crate::record::{CheckRecord, Verdict};
+use crate::run::DEFAULT_SEED;
+use crate::run::{run_plan, AuditOptions, AuditReport};
+use crate::scene::Sampling;
+use crate::subject::{Hints, Subject};
+use mfh_reference::{Masking, ModelSpec, Ndf};
+use serde_json::json;
+use std::f64::consts::FRAC_PI_2;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+use std::sync::Arc;
 use std::time::Instant;
 
-/// The default audit seed (overridable everywhere a seed is taken: `--seed`, `MFH_SEED`, the
-/// options): every check's random stream derives from it and the check's id, model and case.
-pub const DEFAULT_SEED: u64 = 0x6d66_6800_0000_0001;
-
-/// The Šidák-corrected level for each of `k` independent tests so that the family-wise level
-/// is `alpha`: 1 − (1 − α)^{1/k} (computed as −expm1(ln(1 − α)/k), exact for small α).
-pub fn sidak_alpha(alpha: f64, k: usize) -> f64 {
-    if k <= 1 {
-        return alpha;
-    }
-    -((-alpha).ln_1p() / k as f64).exp_m1()
+/// An audit of one model, configured by its builder methods and carried out by [`Audit::run`].
+pub struct Audit<'a> {
+    model: Arc<dyn Ndf + 'a>,
+    name: String,
+    hints: Hints,
+    options: AuditOptions,
+    masking: Option<Option<Masking>>,
+    sampling: Option<Option<Sampling>>,
+    slope_moments: bool,
+    theta_max: f64,
+    against: Option<String>,
 }
 
-/// How to run an audit.
-#[derive(Debug, Clone)]
-pub struct AuditOptions {
-    /// The profile.
-    pub profile: Profile,
-    /// The audit seed (every check's stream derives from it).
-    pub seed: u64,
-    /// Where artefacts go (None: none are written).
-    pub out: Option<PathBuf>,
-    /// Called after each check (from worker threads); None: no progress is reported.
-    pub progress: Option<ProgressFn>,
-}
-
-impl Default for AuditOptions {
-    fn default() -> Self {
+impl<'a> Audit<'a> {
+    /// An audit of `model`: by default every capability it has is audited (masking checked in
+    /// both G2 forms, normal sampling, visible-normal sampling where it has that), at the quick
+    /// profile, with the default seed (`MFH_SEED` overrides it).
+    pub fn of<M: Ndf + 'a>(model: &'a M) -> Self {
+        let seed = std::env::var("MFH_SEED")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(DEFAULT_SEED);
         Self {
-            profile: Profile::Quick,
-            seed: DEFAULT_SEED,
-            out: None,
-            progress: None,
+            model: Arc::new(model),
+            name: std::any::type_name::<M>().to_string(),
+            hints: Hints::default(),
+            options: AuditOptions {
+                profile: Profile::Quick,
+                seed,
+                out: None,
+                ..Default::default()
+            },
+            masking: None,
+            sampling: None,
+            slope_moments: false,
+            theta_max: FRAC_PI_2,
+            against: None,
         }
     }
-}
 
-/// How far an audit has got: checks done of those planned, and failures so far (before the
-/// Šidák correction re-judges the statistical checks).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Progress {
-    /// Checks done.
-    pub done: usize,
-    /// Checks planned.
-    pub planned: usize,
-    /// Checks failed or errored so far.
-    pub failures: usize,
-}
-
-/// A progress callback; it never changes a result.
-#[derive(Clone)]
-pub struct ProgressFn(pub std::sync::Arc<dyn Fn(Progress) + Send + Sync>);
-
-impl std::fmt::Debug for ProgressFn {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("ProgressFn")
+    /// The name records give the model (default: its Rust type name).
+    pub fn name(mut self, name: &str) -> Self {
+        self.name = name.to_string();
+        self
     }
-}
 
-/// Counts and extremes of an audit.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Summary {
-    /// Records by verdict name.
-    pub counts: BTreeMap<String, usize>,
-    /// The worst measured error (relative or absolute) per model family, with its check.
-    pub worst_error: BTreeMap<String, (f64, String)>,
-    /// Records, time (s) and worst error per check id.
-    pub by_check: BTreeMap<String, CheckSummary>,
-    /// The Šidák level each statistical check was judged at, and how many there were.
-    pub statistical: (usize, f64),
-    /// Wall time of the whole audit, seconds.
-    pub wall_seconds: f64,
-}
+    /// The profile (default quick; `Profile::Ci` is sized for one model in CI).
+    pub fn profile(mut self, profile: Profile) -> Self {
+        self.options.profile = profile;
+        self
+    }
 
-/// Per-check-id totals.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-pub struct CheckSummary {
-    /// Records.
-    pub records: usize,
-    /// Failing records (fail or error).
-    pub failures: usize,
-    /// Expected failures.
-    pub expected_failures: usize,
-    /// Summed wall time of its records (CPU-parallel, so it can exceed the audit's wall time).
-    pub seconds: f64,
-    /// The worst measured error among passing records.
-    pub worst_passing_error: f64,
-}
-
-/// The result of an audit, as written to `report.json`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct AuditReport {
-    /// The record schema version.
-    pub schema_version: u32,
-    /// mfh's version.
-    #[serde(deserialize_with = "crate::record_serde::interned")]
-    pub mfh_version: crate::record_serde::StaticStr,
-    /// The scene's name.
-    pub scene: String,
-    /// The profile.
-    #[serde(deserialize_with = "crate::check::deserialize_profile")]
-    pub profile: Profile,
     /// The audit seed.
-    pub seed: u64,
-    /// The command that reproduces the run.
-    pub command: String,
-    /// The summary.
-    pub summary: Summary,
-    /// Every record, in plan order.
-    pub records: Vec<CheckRecord>,
-    /// What the scene file holds that was not audited, and why (Mitsuba scenes).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub not_audited: Vec<crate::scene::NotAudited>,
-}
-
-impl AuditReport {
-    /// Whether the audit passes: no record failed or errored (expected failures pass).
-    pub fn passed(&self) -> bool {
-        !self.records.iter().any(|r| r.verdict.is_failure())
+    pub fn seed(mut self, seed: u64) -> Self {
+        self.options.seed = seed;
+        self
     }
 
-    /// The CI gate: Ok when the audit passes, else the table of failures ([`failure_table`]).
-    pub fn check_pass(&self) -> Result<(), String> {
-        if self.passed() {
-            Ok(())
-        } else {
-            Err(failure_table(self))
-        }
+    /// What is known of the model's lobe, to speed the oracles up (never needed).
+    pub fn hint(mut self, hints: Hints) -> Self {
+        self.hints = hints;
+        self
     }
 
-    /// The CI gate for a test: panics with the table of failures (check, case, measured
-    /// against the oracle, tolerance and why, the seed and the command that reproduces the
-    /// run) unless the audit passes.
-    #[track_caller]
-    pub fn assert_pass(&self) {
-        if let Err(table) = self.check_pass() {
-            panic!("{table}");
-        }
+    /// The G2 form the renderer uses (None: it does not mask; default: checked if the model
+    /// has Smith masking).
+    pub fn masking(mut self, masking: Option<Masking>) -> Self {
+        self.masking = Some(masking);
+        self
     }
 
-    /// The records of one check id.
-    pub fn records_of<'r>(&'r self, check: &'r str) -> impl Iterator<Item = &'r CheckRecord> {
-        self.records.iter().filter(move |r| r.check == check)
+    /// How the renderer samples (None: it does not; default: normals if the model has a
+    /// sampler, visible normals too if it has a visible-normal sampler).
+    pub fn sampling(mut self, sampling: Option<Sampling>) -> Self {
+        self.sampling = Some(sampling);
+        self
     }
 
-    /// The ids of the checks with a failing record, sorted and unique.
-    pub fn failed_checks(&self) -> Vec<&str> {
-        let mut ids: Vec<&str> = self
-            .records
-            .iter()
-            .filter(|r| r.verdict.is_failure())
-            .map(|r| r.check.as_str())
-            .collect();
-        ids.sort_unstable();
-        ids.dedup();
-        ids
+    /// Whether the renderer filters with slope moments (needs the slope capability).
+    pub fn slope_moments(mut self, on: bool) -> Self {
+        self.slope_moments = on;
+        self
     }
-}
 
-/// A readable table of an audit's failures: per failing record its check, model and case, the
-/// value against the oracle, the measured error against the tolerance and why, and the verdict;
-/// then the seed and the command that reproduces the run.
-pub fn failure_table(report: &AuditReport) -> String {
-    use std::fmt::Write;
-    let failures: Vec<&CheckRecord> = report
-        .records
-        .iter()
-        .filter(|r| r.verdict.is_failure())
-        .collect();
-    let mut out = format!(
-        "mfh: {} of {} check record(s) failed ({}, profile {}, seed {})\n",
-        failures.len(),
-        report.records.len(),
-        report.scene,
-        report.profile.name(),
-        report.seed
-    );
-    for r in failures {
-        let _ = writeln!(out, "\n  ✗ {}  {}", r.check, r.model);
-        let _ = writeln!(out, "    case      {}", r.case);
-        if let (Some(v), Some(o)) = (r.value, r.oracle) {
-            let _ = writeln!(
-                out,
-                "    value     {v:e}   oracle {:e} (± {:e})",
-                o.value, o.uncertainty
-            );
-        }
-        match (r.measured, &r.tolerance) {
-            (Some(m), Some(t)) => {
-                let measured = match m {
-                    Measured::PValue { p, alpha, .. } => format!("p = {p:e} < α = {alpha:e}"),
-                    Measured::Rate { exponent, expected } => {
-                        format!("rate {exponent} (expected {expected})")
-                    }
-                    other => format!("error {:e}", other.error().unwrap_or(f64::NAN)),
-                };
-                let _ = writeln!(
-                    out,
-                    "    measured  {measured}   tolerance {} = {:e}: {}",
-                    t.name, t.value, t.reason
-                );
-            }
-            (Some(m), None) => {
-                let _ = writeln!(out, "    measured  {m:?}");
-            }
-            _ => {}
-        }
-        match &r.verdict {
-            Verdict::Error { message } => {
-                let _ = writeln!(out, "    error     {message}");
-            }
-            v => {
-                let _ = writeln!(out, "    verdict   {}", v.name());
-            }
-        }
-        if !r.source.is_empty() {
-            let _ = writeln!(out, "    source    {}", r.source);
-        }
+    /// The largest incidence the renderer evaluates (radians, default π/2).
+    pub fn theta_max(mut self, theta_max: f64) -> Self {
+        self.theta_max = theta_max;
+        self
     }
-    let _ = write!(out, "\nreproduce: {}", report.command);
-    out
-}
 
-impl AuditReport {
-    /// Assembles a report from a run's records.
-    pub fn from_records(
-        scene: String,
-        options: &AuditOptions,
-        command: String,
-        records: Vec<CheckRecord>,
-        statistical: (usize, f64),
-        wall_seconds: f64,
-    ) -> Self {
-        let summary = summarize(&records, statistical, wall_seconds);
-        AuditReport {
-            schema_version: SCHEMA_VERSION,
-            mfh_version: env!("CARGO_PKG_VERSION"),
-            scene,
-            profile: options.profile,
-            seed: options.seed,
-            command,
-            summary,
-            records,
-            not_audited: Vec::new(),
-        }
+    /// Also compare the model value by value with the reference closed forms of `spec`
+    /// (JSON, e.g. `{"family":"ggx","alpha":0.3}`).
+    pub fn against(mut self, spec: &str) -> Self {
+        self.against = Some(spec.to_string());
+        self
     }
-}
 
-/// FNV-1a of a string: a stable key for seeding (std's hasher may change between releases).
-pub fn fnv1a(text: &str) -> u64 {
-    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    })
-}
+    /// Where reports' artefacts go (chi-square tables, heat maps).
+    pub fn out(mut self, dir: impl Into<PathBuf>) -> Self {
+        self.options.out = Some(dir.into());
+        self
+    }
 
-/// The seed of one planned check: the audit seed mixed with its id, model and case, so that
-/// neither plan order nor thread count changes any stream.
-pub fn check_seed(seed: u64, planned: &PlannedCheck<'_>) -> u64 {
-    splitmix64(
-        seed ^ fnv1a(&format!(
-            "{}|{}|{}",
-            planned.check, planned.model, planned.case
-        )),
-    )
-}
-
-/// Runs a plan: every check in parallel (with `MFH_TRACE` set, each start and end is printed
-/// to standard error with its time), records in plan order, statistical verdicts at the
-/// Šidák-corrected level.
-///
-/// Scheduling: the checks are started longest first by [`crate::estimate::estimated_cost`]
-/// (ties in plan order), each thread taking the next from one queue, so that a long check does
-/// not start last and run alone while the other threads are idle (rayon's split of the plan
-/// into contiguous halves did that). Records do not depend on the order: each check has its
-/// own seed ([`check_seed`]).
-pub fn run_plan(
-    plan: &[PlannedCheck<'_>],
-    options: &AuditOptions,
-) -> (Vec<CheckRecord>, usize, f64) {
-    let trace = std::env::var_os("MFH_TRACE").is_some();
-    let (done, failures) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    let costs: Vec<f64> = plan.iter().map(crate::estimate::estimated_cost).collect();
-    let mut order: Vec<usize> = (0..plan.len()).collect();
-    order.sort_by(|&a, &b| costs[b].total_cmp(&costs[a]));
-    let next = AtomicUsize::new(0);
-    let slots: Vec<std::sync::OnceLock<CheckRecord>> =
-        plan.iter().map(|_| std::sync::OnceLock::new()).collect();
-    let run_one = |p: &PlannedCheck<'_>| {
-        if trace {
-            eprintln!("start {} {} {}", p.check, p.model, p.case);
-        }
-        let ctx = RunContext {
-            seed: check_seed(options.seed, p),
-        };
-        let mut r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| (p.run)(&ctx)))
-            .unwrap_or_else(|e| {
-                let mut r = CheckRecord::new(&p.check, p.model.clone(), p.case.clone(), "");
-                let message = e
-                    .downcast_ref::<String>()
-                    .cloned()
-                    .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
-                    .unwrap_or_default();
-                r.verdict = Verdict::Error {
-                    message: format!("a panic inside the check or the model's methods: {message}"),
-                };
-                r
-            });
-        if r.covers.is_empty() {
-            r.covers = p.covers.clone();
-        }
-        if trace {
-            eprintln!(
-                "done {:.3}s {} {} {} {}",
-                r.cost.wall_seconds,
-                r.verdict.name(),
-                p.check,
-                p.model,
-                p.case
-            );
-        }
-        if let Some(f) = &options.progress {
-            let failed = failures.fetch_add(usize::from(r.verdict.is_failure()), Relaxed);
-            (f.0)(Progress {
-                done: done.fetch_add(1, Relaxed) + 1,
-                planned: plan.len(),
-                failures: failed + usize::from(r.verdict.is_failure()),
-            });
-        }
-        r
-    };
-    (0..rayon::current_num_threads().max(1))
-        .into_par_iter()
-        .for_each(|_| loop {
-            let at = next.fetch_add(1, Relaxed);
-            let Some(&i) = order.get(at) else { break };
-            let _ = slots[i].set(run_one(&plan[i]));
-        });
-    let mut records: Vec<CheckRecord> = slots
-        .into_iter()
-        .zip(plan)
-        .map(|(s, p)| {
-            // Every index is taken from the queue once; an empty slot is not reached.
-            s.into_inner().unwrap_or_else(|| {
-                let mut r = CheckRecord::new(&p.check, p.model.clone(), p.case.clone(), "");
-                r.verdict = Verdict::Error {
-                    message: "the check was not run".into(),
-                };
-                r
-            })
-        })
-        .collect();
-    let (k, alpha) = judge_statistical(&mut records);
-    (records, k, alpha)
-}
-
-/// Judges the statistical records (those with a p-value) at the Šidák level of their number
-/// k, in place: each gets that α, and a pass/fail verdict from p ≥ α (errors stay errors).
-/// Returns (k, α). Idempotent, so a merge of shard reports re-judges over the whole family.
-pub fn judge_statistical(records: &mut [CheckRecord]) -> (usize, f64) {
-    let k = records.iter().filter(|r| r.is_statistical()).count();
-    let alpha = sidak_alpha(STATISTICAL_ALPHA.value, k);
-    judge_at(records, alpha);
-    (k, alpha)
-}
-
-/// Judges the statistical records at the level `alpha` (see [`judge_statistical`]).
-pub fn judge_at(records: &mut [CheckRecord], alpha: f64) {
-    for r in records.iter_mut() {
-        if let Some(Measured::PValue {
-            p, statistic, dof, ..
-        }) = r.measured
-        {
-            r.measured = Some(Measured::PValue {
-                p,
-                statistic,
-                dof,
-                alpha,
-            });
-            if matches!(r.verdict, Verdict::Pass | Verdict::Fail) {
-                r.verdict = if p >= alpha {
-                    Verdict::Pass
+    /// The effects the plan follows: the declared ones, else what the capabilities allow.
+    pub fn effects(&self) -> Effects {
+        let m = &self.model;
+        Effects {
+            masking: self
+                .masking
+                .unwrap_or_else(|| m.as_smith().is_some().then_some(Masking::HeightCorrelated)),
+            sampling: self.sampling.unwrap_or_else(|| {
+                if m.as_visible_sampler().is_some() {
+                    Some(Sampling::VisibleNormals)
                 } else {
-                    Verdict::Fail
-                };
-            }
-        }
-    }
-}
-
-/// The family of a record's model (its `family` key), or the check's family for non-NDF checks.
-fn family_of(r: &CheckRecord) -> String {
-    r.model
-        .get("family")
-        .and_then(|f| f.as_str())
-        .map(str::to_string)
-        .unwrap_or_else(|| r.check.split('.').next().unwrap_or("").to_string())
-}
-
-/// Summarizes records.
-pub fn summarize(records: &[CheckRecord], statistical: (usize, f64), wall_seconds: f64) -> Summary {
-    let mut counts = BTreeMap::new();
-    for name in [
-        "pass",
-        "fail",
-        "expected_failure",
-        "unexpected_pass",
-        "skipped",
-        "error",
-    ] {
-        counts.insert(name.to_string(), 0);
-    }
-    let mut worst_error: BTreeMap<String, (f64, String)> = BTreeMap::new();
-    let mut by_check: BTreeMap<String, CheckSummary> = BTreeMap::new();
-    for r in records {
-        *counts.entry(r.verdict.name().to_string()).or_default() += 1;
-        let c = by_check.entry(r.check.clone()).or_default();
-        c.records += 1;
-        c.seconds += r.cost.wall_seconds;
-        if r.verdict.is_failure() {
-            c.failures += 1;
-        }
-        if matches!(r.verdict, Verdict::ExpectedFailure { .. }) {
-            c.expected_failures += 1;
-        }
-        if r.verdict == Verdict::Pass {
-            if let Some(e) = r.measured.and_then(|m| m.error()) {
-                c.worst_passing_error = c.worst_passing_error.max(e);
-                if !matches!(r.measured, Some(Measured::Rate { .. })) {
-                    let w = worst_error
-                        .entry(family_of(r))
-                        .or_insert((0.0, String::new()));
-                    if e > w.0 {
-                        *w = (e, format!("{} {}", r.check, r.case));
-                    }
+                    m.as_sampler().is_some().then_some(Sampling::Normals)
                 }
-            }
+            }),
+            slope_moments: self.slope_moments,
+            theta_max: self.theta_max,
         }
     }
-    Summary {
-        counts,
-        worst_error,
-        by_check,
-        statistical,
-        wall_seconds,
+
+    /// The planned checks, each with the reason it is planned, and any configuration error as
+    /// a record that fails.
+    pub fn plan(&self) -> (Vec<PlannedCheck<'a>>, Vec<CheckRecord>) {
+        let subject = Subject::user(self.model.clone(), &self.name, self.hints.clone());
+        let why = format!("model `{}`", self.name);
+        let mut errors = Vec::new();
+        if !(self.theta_max > 0.0 && self.theta_max <= FRAC_PI_2) {
+            errors.push(config_error(
+                &subject.label,
+                format!("theta_max = {} is outside (0, π/2]", self.theta_max),
+            ));
+        }
+        let effects = self.effects();
+        let mut plan = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            plan_model(&subject, &effects, self.options.profile, &why)
+        }))
+        .unwrap_or_else(|_| {
+            errors.push(config_error(
+                &subject.label,
+                "the model panicked while the audit was planned".into(),
+            ));
+            Vec::new()
+        });
+        if let Some(text) = &self.against {
+            match serde_json::from_str::<ModelSpec>(text)
+                .map_err(|e| e.to_string())
+                .and_then(|s| s.build().map(|_| s).map_err(|e| e.to_string()))
+            {
+                Ok(spec) => plan.extend(against::plan(&subject, &spec, &why)),
+                Err(e) => errors.push(config_error(
+                    &subject.label,
+                    format!("against: the reference spec {text} is invalid: {e}"),
+                )),
+            }
+        }
+        (plan, errors)
+    }
+
+    /// Runs the audit.
+    pub fn run(&self) -> AuditReport {
+        let t = Instant::now();
+        let (plan, mut errors) = self.plan();
+        let (mut records, k, alpha) = run_plan(&plan, &self.options);
+        records.append(&mut errors);
+        let command = format!(
+            "MFH_SEED={} cargo test (Audit::of({}).profile(Profile::{:?}))",
+            self.options.seed, self.name, self.options.profile
+        );
+        AuditReport::from_records(
+            self.name.clone(),
+            &self.options,
+            command,
+            records,
+            (k, alpha),
+            t.elapsed().as_secs_f64(),
+        )
     }
 }
 
-/// The command line that reproduces an audit.
-pub fn reproduce_command(scene: Option<&str>, options: &AuditOptions) -> String {
-    let mut c = format!(
-        "mfh audit --profile {} --seed {}",
-        options.profile.name(),
-        options.seed
-    );
-    if let Some(s) = scene {
-        c.push_str(&format!(" --scene {s}"));
-    }
-    c
-}
-
-/// Audits a scene: plans, runs, corrects, summarizes. `scene_path` only names the scene in
-/// the reproduce command.
-pub fn audit_scene(scene: &Scene, scene_path: Option<&str>, options: &AuditOptions) -> AuditReport {
-    let t = Instant::now();
-    let planned = plan(scene, options.profile);
-    let (records, k, alpha) = run_plan(&planned, options);
-    let mut report = AuditReport::from_records(
-        scene.name.clone(),
-        options,
-        reproduce_command(scene_path, options),
-        records,
-        (k, alpha),
-        t.elapsed().as_secs_f64(),
-    );
-    report.not_audited = scene.not_audited.clone();
-    report
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// One test keeps its level; k tests share it so that the family-wise level is α.
-    #[test]
-    fn sidak_alpha_keeps_the_family_wise_level() {
-        assert_eq!(sidak_alpha(0.01, 1), 0.01);
-        let a = sidak_alpha(0.01, 10);
-        assert!((1.0 - (1.0 - a).powi(10) - 0.01).abs() < 1e-15);
-    }
+fn config_error(model: &serde_json::Value, message: String) -> CheckRecord {
+    let mut r = CheckRecord::new("audit.configuration", model.clone(), json!({}), "");
+    r.verdict = Verdict::Error { message };
+    r
 }

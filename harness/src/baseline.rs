@@ -8,8 +8,8 @@
 //!
 //! Checks only in one of the two runs are counted, not regressions (the plan changed).
 
-use crate::audit::AuditReport;
 use crate::record::CheckRecord;
+use crate::run::AuditReport;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 

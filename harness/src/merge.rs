@@ -7,9 +7,9 @@
 //! Refused, with the shard folder named: a missing or duplicated shard, shards of different
 //! plans (fingerprint), seeds, profiles, scenes or mfh versions, another schema version.
 
-use crate::audit::{judge_statistical, summarize, AuditReport};
 use crate::readback::{read_report, ReadError};
 use crate::record::{CheckRecord, SCHEMA_VERSION};
+use crate::run::{judge_statistical, summarize, AuditReport};
 use crate::shard::{ShardInfo, SHARD_FILE};
 use std::path::{Path, PathBuf};
 

@@ -2,8 +2,8 @@
 //! the parse into an `AuditReport` (the serde helpers the record types need to read back what
 //! they write are in `record_serde.rs`).
 
-use crate::audit::AuditReport;
 use crate::record::SCHEMA_VERSION;
+use crate::run::AuditReport;
 use std::path::Path;
 
 /// Why a report could not be read back.

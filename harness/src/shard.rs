@@ -7,21 +7,21 @@
 //! load so far (ties: the lowest shard). It depends only on the plan (whose cases carry the
 //! profile's sample counts) and n, so every machine computes the same partition without
 //! talking to the others. Per-check seeds
-//! do not depend on plan order ([`crate::audit::check_seed`]), so a check's record is the same
+//! do not depend on plan order ([`crate::run::check_seed`]), so a check's record is the same
 //! whichever shard runs it.
 //!
 //! A shard's statistical verdicts are taken at the Šidák level of the whole plan's planned
 //! statistical checks (at least as strict as the final level, which counts only those that
 //! produced a p-value); `mfh merge` re-judges over the whole family.
 
-use crate::audit::sidak_alpha;
-use crate::audit::{
-    fnv1a, judge_at, reproduce_command, run_plan, summarize, AuditOptions, AuditReport,
-};
 use crate::check::Planned;
 use crate::estimate::estimated_cost;
 use crate::plan::plan;
 use crate::record::SCHEMA_VERSION;
+use crate::run::sidak_alpha;
+use crate::run::{
+    fnv1a, judge_at, reproduce_command, run_plan, summarize, AuditOptions, AuditReport,
+};
 use crate::scene::Scene;
 use crate::tolerance::STATISTICAL_ALPHA;
 use serde::{Deserialize, Serialize};

@@ -143,7 +143,7 @@ fn cost_markdown_is_current() {
         &CostOptions {
             quick: false,
             timed: false,
-            seed: mfh_harness::audit::DEFAULT_SEED,
+            seed: mfh_harness::run::DEFAULT_SEED,
             selection: Selection::ALL,
         },
         &mut |_, _, _| {},

@@ -4,8 +4,8 @@
 //! size limits. 10⁴ cases per parser here (seconds at the test profile's opt-level 2);
 //! `MFH_EXTENSIVE=1` runs 10⁶.
 
-use mfh_harness::chi2_run::{self, Chi2Request, SamplingKind, MAX_RESOLUTION, MAX_SAMPLES};
 use mfh_harness::eval::{answer_line, eval_stream};
+use mfh_harness::sampler_chi2::{self, Chi2Request, SamplingKind, MAX_RESOLUTION, MAX_SAMPLES};
 use mfh_harness::scene::{Scene, MAX_MATERIALS};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
@@ -334,12 +334,12 @@ fn chi2_requests_validate_within_the_stated_limits() {
                     incidence,
                     azimuth,
                 };
-                match chi2_run::validate(&r) {
+                match sampler_chi2::validate(&r) {
                     Ok(plan) => {
                         let c = &plan.config;
                         prop_assert!((1..=MAX_RESOLUTION).contains(&c.resolution));
                         prop_assert!(c.samples <= MAX_SAMPLES);
-                        prop_assert!(c.samples >= chi2_run::min_samples(c.resolution));
+                        prop_assert!(c.samples >= sampler_chi2::min_samples(c.resolution));
                         prop_assert!(c.alpha > 0.0 && c.alpha < 1.0);
                         prop_assert_eq!(plan.incidence.is_some(), visible);
                     }

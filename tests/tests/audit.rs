@@ -2,10 +2,10 @@
 //! driven through `mfh_harness::cli::run` as the binary calls it, and the coverage registry:
 //! every closed form of `reference/` is covered by a planned check of the default scene.
 
-use mfh_harness::audit::{audit_scene, run_plan, AuditOptions};
 use mfh_harness::check::{Planned, Profile};
 use mfh_harness::plan::plan;
 use mfh_harness::record::{CheckRecord, Verdict, SCHEMA_VERSION};
+use mfh_harness::run::{audit_scene, run_plan, AuditOptions};
 use mfh_harness::scene::Scene;
 use mfh_reference::Model;
 use serde_json::{json, Value};

@@ -523,7 +523,7 @@ mod tests {
         // The summaries count an unexpected pass as a failure.
         let mut r = CheckRecord::new("smith.lambda_route", Value::Null, Value::Null, "");
         r.verdict = Verdict::UnexpectedPass { reason: "x".into() };
-        let s = crate::audit::summarize(&[r], (0, 0.0), 0.0);
+        let s = crate::run::summarize(&[r], (0, 0.0), 0.0);
         assert_eq!(s.counts["unexpected_pass"], 1);
         assert_eq!(s.by_check["smith.lambda_route"].failures, 1);
     }

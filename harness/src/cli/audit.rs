@@ -2,7 +2,7 @@
 
 use super::progress::Bar;
 use super::{load_scene, resolve_seed, ProfileArg, EXIT_BAD_INPUT, EXIT_FAIL, EXIT_PASS};
-use crate::audit::{Progress, ProgressFn};
+use crate::run::{Progress, ProgressFn};
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
@@ -106,7 +106,7 @@ pub fn run(args: AuditArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i
         let _ = writeln!(stderr, "mfh audit: cannot create {}: {e}", out.display());
         return EXIT_BAD_INPUT;
     }
-    let mut options = crate::audit::AuditOptions {
+    let mut options = crate::run::AuditOptions {
         profile: args.profile.profile(),
         seed,
         out: Some(out.clone()),
@@ -127,7 +127,7 @@ pub fn run(args: AuditArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i
         })));
     }
     let report = match args.shard {
-        None => crate::audit::audit_scene(&scene, scene_name.as_deref(), &options),
+        None => crate::run::audit_scene(&scene, scene_name.as_deref(), &options),
         Some(spec) => {
             let (report, info) =
                 crate::shard::audit_shard(&scene, scene_name.as_deref(), &options, spec);
@@ -155,7 +155,7 @@ pub fn run(args: AuditArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i
 /// Writes the report's sinks into `out`, prints the summary (or the JSON), the not-audited
 /// list and the baseline comparison; returns the exit status.
 fn finish_report(
-    report: &crate::audit::AuditReport,
+    report: &crate::run::AuditReport,
     out: &std::path::Path,
     json: bool,
     baseline: &BaselineArgs,

@@ -1,10 +1,10 @@
-//! `mfh chi2`: the chi-square test of a model's sampler from the command line ([`crate::chi2_run`]
+//! `mfh chi2`: the chi-square test of a model's sampler from the command line ([`crate::sampler_chi2`]
 //! validates and runs it), with text or JSON output and optional observed/expected tables (JSON)
 //! and heat maps (PNG).
 
 use super::{resolve_seed, SamplingArg, EXIT_BAD_INPUT, EXIT_FAIL, EXIT_PASS};
-use crate::chi2_run::{self, Chi2Request};
 use crate::oracle::chi2::{Chi2Result, Verdict};
+use crate::sampler_chi2::{self, Chi2Request};
 use clap::Args;
 
 use std::io::Write;
@@ -65,7 +65,7 @@ fn bad(stderr: &mut dyn Write, message: String) -> i32 {
 }
 
 /// The options as a [`Chi2Request`] for the model `model` (a spec's JSON text), validated.
-fn validate(args: &Chi2Args, model: String, seed: u64) -> Result<chi2_run::Chi2Plan, String> {
+fn validate(args: &Chi2Args, model: String, seed: u64) -> Result<sampler_chi2::Chi2Plan, String> {
     let request = Chi2Request {
         model,
         samples: args.samples,
@@ -76,7 +76,7 @@ fn validate(args: &Chi2Args, model: String, seed: u64) -> Result<chi2_run::Chi2P
         incidence: args.incidence,
         azimuth: args.azimuth,
     };
-    chi2_run::validate(&request).map_err(|e| e.to_string())
+    sampler_chi2::validate(&request).map_err(|e| e.to_string())
 }
 
 /// Runs `mfh chi2`; returns the exit status (0 pass, 1 fail, 2 bad input).
@@ -95,8 +95,8 @@ pub fn run(args: Chi2Args, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
     let result = run_with_progress(&plan, args.quiet);
     let name = crate::report::artefacts::model_name(&serde_json::json!(plan.model.spec()));
     let spec_text = serde_json::to_string(&plan.model.spec()).unwrap_or_default();
-    let record = chi2_run::record(&plan, &result, &[]);
-    let reproduce = chi2_run::reproduce_command(&plan);
+    let record = sampler_chi2::record(&plan, &result, &[]);
+    let reproduce = sampler_chi2::reproduce_command(&plan);
     report(
         &args,
         &result,
@@ -197,9 +197,9 @@ fn run_external(
         "command": cmd,
         "parameters": description.parameters,
     });
-    let mut record = chi2_run::record(&plan, &result, &[]);
+    let mut record = sampler_chi2::record(&plan, &result, &[]);
     record["model"] = label.clone();
-    let mut reproduce = chi2_run::reproduce_command(&plan);
+    let mut reproduce = sampler_chi2::reproduce_command(&plan);
     if let Some(rest) = reproduce
         .split_once(" --samples ")
         .map(|(_, r)| r.to_string())
@@ -298,12 +298,12 @@ fn report(
 
 /// Runs the test with a progress bar of samples drawn (see [`super::progress`]); the bar
 /// reads a shared counter from a second thread, so the result is the same with or without it.
-fn run_with_progress(plan: &chi2_run::Chi2Plan, quiet: bool) -> Chi2Result {
+fn run_with_progress(plan: &sampler_chi2::Chi2Plan, quiet: bool) -> Chi2Result {
     use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
     use std::sync::Arc;
     let bar = super::progress::Bar::new(plan.config.samples, "samples", quiet);
     if !bar.enabled() {
-        return chi2_run::run(plan, None);
+        return sampler_chi2::run(plan, None);
     }
     let counter = Arc::new(AtomicU64::new(0));
     let finished = AtomicBool::new(false);
@@ -320,7 +320,7 @@ fn run_with_progress(plan: &chi2_run::Chi2Plan, quiet: bool) -> Chi2Result {
                 std::thread::sleep(std::time::Duration::from_millis(100));
             }
         });
-        let result = chi2_run::run(plan, Some(counter.clone()));
+        let result = sampler_chi2::run(plan, Some(counter.clone()));
         finished.store(true, Ordering::Relaxed);
         result
     });

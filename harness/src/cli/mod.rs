@@ -74,8 +74,8 @@ pub enum SamplingArg {
 
 impl SamplingArg {
     /// The library's sampling kind.
-    pub fn kind(self) -> crate::chi2_run::SamplingKind {
-        use crate::chi2_run::SamplingKind;
+    pub fn kind(self) -> crate::sampler_chi2::SamplingKind {
+        use crate::sampler_chi2::SamplingKind;
         match self {
             SamplingArg::Normals => SamplingKind::Normals,
             SamplingArg::Visible => SamplingKind::Visible,
@@ -213,6 +213,6 @@ pub fn resolve_seed(seed: Option<u64>) -> Result<u64, String> {
             .trim()
             .parse()
             .map_err(|_| format!("MFH_SEED={text:?} is not an unsigned integer")),
-        Err(_) => Ok(crate::audit::DEFAULT_SEED),
+        Err(_) => Ok(crate::run::DEFAULT_SEED),
     }
 }

@@ -47,7 +47,7 @@ pub fn run(args: PlanArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
     }
     match args.format {
         PlanFormat::Table => {
-            let table = crate::plan_table::plan_table(&plan, &scene.not_audited);
+            let table = crate::report::plan_table::plan_table(&plan, &scene.not_audited);
             let _ = write!(stdout, "{table}");
         }
         PlanFormat::Jsonl => {

@@ -1,6 +1,6 @@
 //! Audit an implementation in any language: a child process speaking the external protocol
 //! (JSON lines over stdin / stdout, [`protocol`]) is one more implementation of the capability
-//! traits ([`model::ExternalModel`]), audited by [`crate::gate::Audit`] like a Rust model.
+//! traits ([`model::ExternalModel`]), audited by [`crate::audit::Audit`] like a Rust model.
 
 pub mod model;
 pub mod process;
@@ -9,10 +9,10 @@ pub mod protocol;
 pub use model::ExternalModel;
 pub use process::{ExternalError, DEFAULT_TIMEOUT_SECONDS};
 
-use crate::audit::{AuditOptions, AuditReport};
+use crate::audit::Audit;
 use crate::check::Profile;
-use crate::gate::Audit;
 use crate::record::{CheckRecord, Verdict};
+use crate::run::{AuditOptions, AuditReport};
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Duration;

@@ -9,8 +9,8 @@ use super::artefacts::{case_name, model_name, record_title};
 use super::page::{escape, fmt_num, STYLE};
 use super::plot::PlotError;
 use super::record_plots::{data_plots, limit_plot, plot_policy, smith_plots};
-use crate::audit::AuditReport;
 use crate::record::{CheckRecord, Measured, Verdict};
+use crate::run::AuditReport;
 use serde_json::Value;
 use std::fmt::Write as _;
 

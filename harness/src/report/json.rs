@@ -1,7 +1,7 @@
 //! `report.json`: the whole audit (schema version, scene, profile, seed, reproduce command,
 //! summary, every record), for machines.
 
-use crate::audit::AuditReport;
+use crate::run::AuditReport;
 use std::path::Path;
 
 /// Serializes the report as pretty JSON, without the records' data (tables and curves go to

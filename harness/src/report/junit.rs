@@ -2,8 +2,8 @@
 //! and errors carry the measured error and tolerance, expected failures and skips are skipped
 //! cases with their reason.
 
-use crate::audit::AuditReport;
 use crate::record::{CheckRecord, Verdict};
+use crate::run::AuditReport;
 use std::collections::BTreeMap;
 
 fn escape(s: &str) -> String {

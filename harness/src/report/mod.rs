@@ -12,6 +12,7 @@ pub mod json;
 pub mod junit;
 #[cfg(feature = "html")]
 pub mod page;
+pub mod plan_table;
 #[cfg(feature = "html")]
 pub mod plot;
 #[cfg(feature = "html")]
@@ -20,7 +21,7 @@ pub mod record_plots;
 pub mod selftest_html;
 pub mod terminal;
 
-use crate::audit::AuditReport;
+use crate::run::AuditReport;
 use std::path::{Path, PathBuf};
 
 /// Why the report could not be written; names the path (or the plot) and the cause.

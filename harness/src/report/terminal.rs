@@ -1,7 +1,7 @@
 //! The terminal summary of an audit: counts by verdict, the failures, the worst error per
 //! family, time per check family, the seed and the command that reproduces the run.
 
-use crate::audit::AuditReport;
+use crate::run::AuditReport;
 use std::fmt::Write;
 
 /// Renders the summary (at most `max_failures` failures listed).

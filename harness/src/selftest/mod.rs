@@ -17,11 +17,11 @@ pub mod catalog;
 pub mod mutant;
 pub mod power;
 
-use crate::audit::DEFAULT_SEED;
-use crate::audit::{run_plan, AuditOptions};
+use crate::audit::Audit;
 use crate::check::Profile;
-use crate::gate::Audit;
 use crate::record::{CheckRecord, Verdict};
+use crate::run::DEFAULT_SEED;
+use crate::run::{run_plan, AuditOptions};
 use crate::subject::{spec_width, Hints};
 use catalog::{Entry, Route, CATALOG};
 use mfh_reference::{Model, ModelSpec};

@@ -7,10 +7,10 @@
 //! sample counts the profile sets.)
 
 use super::mutant::{Defect, Mutated};
-use crate::audit::sidak_alpha;
-use crate::audit::{judge_at, run_plan, AuditOptions};
+use crate::audit::Audit;
 use crate::check::{sampling, Profile};
-use crate::gate::Audit;
+use crate::run::sidak_alpha;
+use crate::run::{judge_at, run_plan, AuditOptions};
 use crate::subject::Subject;
 use crate::tolerance::STATISTICAL_ALPHA;
 use mfh_reference::ModelSpec;

@@ -57,11 +57,11 @@ fn spec(m: &Microfacet) -> String {
     )
 }
 
-fn audit(m: Microfacet) -> mfh_harness::audit::AuditReport {
+fn audit(m: Microfacet) -> mfh_harness::run::AuditReport {
     gate(&Gated(m))
 }
 
-fn gate(g: &Gated) -> mfh_harness::audit::AuditReport {
+fn gate(g: &Gated) -> mfh_harness::run::AuditReport {
     let m = g.0;
     Audit::of(g)
         .name(&format!(
