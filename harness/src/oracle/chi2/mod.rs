@@ -1,5 +1,5 @@
 //! Chi-square goodness-of-fit test of a normal sampler against its pdf over the (φ, cos θ)
-//! grid of the upper hemisphere (ARCHITECTURE.md, "Checks and records"): the test entry points
+//! grid of the upper hemisphere (ARCHITECTURE.md, "Data flows one way"): the test entry points
 //! and their result types here; the binning in `binning.rs`, the expected masses in
 //! `expected.rs`, the verdict in `judge.rs`; the numeric tolerances in `tolerance/chi2.rs`.
 //!
