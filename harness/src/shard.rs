@@ -23,9 +23,10 @@ use crate::plan::plan;
 use crate::record::SCHEMA_VERSION;
 use crate::scene::Scene;
 use crate::tolerance::STATISTICAL_ALPHA;
-use mfh_reference::registry::SamplerCost;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
+
+pub mod sampler_cost;
 
 /// The largest number of shards accepted.
 pub const MAX_SHARDS: usize = 10_000;
@@ -92,7 +93,7 @@ pub struct ShardInfo {
 /// change a record). Fitted to the records of the default scene's thorough audit on a 2-core
 /// Zen 4 (2026-12-02), whose sampling checks are nine tenths of its time:
 /// - a sampling check costs its sample count (its case's `samples`) times
-///   the family's measured cost per sample (the registry's [`SamplerCost`]: 11 ns for GGX's
+///   the family's measured cost per sample ([`sampler_cost::SamplerCost`]: 11 ns for GGX's
 ///   normals, 634 ns for Beckmann's visible normals, 568 ns for the piecewise-linear sampler)
 ///   plus what the check adds per sample: the KS tests' sort and CDF table 70 ns, the Monte
 ///   Carlo Λ 10 ns, the pseudo-VNIS bias (a Λ per sample) 250 ns, its chi-square 25 ns; the
@@ -100,7 +101,7 @@ pub struct ShardInfo {
 /// - quadrature-heavy checks (`precise.*`, `smith.*`, `ds.*`, `sg.*`, `normalization.*`,
 ///   errata demonstrations, claims) 0.05 s; everything else 0.01 s.
 ///
-/// A family outside the registry (a user's model) is taken at [`UNKNOWN_SAMPLER`]. Splitting
+/// A family outside the registry (a user's model) is taken at [`sampler_cost::UNKNOWN_SAMPLER`]. Splitting
 /// the default scene's plan into 4 shards by these estimates and summing its records' measured
 /// costs per shard, the longest shard is 1.09× the ideal (total / 4) for the thorough, standard
 /// and ci profiles alike (1.05× for ci); the previous model (one per-sample cost for every
@@ -112,7 +113,7 @@ pub fn estimated_cost(planned: &PlannedCheck<'_>) -> f64 {
         .get("family")
         .and_then(|f| f.as_str())
         .unwrap_or("");
-    let cost = mfh_reference::registry::by_name(family).map_or(UNKNOWN_SAMPLER, |f| f.sampler_cost);
+    let cost = sampler_cost::for_family(family);
     let id = planned.check.as_str();
     // Every sampling check states its sample count in its case (the test
     // `every_sampling_check_states_its_samples`).
@@ -151,13 +152,6 @@ pub fn estimated_cost(planned: &PlannedCheck<'_>) -> f64 {
     };
     cubature + samples * per_sample_ns * 1e-9
 }
-
-/// The sampler cost assumed for a family the registry does not know (a user's model): that
-/// of the Student family's closed-form samplers, ~50 ns a sample.
-pub const UNKNOWN_SAMPLER: SamplerCost = SamplerCost {
-    normal_ns: 50.0,
-    visible_ns: 50.0,
-};
 
 /// The shard (0-based) of every planned check, by the greedy of the module doc.
 pub fn assign(plan: &[Planned], count: usize) -> Vec<usize> {
@@ -265,12 +259,12 @@ mod tests {
         }
     }
 
-    /// The estimates follow the registry's sampler costs and the case's sample count: in the
+    /// The estimates follow the measured sampler costs and the case's sample count: in the
     /// default scene's thorough plan, Beckmann's visible chi-square (634 ns a sample) is
     /// estimated 45× GGX's (14 ns), and the piecewise Monte Carlo Λ at its own 10⁸ samples (not
     /// the KS checks' 10⁶ for a slow sampler).
     #[test]
-    fn estimates_follow_the_registry_costs_and_the_sample_counts() {
+    fn estimates_follow_the_measured_costs_and_the_sample_counts() {
         let planned = plan(&Scene::default_scene(), Profile::Thorough);
         let cost_of = |check: &str, family: &str| {
             let costs: Vec<f64> = planned

@@ -7,6 +7,7 @@
 
 pub mod errata;
 pub mod error;
+pub mod family;
 pub mod geometry;
 pub mod model;
 pub mod ndf;

@@ -2,8 +2,8 @@
 //! integral over the sphere, the ASG × ASG product and the ASG–SG convolution.
 
 use super::circular::bessel_i0_scaled;
+use super::isotropic::Sg;
 use super::quadrature::{integrate, integrate_directions, Lobe};
-use super::sg::Sg;
 use super::{add, normalize, scale, unit_axis, UNIT_TOLERANCE};
 use crate::error::{ParamError, QueryError};
 use crate::geometry::{dot, Vec3};

@@ -1,4 +1,4 @@
-use super::sg::SRC_INTEGRAL;
+use super::isotropic::SRC_INTEGRAL;
 use super::*;
 use crate::check::RunContext;
 use crate::tolerance::CLOSED_FORM;
