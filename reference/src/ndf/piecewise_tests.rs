@@ -983,11 +983,8 @@ mod accuracy_table {
     }
 
     #[test]
+    #[cfg_attr(not(mfh_extensive), ignore = "extensive tier: set MFH_EXTENSIVE=1")]
     fn accuracy_table_piecewise() {
-        if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (README, \"The extensive tier\")");
-            return;
-        }
         let mut out = ReportTable::new("seed000");
         let models: Vec<(&str, PiecewiseLinear)> =
             small_models().into_iter().chain(big_models()).collect();
