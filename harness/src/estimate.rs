@@ -3,14 +3,15 @@
 //! layer), so that neither imports the other for it.
 
 use crate::check::PlannedCheck;
-use mfh_reference::registry::SamplerCost;
+
+pub mod sampler_cost;
 
 /// The estimated cost of a planned check, in seconds of audit wall time — a model, not a
 /// measurement, used only to balance shards (a wrong estimate unbalances them; it cannot
 /// change a record). Fitted to the records of the default scene's thorough audit on a 2-core
 /// Zen 4 (2026-12-02), whose sampling checks are nine tenths of its time:
 /// - a sampling check costs its sample count (its case's `samples`) times
-///   the family's measured cost per sample (the registry's [`SamplerCost`]: 11 ns for GGX's
+///   the family's measured cost per sample ([`sampler_cost::SamplerCost`]: 11 ns for GGX's
 ///   normals, 634 ns for Beckmann's visible normals, 568 ns for the piecewise-linear sampler)
 ///   plus what the check adds per sample: the KS tests' sort and CDF table 70 ns, the Monte
 ///   Carlo Λ 10 ns, the pseudo-VNIS bias (a Λ per sample) 250 ns, its chi-square 25 ns; the
@@ -18,7 +19,7 @@ use mfh_reference::registry::SamplerCost;
 /// - quadrature-heavy checks (`precise.*`, `smith.*`, `ds.*`, `sg.*`, `normalization.*`,
 ///   errata demonstrations, claims) 0.05 s; everything else 0.01 s.
 ///
-/// A family outside the registry (a user's model) is taken at [`UNKNOWN_SAMPLER`]. Splitting
+/// A family outside the registry (a user's model) is taken at [`sampler_cost::UNKNOWN_SAMPLER`]. Splitting
 /// the default scene's plan into 4 shards by these estimates and summing its records' measured
 /// costs per shard, the longest shard is 1.09× the ideal (total / 4) for the thorough, standard
 /// and ci profiles alike (1.05× for ci); the previous model (one per-sample cost for every
@@ -30,7 +31,7 @@ pub fn estimated_cost(planned: &PlannedCheck<'_>) -> f64 {
         .get("family")
         .and_then(|f| f.as_str())
         .unwrap_or("");
-    let cost = mfh_reference::registry::by_name(family).map_or(UNKNOWN_SAMPLER, |f| f.sampler_cost);
+    let cost = sampler_cost::for_family(family);
     let id = planned.check.as_str();
     // Every sampling check states its sample count in its case (the test
     // `every_sampling_check_states_its_samples`).
@@ -69,10 +70,3 @@ pub fn estimated_cost(planned: &PlannedCheck<'_>) -> f64 {
     };
     cubature + samples * per_sample_ns * 1e-9
 }
-
-/// The sampler cost assumed for a family the registry does not know (a user's model): that
-/// of the Student family's closed-form samplers, ~50 ns a sample.
-pub const UNKNOWN_SAMPLER: SamplerCost = SamplerCost {
-    normal_ns: 50.0,
-    visible_ns: 50.0,
-};

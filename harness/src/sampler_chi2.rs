@@ -5,6 +5,7 @@
 
 use crate::oracle::chi2::{chi2_test_batch_in, Chi2Config, Chi2Result};
 use crate::tolerance::{CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE, MIN_EXPECTED};
+use mfh_reference::family::FamilySpec;
 use mfh_reference::{Model, ModelSpec, Vec3};
 use serde_json::{json, Value};
 use std::f64::consts::FRAC_PI_2;
@@ -233,7 +234,7 @@ pub fn validate(request: &Chi2Request) -> Result<Chi2Plan, Chi2InputError> {
         },
         sampling: request.sampling,
         incidence,
-        theta_kinks: (mfh_reference::registry::info(&spec).theta_kinks)(&spec),
+        theta_kinks: spec.theta_kinks(),
     })
 }
 

@@ -193,12 +193,12 @@ mod tests {
         }
     }
 
-    /// The estimates follow the registry's sampler costs and the case's sample count: in the
+    /// The estimates follow the measured sampler costs and the case's sample count: in the
     /// default scene's thorough plan, Beckmann's visible chi-square (634 ns a sample) is
     /// estimated 45× GGX's (14 ns), and the piecewise Monte Carlo Λ at its own 10⁸ samples (not
     /// the KS checks' 10⁶ for a slow sampler).
     #[test]
-    fn estimates_follow_the_registry_costs_and_the_sample_counts() {
+    fn estimates_follow_the_measured_costs_and_the_sample_counts() {
         let planned = plan(&Scene::default_scene(), Profile::Thorough);
         let cost_of = |check: &str, family: &str| {
             let costs: Vec<f64> = planned

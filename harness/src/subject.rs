@@ -5,7 +5,8 @@
 
 use crate::oracle::lobe::{self, Lobe, Options};
 use crate::oracle::smith_lambda::LambdaSubject;
-use mfh_reference::registry::{self, FamilyInfo};
+use mfh_reference::family::{FamilyInfo, FamilySpec};
+use mfh_reference::registry;
 use mfh_reference::{Model, ModelSpec, Ndf, ParamError, Vec3};
 use serde_json::{json, Value};
 use std::sync::{Arc, OnceLock};
@@ -63,7 +64,7 @@ impl<'a> Subject<'a> {
         let info = registry::info(&spec);
         let hints = Hints {
             lobe_width: Some(spec_width(&spec)),
-            theta_kinks: (info.theta_kinks)(&spec),
+            theta_kinks: spec.theta_kinks(),
             anisotropic: Some(spec_anisotropic(&spec)),
         };
         Self {
@@ -143,16 +144,14 @@ impl<'a> Subject<'a> {
 
     /// The exponent C of a Student-t slope marginal, where the registry knows it.
     pub fn tail_exponent(&self) -> Option<f64> {
-        self.reference
-            .as_ref()
-            .and_then(|(s, i)| (i.tail_exponent)(s))
+        self.reference.as_ref().and_then(|(s, _)| s.tail_exponent())
     }
 
     /// The mean slope (s̄x, s̄y): zero unless the registry says otherwise.
     pub fn mean_slope(&self) -> [f64; 2] {
         self.reference
             .as_ref()
-            .map_or([0.0, 0.0], |(s, i)| (i.mean_slope)(s))
+            .map_or([0.0, 0.0], |(s, _)| s.mean_slope())
     }
 
     /// Whether the default Λ is a numerical integral (registry); false for user models, whose

@@ -205,7 +205,7 @@ pub const CLAMPED_COSINE_FIT: Tolerance = Tolerance {
     name: "clamped_cosine_fit",
     value: 0.195,
     reason: "the document states no error for the fit; the reference measured ≤ 0.1944 (relative) \
-             for SG lights of sharpness 1e-3…1e4 within 60° of n (sg::sg \
+             for SG lights of sharpness 1e-3…1e4 within 60° of n (sg::isotropic \
              CLAMPED_COSINE_MAX_REL_ERROR_60): a bound on the measured error, so a changed fit \
              constant or inner product fails",
 };

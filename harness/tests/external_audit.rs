@@ -6,14 +6,10 @@
 #[path = "external/common.rs"]
 mod common;
 
-use common::{example, extensive, has_numpy, run};
+use common::{example, require_numpy, run};
 use serde_json::Value;
 use std::path::PathBuf;
 use std::time::Instant;
-
-/// Why the pure-Python GGX audits are extensive tier.
-const SLOW_PURE_PYTHON: &str = "the pure-Python child answers ~46 000 small KS-table requests; \
-                                minutes on 2 cores";
 
 fn temp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("mfh-{name}-{}", std::process::id()))
@@ -57,11 +53,14 @@ fn audit(file: &str, against: Option<&str>) -> (i32, Vec<String>, Value) {
     (code, failing, report)
 }
 
+/// Extensive tier: the pure-Python child answers ~46 000 small KS-table requests, minutes on
+/// 2 cores.
 #[test]
+#[cfg_attr(
+    not(mfh_extensive),
+    ignore = "extensive tier: set MFH_EXTENSIVE=1 (the pure-Python GGX audit takes minutes)"
+)]
 fn the_pure_python_ggx_passes_the_ci_audit() {
-    if !extensive(SLOW_PURE_PYTHON) {
-        return;
-    }
     let (code, failing, report) = audit("ggx.py", Some(r#"{"family":"ggx","alpha":0.3}"#));
     assert_eq!(code, 0, "failing: {failing:?}");
     assert!(failing.is_empty());
@@ -91,21 +90,25 @@ fn the_pure_python_beckmann_passes_the_ci_audit() {
 }
 
 #[test]
+#[cfg_attr(
+    not(has_numpy),
+    ignore = "numpy is not installed (python3 -m pip install numpy)"
+)]
 fn the_numpy_ggx_passes_the_ci_audit() {
-    if !has_numpy() {
-        return;
-    }
+    require_numpy();
     let (code, failing, _) = audit("ggx_numpy.py", Some(r#"{"family":"ggx","alpha":0.3}"#));
     assert_eq!(code, 0, "failing: {failing:?}");
 }
 
 /// The wrong sampler (GGX with Beckmann's slope radius) fails `sampling.chi2`; what does not
-/// look at its samples (D, Λ, the value comparison) passes.
+/// look at its samples (D, Λ, the value comparison) passes. Extensive tier, like the
+/// pure-Python GGX audit.
 #[test]
+#[cfg_attr(
+    not(mfh_extensive),
+    ignore = "extensive tier: set MFH_EXTENSIVE=1 (the pure-Python GGX audit takes minutes)"
+)]
 fn the_wrong_sampler_fails_the_chi_square_check() {
-    if !extensive(SLOW_PURE_PYTHON) {
-        return;
-    }
     let (code, failing, _) = audit("ggx_wrong_sampler.py", None);
     assert_eq!(code, 1);
     assert!(
@@ -123,7 +126,7 @@ fn the_wrong_sampler_fails_the_chi_square_check() {
 
 /// `mfh chi2 --cmd` prints what `--model` prints and writes the same tables and heat maps; the
 /// expected counts come from the child's pdf (GGX α = 0.3: the reference's, to 1e-9); the
-/// wrong sampler fails; a child without the capability is bad input.
+/// wrong sampler fails; `--cmd` with `--model` is bad input.
 #[test]
 fn chi2_cmd_tests_an_external_sampler() {
     let out = temp("chi2-cmd");
@@ -205,17 +208,35 @@ fn chi2_cmd_tests_an_external_sampler() {
     args.extend(common);
     let (code, stdout, _) = run(&args);
     assert_eq!(code, 1, "{stdout}");
-    // No visible sampler declared (the numpy example): bad input naming the capability; and
     // --cmd with --model is bad input.
-    let numpy = example("ggx_numpy.py", "");
-    let mut args = vec!["chi2", "--cmd", &numpy, "--sampling", "visible"];
-    args.extend(common);
-    let (code, _, stderr) = run(&args);
-    if has_numpy() {
-        assert_eq!(code, 2, "{stderr}");
-        assert!(stderr.contains("sample_wm_visible"), "{stderr}");
-    }
     let (code, _, stderr) = run(&["chi2", "--cmd", &cmd, "--model", "{}"]);
     assert_eq!(code, 2, "{stderr}");
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// `mfh chi2 --cmd --sampling visible` on a child that declares no visible sampler (the numpy
+/// example) is bad input naming the capability.
+#[test]
+#[cfg_attr(
+    not(has_numpy),
+    ignore = "numpy is not installed (python3 -m pip install numpy)"
+)]
+fn chi2_cmd_without_the_capability_is_bad_input() {
+    require_numpy();
+    let numpy = example("ggx_numpy.py", "");
+    let (code, _, stderr) = run(&[
+        "chi2",
+        "--cmd",
+        &numpy,
+        "--sampling",
+        "visible",
+        "--samples",
+        "200000",
+        "--resolution",
+        "8",
+        "--seed",
+        "3",
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("sample_wm_visible"), "{stderr}");
 }

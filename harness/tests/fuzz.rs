@@ -11,9 +11,10 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use serde_json::{json, Map, Value};
 
-/// Cases per parser: 10⁴, or 10⁶ with `MFH_EXTENSIVE=1`.
+/// Cases per parser: 10⁴, or 10⁶ with `MFH_EXTENSIVE=1` (the `mfh_extensive` flag of the
+/// build script, `mfh-test-tiers`).
 fn cases() -> u32 {
-    if std::env::var("MFH_EXTENSIVE").is_ok_and(|v| v == "1") {
+    if cfg!(mfh_extensive) {
         1_000_000
     } else {
         10_000

@@ -154,11 +154,11 @@ fn a_survivor_or_a_miss_fails_the_selftest() {
 }
 
 #[test]
+#[cfg_attr(
+    not(mfh_extensive),
+    ignore = "extensive tier: set MFH_EXTENSIVE=1 (1000 calibration runs per test)"
+)]
 fn false_alarm_calibration_extensive() {
-    if std::env::var("MFH_EXTENSIVE").as_deref() != Ok("1") {
-        eprintln!("skipped: the calibration runs with MFH_EXTENSIVE=1 (1000 runs per test)");
-        return;
-    }
     let c = calibrate::calibrate(
         &calibrate::DEFAULT_MODELS,
         1000,

@@ -8,6 +8,7 @@
 pub mod bsdf;
 pub mod errata;
 pub mod error;
+pub mod family;
 pub mod geometry;
 pub mod model;
 pub mod ndf;

@@ -1,84 +1,190 @@
-//! Models described as data (`ModelSpec`, serde) and built into validated models. The
-//! `ModelSpec` enum is written by the registry (`crate::registry`) from one line per family;
-//! each family's spec type lives in its own file and implements [`FamilySpec`].
+//! Models described as data: [`ModelSpec`], e.g. `{"family": "std", "gamma": 2.5, "alpha": 0.3}`
+//! (ARCHITECTURE.md, "Evaluating closed forms"), and the spec type of every family. A spec is
+//! parameters only: each family's file builds its model from its spec type and describes its
+//! model as one ([`crate::family::FamilySpec`], [`crate::model::Model::spec`]), and the
+//! registry ([`crate::registry`]) lists the families. This file names no model, so the models
+//! and the registry may name it.
 
-use serde::{Deserializer, Serializer};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use crate::error::ParamError;
-use crate::model::Model;
-pub use crate::registry::ModelSpec;
+use crate::ndf::angular_profile::AngularProfile;
 
-/// Resolves `alpha` or (`alpha_x`, `alpha_y`) into validated per-axis roughness.
-pub fn resolve_roughness(
-    alpha: Option<f64>,
-    alpha_x: Option<f64>,
-    alpha_y: Option<f64>,
-) -> Result<(f64, f64), ParamError> {
-    match (alpha, alpha_x, alpha_y) {
-        (Some(a), None, None) => {
-            let a = crate::model::check_alpha("alpha", a)?;
-            Ok((a, a))
+/// Declares [`ModelSpec`]: one line per family, `Variant(SpecType) = "name"`, the name being
+/// the `family` key (and the registry's name of the family). Writes the enum (serde-tagged by
+/// `family`), [`ModelSpec::family`] and `From<SpecType> for ModelSpec`.
+macro_rules! model_spec {
+    ($($(#[$doc:meta])* $variant:ident($spec:ty) = $name:literal),+ $(,)?) => {
+        /// A model described as data, e.g. `{"family": "std", "gamma": 2.5, "alpha": 0.3}`.
+        /// Unknown keys are errors. Each variant holds its family's spec type (below); the
+        /// registry (`crate::registry`) has a line for each.
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[serde(tag = "family")]
+        pub enum ModelSpec {
+            $($(#[$doc])* #[serde(rename = $name)] $variant($spec),)+
         }
-        (None, Some(ax), Some(ay)) => Ok((
-            crate::model::check_alpha("alpha_x", ax)?,
-            crate::model::check_alpha("alpha_y", ay)?,
-        )),
-        _ => Err(ParamError::Combination(
-            "give either alpha, or both alpha_x and alpha_y".to_string(),
-        )),
-    }
+
+        impl ModelSpec {
+            /// The family name, as written in the spec's `family` key.
+            pub fn family(&self) -> &'static str {
+                match self {
+                    $(ModelSpec::$variant(_) => $name,)+
+                }
+            }
+        }
+
+        $(impl From<$spec> for ModelSpec {
+            fn from(s: $spec) -> ModelSpec {
+                ModelSpec::$variant(s)
+            }
+        })+
+    };
 }
 
-/// What every family's spec type does (each family's file implements it for its spec type; the
-/// registry's line for the family makes it a [`ModelSpec`] variant).
-pub trait FamilySpec {
-    /// Validates the parameters and builds the model.
-    fn build(&self) -> Result<Box<dyn Model>, ParamError>;
-
-    /// The parameter (name, value) that puts the model outside the domain of its Smith Λ, if
-    /// any: for the Student-t members with γ ≤ 3/2 (and D^G(B, C) with C ≤ 3/2) the mean slope
-    /// diverges and Λ = ∞ at every incidence (seed 001 eq 18).
-    fn smith_limit(&self) -> Option<(&'static str, f64)> {
-        None
-    }
+model_spec! {
+    /// Beckmann (seed 001, Table 1, γ → ∞).
+    Beckmann(BeckmannSpec) = "beckmann",
+    /// GGX / Trowbridge–Reitz (seed 001, Table 1, γ = 2).
+    Ggx(GgxSpec) = "ggx",
+    /// Student's t NDF, STD (seed 001, f = 1/(γ−1)); `gamma: "inf"` is Beckmann.
+    Std(StdSpec) = "std",
+    /// Hyper-Cauchy (seed 001, eq 8, f = 1).
+    HyperCauchy(HyperCauchySpec) = "hyper_cauchy",
+    /// The fixed-variance Student member (seed 001, eq 9, f = 1/(γ−2)); `gamma: "inf"` is
+    /// Beckmann.
+    StudentFixedVariance(FixedVarianceSpec) = "student_fixed_variance",
+    /// The general isotropic family D^G(B, C) (seed 001, eq 1–2).
+    StudentGeneral(GeneralSpec) = "student_general",
+    /// The piecewise-linear NDF (seed 000, eq 1–5).
+    PiecewiseLinear(PiecewiseSpec) = "piecewise_linear",
+    /// Two isotropic models combined by eq 1 of seed 000.
+    Blend(BlendSpec) = "blend",
+    /// Generalized-Trowbridge-Reitz (Burley 2012; Smith G1 of seed 004), isotropic.
+    Gtr(GtrSpec) = "gtr",
+    /// A Gaussian distribution of slopes N(s̄, Σ) (seed 002, eq 1; slope sign of eq 11).
+    GaussianSlopes(GaussianSlopesSpec) = "gaussian_slopes",
 }
 
-/// Per-axis roughness written back as a spec's fields: `alpha` when isotropic, otherwise
-/// `alpha_x` and `alpha_y` (the inverse of [`resolve_roughness`]).
-pub fn roughness_fields(alpha_x: f64, alpha_y: f64) -> (Option<f64>, Option<f64>, Option<f64>) {
-    if alpha_x == alpha_y {
-        (Some(alpha_x), None, None)
-    } else {
-        (None, Some(alpha_x), Some(alpha_y))
-    }
+/// Declares the spec type of a family parameterized by roughness only: `alpha`, or `alpha_x`
+/// and `alpha_y` (validated when the model is built).
+macro_rules! roughness_spec {
+    ($(#[$doc:meta])* $name:ident) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct $name {
+            /// Isotropic roughness.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub alpha: Option<f64>,
+            /// Roughness along x.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub alpha_x: Option<f64>,
+            /// Roughness along y.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub alpha_y: Option<f64>,
+        }
+    };
 }
 
-/// The Smith limit of a Student-t shape parameter: Λ exists for `value` > 3/2 only.
-pub fn student_smith_limit(field: &'static str, value: f64) -> Option<(&'static str, f64)> {
-    (value <= 1.5).then_some((field, value))
+/// Declares the spec type of a Student member parameterized by γ and roughness (STD,
+/// Hyper-Cauchy, fixed variance: the same fields, a different member).
+macro_rules! student_spec {
+    ($(#[$doc:meta])* $name:ident) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct $name {
+            /// Shape γ (a number, or the string `"inf"`).
+            #[serde(with = "gamma_serde")]
+            pub gamma: f64,
+            /// Isotropic roughness.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub alpha: Option<f64>,
+            /// Roughness along x.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub alpha_x: Option<f64>,
+            /// Roughness along y.
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub alpha_y: Option<f64>,
+        }
+    };
 }
 
-impl ModelSpec {
-    /// The family name, as written in the spec's `family` key.
-    pub fn family(&self) -> &'static str {
-        crate::registry::info(self).name
-    }
+roughness_spec!(
+    /// The spec of a Beckmann model: `{"family": "beckmann", "alpha": 0.3}`, or `alpha_x` and
+    /// `alpha_y`.
+    BeckmannSpec
+);
+roughness_spec!(
+    /// The spec of a GGX model: `{"family": "ggx", "alpha": 0.3}`, or `alpha_x` and `alpha_y`.
+    GgxSpec
+);
+student_spec!(
+    /// The spec of an STD model (seed 001, f = 1/(γ−1)): `{"family": "std", "gamma": 2.5,
+    /// "alpha": 0.3}`; `gamma: "inf"` is Beckmann.
+    StdSpec
+);
+student_spec!(
+    /// The spec of a Hyper-Cauchy model (seed 001 eq 8, f = 1), γ > 1.
+    HyperCauchySpec
+);
+student_spec!(
+    /// The spec of the fixed-variance Student member (seed 001 eq 9, f = 1/(γ−2)), γ > 2;
+    /// `gamma: "inf"` is Beckmann.
+    FixedVarianceSpec
+);
 
-    /// Why the model has no Smith Λ (and so no G1 or G2), if that follows from its parameters
-    /// ([`FamilySpec::smith_limit`]). The message names the field and the limit.
-    pub fn smith_limit(&self) -> Option<String> {
-        let (field, value) = self.family_spec().smith_limit()?;
-        Some(format!(
-            "{} {field} = {value} has no Smith Λ: Λ diverges for {field} ≤ 3/2 (the mean \
-             slope is infinite); masking needs {field} > 3/2",
-            self.family()
-        ))
-    }
+/// The spec of the general isotropic family D^G(B, C) (seed 001 eq 1–2):
+/// `{"family": "student_general", "b": 4, "c": 2.5}`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeneralSpec {
+    /// B > 0.
+    pub b: f64,
+    /// C > 1.
+    pub c: f64,
+}
 
-    /// Validates the parameters and builds the model.
-    pub fn build(&self) -> Result<Box<dyn Model>, ParamError> {
-        self.family_spec().build()
-    }
+/// The spec of a piecewise-linear NDF: `{"family": "piecewise_linear", "x": {"theta": […],
+/// "value": […]}}`, with an optional profile `y` for the anisotropic blend.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PiecewiseSpec {
+    /// The profile D_x (alone: the isotropic D_iso).
+    pub x: AngularProfile,
+    /// The profile D_y of the anisotropic blend (eq 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y: Option<AngularProfile>,
+}
+
+/// The spec of a blend: `{"family": "blend", "x": {…}, "y": {…}}`, two isotropic model specs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlendSpec {
+    /// The model along x.
+    pub x: Box<ModelSpec>,
+    /// The model along y.
+    pub y: Box<ModelSpec>,
+}
+
+/// The spec of a GTR model: `{"family": "gtr", "gamma": 1.5, "alpha": 0.3}`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GtrSpec {
+    /// Shape 0 ≤ γ ≤ 10.
+    pub gamma: f64,
+    /// Roughness 1e-4 ≤ α ≤ 1.
+    pub alpha: f64,
+}
+
+/// The spec of a Gaussian distribution of slopes:
+/// `{"family": "gaussian_slopes", "mean": [0, 0], "cov": [[0.1, 0], [0, 0.2]]}`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GaussianSlopesSpec {
+    /// The mean slope s̄ = `[s̄x, s̄y]`.
+    pub mean: [f64; 2],
+    /// The covariance Σ = `[[σx², cxy], [cxy, σy²]]`, symmetric positive definite.
+    pub cov: [[f64; 2]; 2],
 }
 
 /// γ as a JSON number, or the string `"inf"` for +∞.
@@ -135,6 +241,7 @@ pub(crate) mod gamma_serde {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::ParamError;
 
     fn parse(text: &str) -> Result<ModelSpec, serde_json::Error> {
         serde_json::from_str(text)
@@ -195,7 +302,7 @@ mod tests {
         let s = parse(r#"{"family":"gtr","gamma":1.5,"alpha":0.3}"#).unwrap();
         assert_eq!(
             s,
-            ModelSpec::Gtr(crate::ndf::gtr::GtrSpec {
+            ModelSpec::Gtr(GtrSpec {
                 gamma: 1.5,
                 alpha: 0.3
             })
@@ -226,18 +333,6 @@ mod tests {
 
     #[test]
     fn bad_parameters_are_typed_errors() {
-        let e = resolve_roughness(Some(0.1), Some(0.2), None).unwrap_err();
-        assert!(matches!(e, ParamError::Combination(_)));
-        let e = resolve_roughness(Some(f64::NAN), None, None).unwrap_err();
-        assert!(matches!(e, ParamError::AlphaNotPositive { .. }));
-        let e = resolve_roughness(None, Some(0.1), Some(-1.0)).unwrap_err();
-        assert!(matches!(
-            e,
-            ParamError::AlphaNotPositive {
-                name: "alpha_y",
-                ..
-            }
-        ));
         for gamma in [1.0, 0.5, f64::NAN, 2e8] {
             let e = parse(&format!(
                 r#"{{"family":"std","gamma":{},"alpha":0.3}}"#,

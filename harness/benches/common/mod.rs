@@ -5,7 +5,7 @@
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, Throughput};
 use mfh_reference::geometry::from_spherical;
-use mfh_reference::ndf::{Beckmann, Ggx, PiecewiseLinear, Profile};
+use mfh_reference::ndf::{AngularProfile, Beckmann, Ggx, PiecewiseLinear};
 use mfh_reference::{Ndf, Vec3};
 use std::f64::consts::FRAC_PI_2;
 use std::hint::black_box;
@@ -86,7 +86,7 @@ pub fn config(measurement: Duration, warm_up: Duration) -> Criterion {
 pub fn piecewise_model() -> PiecewiseLinear {
     let ggx = Ggx::new(0.2, 0.2).expect("valid");
     let beckmann = Beckmann::new(0.4, 0.4).expect("valid");
-    let x = Profile::discretize(&|t| ggx.d(from_spherical(t, 0.0)), 32);
-    let y = Profile::discretize(&|t| beckmann.d(from_spherical(t, 0.0)), 32);
+    let x = AngularProfile::discretize(&|t| ggx.d(from_spherical(t, 0.0)), 32);
+    let y = AngularProfile::discretize(&|t| beckmann.d(from_spherical(t, 0.0)), 32);
     PiecewiseLinear::new(x, Some(y)).expect("valid profiles")
 }

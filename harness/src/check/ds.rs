@@ -318,11 +318,8 @@ mod dump {
     use super::*;
 
     #[test]
+    #[cfg_attr(not(mfh_extensive), ignore = "extensive tier: set MFH_EXTENSIVE=1")]
     fn standard() {
-        if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (docs/testing.md, \"The extensive tier\")");
-            return;
-        }
         let spec = ModelSpec::GaussianSlopes(mfh_reference::slopes::gaussian::GaussianSlopesSpec {
             mean: [0.1, -0.2],
             cov: [[0.04, 0.01], [0.01, 0.09]],

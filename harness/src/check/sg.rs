@@ -4,18 +4,17 @@
 //! integral, product, ASG–SG convolution), each against sphere quadrature or its definition.
 //!
 //! The shared geometry and record helpers live here; the checks mirror `reference/src/sg/`:
-//! `sg.rs`, `circular.rs`, `asg.rs`.
+//! `isotropic.rs`, `circular.rs`, `asg.rs`.
 
 mod asg;
 mod circular;
-#[allow(clippy::module_inception)]
-mod sg;
+mod isotropic;
 
 use crate::check::Check;
 use asg::plan_asg;
 use circular::plan_circular;
-use sg::plan_sg;
-pub use sg::product_check;
+use isotropic::plan_sg;
+pub use isotropic::product_check;
 
 use super::{compare, compare_exact, covers, Planned, Profile};
 use crate::oracle::quadrature::{frame_about, integrate_cap, Accuracy, Cuts};

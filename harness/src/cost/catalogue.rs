@@ -21,8 +21,8 @@
 
 use super::{Candidate, Selection, Sweep};
 use crate::oracle::precise::student_lambda_standardized;
-use mfh_reference::ndf::piecewise::{PiecewiseLinear, Profile};
 use mfh_reference::ndf::{gtr_lambda, student_lambda};
+use mfh_reference::ndf::{AngularProfile, PiecewiseLinear};
 use mfh_reference::sg::{Asg, Sg};
 use mfh_reference::Smith;
 use std::f64::consts::FRAC_PI_2;
@@ -248,7 +248,7 @@ pub fn piecewise() -> Sweep<'static> {
         PIECES
             .iter()
             .map(|&n| {
-                PiecewiseLinear::new(Profile::discretize(&ggx_profile, n), None)
+                PiecewiseLinear::new(AngularProfile::discretize(&ggx_profile, n), None)
                     .expect("a discretized GGX profile is a valid piecewise-linear model")
             })
             .collect(),

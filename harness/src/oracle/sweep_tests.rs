@@ -27,8 +27,9 @@ fn model(json: &str) -> Box<dyn Model> {
         .unwrap()
 }
 
+/// The extensive tier (`MFH_EXTENSIVE=1`, read by the build script: `mfh-test-tiers`).
 fn extensive() -> bool {
-    std::env::var("MFH_EXTENSIVE").is_ok_and(|v| v == "1")
+    cfg!(mfh_extensive)
 }
 
 /// The roughness pairs: (a, a) and the 1:100 pair (a, 100a), or (a/100, a) where 100a > 2.

@@ -11,6 +11,7 @@ use crate::oracle::ks::ks_p_value;
 use crate::oracle::ks::{ks_statistic, ks_test_lobe, KsConfig, Marginal};
 use crate::oracle::lobe;
 use crate::tolerance::CELL_RELATIVE_TOLERANCE;
+use mfh_reference::family::FamilySpec;
 use mfh_reference::{ModelSpec, Vec3};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -183,7 +184,7 @@ pub fn calibrate(
             .as_sampler()
             .ok_or_else(|| format!("calibration model {text} has no sampler"))?;
         let value = serde_json::to_value(&spec).unwrap_or(Value::Null);
-        let kinks = (mfh_reference::registry::info(&spec).theta_kinks)(&spec);
+        let kinks = spec.theta_kinks();
         let lobe = lobe::measure(&|m: Vec3| model.d(m) * m[2]);
         let seed = |i: usize| CALIBRATION_SEED.wrapping_add(i as u64);
         // Chi-square, as `sampling.chi2` runs it (R = 16).

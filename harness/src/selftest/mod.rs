@@ -24,6 +24,7 @@ use crate::run::DEFAULT_SEED;
 use crate::run::{run_plan, AuditOptions};
 use crate::subject::{spec_width, Hints};
 use catalog::{Entry, Route, CATALOG};
+use mfh_reference::family::FamilySpec;
 use mfh_reference::{Model, ModelSpec};
 use mutant::Mutated;
 use serde::Serialize;
@@ -211,7 +212,7 @@ pub(crate) fn hints_of(base: &Value) -> Hints {
     };
     Hints {
         lobe_width: Some(spec_width(&spec)),
-        theta_kinks: (mfh_reference::registry::info(&spec).theta_kinks)(&spec),
+        theta_kinks: spec.theta_kinks(),
         anisotropic: None,
     }
 }

@@ -1,5 +1,7 @@
 //! What the external-protocol tests share (included by `external.rs` and `external_audit.rs`
-//! with `#[path]`): where the examples are, the CLI runner, and the numpy / extensive-tier gates.
+//! with `#[path]`): where the examples are, the CLI runner, and what a numpy test checks first.
+//! Which tests run is decided by cfg flags (`has_numpy`, `mfh_extensive`) that the build script
+//! sets by the rules of `mfh-test-tiers`: a test left out is ignored, and listed as such.
 
 #![allow(dead_code)] // each test file uses its own subset
 
@@ -25,28 +27,17 @@ pub fn run(args: &[&str]) -> (i32, String, String) {
     mfh_harness::cli::run_captured(args)
 }
 
-/// Whether python3 has numpy. Without it a numpy test is skipped with a message, except under
-/// CI (`.ci/run` installs numpy, so there a missing numpy fails the test).
-pub fn has_numpy() -> bool {
+/// Fails the test with a clear message if python3 has no numpy. A numpy test runs where the
+/// build found numpy (`has_numpy`) or under `CI=true`, where `.ci/run` installs it: there a
+/// missing numpy is a failure, not a skip.
+pub fn require_numpy() {
     let present = std::process::Command::new("python3")
         .args(["-c", "import numpy"])
         .status()
         .is_ok_and(|s| s.success());
-    if !present {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI is set but numpy is missing: .ci/run installs it"
-        );
-        eprintln!("SKIPPED: numpy is not installed (python3 -m pip install numpy)");
-    }
-    present
-}
-
-/// Whether the extensive tier runs (MFH_EXTENSIVE set); if not, says why the test is skipped.
-pub fn extensive(why: &str) -> bool {
-    let on = std::env::var_os("MFH_EXTENSIVE").is_some();
-    if !on {
-        eprintln!("skipped: extensive tier ({why}), run with MFH_EXTENSIVE=1");
-    }
-    on
+    assert!(
+        present,
+        "numpy is missing (CI=true, or it was removed since the build): .ci/run installs it \
+         (python3 -m pip install numpy)"
+    );
 }

@@ -145,7 +145,7 @@ fn microfacet(
     if sampling == Sampling::PseudoVnis {
         return match ndf {
             ModelSpec::Std(s) if s.gamma.is_finite() => {
-                let (ax, ay) = crate::spec::resolve_roughness(s.alpha, s.alpha_x, s.alpha_y)?;
+                let (ax, ay) = crate::family::resolve_roughness(s.alpha, s.alpha_x, s.alpha_y)?;
                 Ok(Microfacet::pseudo_vnis(
                     PseudoVnis::new(s.gamma, ax, ay)?,
                     masking,

@@ -345,13 +345,13 @@ pub fn algorithm2_printed(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ndf::piecewise::Profile;
+    use crate::ndf::angular_profile::AngularProfile;
     use crate::test_support::{integrate, rel_err};
 
     fn model() -> PiecewiseLinear {
         PiecewiseLinear::new(
-            Profile::uniform(vec![3.0, 2.2, 1.4, 0.9, 0.3, 0.05]),
-            Some(Profile::uniform(vec![1.0, 0.95, 0.7, 0.2, 0.02])),
+            AngularProfile::uniform(vec![3.0, 2.2, 1.4, 0.9, 0.3, 0.05]),
+            Some(AngularProfile::uniform(vec![1.0, 0.95, 0.7, 0.2, 0.02])),
         )
         .unwrap()
     }

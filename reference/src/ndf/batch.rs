@@ -16,7 +16,7 @@
 //! SIMD math crate would not round as the scalar `libm` kernels do.
 
 use crate::geometry::Vec3;
-use crate::ndf::ggx::VisibleFrame;
+use crate::ndf::ggx_visible::VisibleFrame;
 
 /// Elements per block: the temporaries live on the stack (5 × 64 doubles).
 const BLOCK: usize = 64;

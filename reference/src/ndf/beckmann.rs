@@ -1,11 +1,14 @@
 //! The Beckmann NDF, isotropic and anisotropic: the γ → ∞ limit of STD (seed 001, §2, Table 1).
 
 use crate::error::{ParamError, QueryError};
+use crate::family::{resolve_roughness, roughness_fields, FamilyInfo, FamilySpec};
 use crate::geometry::{normal_from_slopes, Vec3};
 use crate::model::{
     check_alpha, elliptic_direction, lambda_both_hemispheres, scale_along, standardized_cotangent,
     visible_domain, Model, Ndf, NormalSampler, SlopeDistribution, Smith, VisibleNormalSampler,
 };
+/// The family's spec type (declared with every family's in `crate::spec`).
+pub use crate::spec::BeckmannSpec;
 use crate::spec::ModelSpec;
 use std::f64::consts::PI;
 
@@ -261,25 +264,9 @@ impl SlopeDistribution for Beckmann {
     }
 }
 
-/// The spec of a Beckmann model: `{"family": "beckmann", "alpha": 0.3}`, or `alpha_x` and
-/// `alpha_y`.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BeckmannSpec {
-    /// Isotropic roughness.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub alpha: Option<f64>,
-    /// Roughness along x.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub alpha_x: Option<f64>,
-    /// Roughness along y.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub alpha_y: Option<f64>,
-}
-
-impl crate::spec::FamilySpec for BeckmannSpec {
+impl FamilySpec for BeckmannSpec {
     fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
-        let (ax, ay) = crate::spec::resolve_roughness(self.alpha, self.alpha_x, self.alpha_y)?;
+        let (ax, ay) = resolve_roughness(self.alpha, self.alpha_x, self.alpha_y)?;
         Ok(Box::new(Beckmann::new(ax, ay)?))
     }
 }
@@ -287,8 +274,7 @@ impl crate::spec::FamilySpec for BeckmannSpec {
 impl Model for Beckmann {
     fn spec(&self) -> ModelSpec {
         self.described_as.clone().unwrap_or_else(|| {
-            let (alpha, alpha_x, alpha_y) =
-                crate::spec::roughness_fields(self.alpha_x, self.alpha_y);
+            let (alpha, alpha_x, alpha_y) = roughness_fields(self.alpha_x, self.alpha_y);
             ModelSpec::Beckmann(BeckmannSpec {
                 alpha,
                 alpha_x,
@@ -306,7 +292,7 @@ impl Model for Beckmann {
 }
 
 /// The registry entry of beckmann ([`crate::registry`]).
-pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+pub const INFO: FamilyInfo = FamilyInfo {
     name: "beckmann",
     documents: &["001"],
     source: "seed 001 Table 1 (γ → ∞)",
@@ -320,15 +306,8 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     stress_specs: &[],
     lambda_numerical: false,
     slow_sampler: false,
-    sampler_cost: crate::registry::SamplerCost {
-        normal_ns: 23.0,
-        visible_ns: 634.0,
-    },
     beckmann_limit: false,
     intrinsic_moments: false,
-    tail_exponent: crate::registry::no_tail,
-    theta_kinks: crate::registry::no_kinks,
-    mean_slope: crate::registry::zero_mean,
 };
 
 #[cfg(test)]

@@ -2,9 +2,12 @@
 //! isotropic NDFs, e.g. GGX along x and Beckmann along y.
 
 use crate::error::{ParamError, QueryError};
+use crate::family::{FamilyInfo, FamilySpec};
 use crate::geometry::{from_spherical, Vec3};
 use crate::model::{Model, Ndf, Smith};
 use crate::ndf::piecewise_lambda::{both_hemispheres, lambda_exact, EXACT_REL};
+/// The family's spec type (declared with every family's in `crate::spec`).
+pub use crate::spec::BlendSpec;
 use crate::spec::ModelSpec;
 
 /// Interval ends for the Λ quadrature: the analytic profiles have no kinks, but narrow peaks
@@ -20,7 +23,7 @@ const CUTS: [f64; 7] = [0.01, 0.03, 0.1, 0.3, 0.6, 1.0, 1.3];
 ///
 /// The document blends the analytic D_x, D_y directly here (§1.1, §1.2: "one could be defined
 /// from GGX formulation and the second from Beckmann"); it discretizes to a piecewise-linear
-/// profile only for its controllable NDF (`PiecewiseLinear`, `Profile::discretize`), which is
+/// profile only for its controllable NDF (`PiecewiseLinear`, `AngularProfile::discretize`), which is
 /// what makes its Smith derivation tractable. This model does the former: no discretization.
 /// Smith Λ is by the exact route of `piecewise_lambda::lambda_exact` (adaptive quadrature of
 /// the back-facing projected area, relative accuracy ~1e-13); the document gives no Λ for this
@@ -151,19 +154,21 @@ impl Smith for Blend {
     }
 }
 
-/// The spec of a blend: `{"family": "blend", "x": {…}, "y": {…}}`, two isotropic model specs.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BlendSpec {
-    /// The model along x.
-    pub x: Box<ModelSpec>,
-    /// The model along y.
-    pub y: Box<ModelSpec>,
-}
-
-impl crate::spec::FamilySpec for BlendSpec {
+/// The blend's specs are any family's: they are built and asked for their kinks through
+/// [`FamilySpec`] (which the registry implements for every spec), not by naming the families.
+impl FamilySpec for BlendSpec {
     fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
-        Ok(Box::new(Blend::new(self.x.build()?, self.y.build()?)?))
+        let (x, y) = (FamilySpec::build(&*self.x)?, FamilySpec::build(&*self.y)?);
+        Ok(Box::new(Blend::new(x, y)?))
+    }
+
+    /// The kinks of the two models.
+    fn theta_kinks(&self) -> Vec<f64> {
+        let mut out = FamilySpec::theta_kinks(&*self.x);
+        out.extend(FamilySpec::theta_kinks(&*self.y));
+        out.sort_by(f64::total_cmp);
+        out.dedup();
+        out
     }
 }
 
@@ -181,7 +186,7 @@ impl Model for Blend {
 }
 
 /// The registry entry of the blend of seed 000 eq 1 ([`crate::registry`]).
-pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+pub const INFO: FamilyInfo = FamilyInfo {
     name: "blend",
     documents: &["000"],
     source: "seed 000 eq 1 (two isotropic NDFs)",
@@ -194,25 +199,9 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     stress_specs: &[],
     lambda_numerical: true,
     slow_sampler: false,
-    sampler_cost: crate::registry::NO_SAMPLER,
     beckmann_limit: false,
     intrinsic_moments: false,
-    tail_exponent: crate::registry::no_tail,
-    theta_kinks: blend_kinks,
-    mean_slope: crate::registry::zero_mean,
 };
-
-/// The kinks of a blend: those of its two models.
-pub fn blend_kinks(spec: &crate::ModelSpec) -> Vec<f64> {
-    let crate::ModelSpec::Blend(BlendSpec { x, y }) = spec else {
-        return Vec::new();
-    };
-    let mut out = (crate::registry::info(x).theta_kinks)(x);
-    out.extend((crate::registry::info(y).theta_kinks)(y));
-    out.sort_by(f64::total_cmp);
-    out.dedup();
-    out
-}
 
 #[cfg(test)]
 mod tests {

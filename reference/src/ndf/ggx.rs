@@ -1,11 +1,15 @@
 //! The GGX (Trowbridge–Reitz) NDF, isotropic and anisotropic: STD at γ = 2 (seed 001, Table 1).
 
 use crate::error::{ParamError, QueryError};
+use crate::family::{resolve_roughness, roughness_fields, FamilyInfo, FamilySpec};
 use crate::geometry::{normal_from_slopes, Vec3};
 use crate::model::{
     check_alpha, elliptic_direction, lambda_both_hemispheres, scale_along, standardized_cotangent,
-    visible_domain, Model, Ndf, NormalSampler, SlopeDistribution, Smith, VisibleNormalSampler,
+    Model, Ndf, NormalSampler, SlopeDistribution, Smith, VisibleNormalSampler,
 };
+use crate::ndf::ggx_visible::VisibleFrame;
+/// The family's spec type (declared with every family's in `crate::spec`).
+pub use crate::spec::GgxSpec;
 use crate::spec::ModelSpec;
 use std::f64::consts::PI;
 
@@ -168,73 +172,6 @@ impl VisibleNormalSampler for Ggx {
     }
 }
 
-/// The part of Heitz's visible-normal sampler that depends only on the incidence (the
-/// stretched view V_h, its tangent frame T1, T2 and the warp s; the listing above), computed
-/// once per incidence by the scalar and the batch sampler alike.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct VisibleFrame {
-    alpha_x: f64,
-    alpha_y: f64,
-    vh: Vec3,
-    t1: Vec3,
-    t2: Vec3,
-    s: f64,
-}
-
-impl VisibleFrame {
-    /// The frame of incidence `wi`, or `None` outside the visible domain (non-unit, or at or
-    /// below the horizon).
-    pub(crate) fn new(alpha_x: f64, alpha_y: f64, wi: Vec3) -> Option<Self> {
-        if !visible_domain(wi) {
-            return None;
-        }
-        let vh = normalize([alpha_x * wi[0], alpha_y * wi[1], wi[2]]);
-        let lensq = vh[0] * vh[0] + vh[1] * vh[1];
-        let t1 = if lensq > 0.0 {
-            let inv = 1.0 / lensq.sqrt();
-            [-vh[1] * inv, vh[0] * inv, 0.0]
-        } else {
-            [1.0, 0.0, 0.0]
-        };
-        let t2 = [
-            vh[1] * t1[2] - vh[2] * t1[1],
-            vh[2] * t1[0] - vh[0] * t1[2],
-            vh[0] * t1[1] - vh[1] * t1[0],
-        ];
-        Some(Self {
-            alpha_x,
-            alpha_y,
-            vh,
-            t1,
-            t2,
-            s: 0.5 * (1.0 + vh[2]),
-        })
-    }
-
-    /// The sampled normal from r = √u₀ and (sin, cos) of 2πu₁: the per-sample part of the
-    /// listing, without a branch (`max` and `sqrt` only), so that a loop over it vectorizes.
-    #[inline(always)]
-    pub(crate) fn normal(&self, r: f64, sp: f64, cp: f64) -> Vec3 {
-        let (vh, t1v, t2v, s) = (self.vh, self.t1, self.t2, self.s);
-        let t1 = r * cp;
-        let t2 = (1.0 - s) * (1.0 - t1 * t1).max(0.0).sqrt() + s * r * sp;
-        let lift = (1.0 - t1 * t1 - t2 * t2).max(0.0).sqrt();
-        let nh = [
-            t1 * t1v[0] + t2 * t2v[0] + lift * vh[0],
-            t1 * t1v[1] + t2 * t2v[1] + lift * vh[1],
-            t1 * t1v[2] + t2 * t2v[2] + lift * vh[2],
-        ];
-        normalize([self.alpha_x * nh[0], self.alpha_y * nh[1], nh[2].max(0.0)])
-    }
-}
-
-/// `v / |v|`.
-#[inline(always)]
-fn normalize(v: Vec3) -> Vec3 {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    [v[0] / l, v[1] / l, v[2] / l]
-}
-
 impl SlopeDistribution for Ggx {
     fn p22(&self, p: f64, q: f64) -> f64 {
         let t = 1.0 + (p / self.alpha_x).powi(2) + (q / self.alpha_y).powi(2);
@@ -254,31 +191,16 @@ impl SlopeDistribution for Ggx {
     }
 }
 
-/// The spec of a GGX model: `{"family": "ggx", "alpha": 0.3}`, or `alpha_x` and `alpha_y`.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GgxSpec {
-    /// Isotropic roughness.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub alpha: Option<f64>,
-    /// Roughness along x.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub alpha_x: Option<f64>,
-    /// Roughness along y.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub alpha_y: Option<f64>,
-}
-
-impl crate::spec::FamilySpec for GgxSpec {
+impl FamilySpec for GgxSpec {
     fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
-        let (ax, ay) = crate::spec::resolve_roughness(self.alpha, self.alpha_x, self.alpha_y)?;
+        let (ax, ay) = resolve_roughness(self.alpha, self.alpha_x, self.alpha_y)?;
         Ok(Box::new(Ggx::new(ax, ay)?))
     }
 }
 
 impl Model for Ggx {
     fn spec(&self) -> ModelSpec {
-        let (alpha, alpha_x, alpha_y) = crate::spec::roughness_fields(self.alpha_x, self.alpha_y);
+        let (alpha, alpha_x, alpha_y) = roughness_fields(self.alpha_x, self.alpha_y);
         ModelSpec::Ggx(GgxSpec {
             alpha,
             alpha_x,
@@ -292,7 +214,7 @@ impl Model for Ggx {
 }
 
 /// The registry entry of ggx ([`crate::registry`]).
-pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+pub const INFO: FamilyInfo = FamilyInfo {
     name: "ggx",
     documents: &["001"],
     source: "seed 001 Table 1 (γ = 2)",
@@ -306,15 +228,8 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     stress_specs: &[],
     lambda_numerical: false,
     slow_sampler: false,
-    sampler_cost: crate::registry::SamplerCost {
-        normal_ns: 11.0,
-        visible_ns: 14.0,
-    },
     beckmann_limit: false,
     intrinsic_moments: false,
-    tail_exponent: crate::registry::no_tail,
-    theta_kinks: crate::registry::no_kinks,
-    mean_slope: crate::registry::zero_mean,
 };
 
 #[cfg(test)]

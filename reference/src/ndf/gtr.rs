@@ -2,12 +2,15 @@
 //! (Dimov 2015) for every γ ≥ 0: isotropic, shape `gamma`, roughness `alpha`.
 
 use crate::error::{ParamError, QueryError};
+use crate::family::{FamilyInfo, FamilySpec};
 use crate::geometry::Vec3;
 use crate::model::{
     check_alpha, lambda_both_hemispheres, standardized_cotangent, Model, Ndf, NormalSampler,
     SlopeDistribution, Smith,
 };
 use crate::ndf::gtr_lambda as routes;
+/// The family's spec type (declared with every family's in `crate::spec`).
+pub use crate::spec::GtrSpec;
 use crate::spec::ModelSpec;
 use crate::special::gauss_kronrod;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -73,20 +76,6 @@ impl Inversion {
     }
 }
 
-/// The normalization constant c of D_GTR (seed 004 eq 1**, 4**) in the form
-/// c = expm1(L) / (π · expm1(sL)/s), s = 1 − γ, L = log α², with the limits expm1(sL)/s → L at
-/// s = 0 (γ = 1, eq 4**) and c → 1/π at L = 0 (α = 1). No 0/0 anywhere; relative accuracy a few
-/// ulps for 0 ≤ γ ≤ 10, 1e-4 ≤ α ≤ 1.
-pub fn normalization_constant(gamma: f64, alpha: f64) -> f64 {
-    let l = 2.0 * alpha.ln();
-    if l == 0.0 {
-        return 1.0 / PI;
-    }
-    let s = 1.0 - gamma;
-    let denominator = if s == 0.0 { l } else { (s * l).exp_m1() / s };
-    l.exp_m1() / (PI * denominator)
-}
-
 impl Gtr {
     /// A validated GTR NDF: 0 ≤ γ ≤ 10 and 1e-4 ≤ α ≤ 1 (NaN fails).
     pub fn new(gamma: f64, alpha: f64) -> Result<Self, ParamError> {
@@ -109,7 +98,7 @@ impl Gtr {
             gamma,
             alpha,
             a2: alpha * alpha,
-            c: normalization_constant(gamma, alpha),
+            c: routes::normalization_constant(gamma, alpha),
             inversion: Inversion::new(gamma, alpha),
         })
     }
@@ -124,7 +113,7 @@ impl Gtr {
         self.alpha
     }
 
-    /// The normalization constant c of D (`normalization_constant`).
+    /// The normalization constant c of D (`gtr_lambda::normalization_constant`).
     pub fn normalization(&self) -> f64 {
         self.c
     }
@@ -312,17 +301,7 @@ impl SlopeDistribution for Gtr {
     }
 }
 
-/// The spec of a GTR model: `{"family": "gtr", "gamma": 1.5, "alpha": 0.3}`.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GtrSpec {
-    /// Shape 0 ≤ γ ≤ 10.
-    pub gamma: f64,
-    /// Roughness 1e-4 ≤ α ≤ 1.
-    pub alpha: f64,
-}
-
-impl crate::spec::FamilySpec for GtrSpec {
+impl FamilySpec for GtrSpec {
     fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
         Ok(Box::new(Gtr::new(self.gamma, self.alpha)?))
     }
@@ -342,7 +321,7 @@ impl Model for Gtr {
 }
 
 /// The registry entry of gtr ([`crate::registry`]).
-pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+pub const INFO: FamilyInfo = FamilyInfo {
     name: "gtr",
     documents: &["004"],
     source: "seed 004 §2 (Burley 2012 GTR), Smith G1 of seed 004",
@@ -353,15 +332,8 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     stress_specs: &[],
     lambda_numerical: true,
     slow_sampler: false,
-    sampler_cost: crate::registry::SamplerCost {
-        normal_ns: 84.0,
-        visible_ns: 0.0,
-    },
     beckmann_limit: false,
     intrinsic_moments: false,
-    tail_exponent: crate::registry::no_tail,
-    theta_kinks: crate::registry::no_kinks,
-    mean_slope: crate::registry::zero_mean,
 };
 
 #[cfg(test)]

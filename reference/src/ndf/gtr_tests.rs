@@ -797,11 +797,8 @@ mod accuracy_table {
     }
 
     #[test]
+    #[cfg_attr(not(mfh_extensive), ignore = "extensive tier: set MFH_EXTENSIVE=1")]
     fn accuracy_table_gtr() {
-        if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (docs/testing.md, \"The extensive tier\")");
-            return;
-        }
         let mut out = ReportTable::new("seed004");
         // route label, quantity compared ("Λ" or "G1").
         let rows = [

@@ -1,9 +1,11 @@
 //! Normal distribution functions, one model per file.
 
+pub mod angular_profile;
 mod batch;
 pub mod beckmann;
 pub mod blend;
 pub mod ggx;
+mod ggx_visible;
 pub mod gtr;
 pub mod gtr_lambda;
 pub mod piecewise;
@@ -17,9 +19,10 @@ mod conformance;
 #[cfg(test)]
 mod student_errata;
 
+pub use angular_profile::AngularProfile;
 pub use beckmann::Beckmann;
 pub use blend::Blend;
 pub use ggx::Ggx;
 pub use gtr::Gtr;
-pub use piecewise::{PiecewiseLinear, Profile};
+pub use piecewise::PiecewiseLinear;
 pub use student::Student;

@@ -1,62 +1,21 @@
 //! The piecewise-linear NDF of seed 000 (Ribardière et al., "A Piecewise-Linear NDF"):
 //! isotropic profiles linear between breakpoints (eq 4–5), their anisotropic blend (eq 1–3),
-//! importance sampling (eq 6–9, Algorithms 1–2) and the Smith Λ routes (eq 10–34, in
-//! `piecewise_lambda`).
+//! importance sampling (eq 6–9, Algorithms 1–2); the Smith Λ routes (eq 10–34) and the model's
+//! `Smith` implementation are in `piecewise_lambda`, which builds on this file.
 
-use crate::error::{ParamError, QueryError};
+use crate::error::ParamError;
+use crate::family::{FamilyInfo, FamilySpec};
 use crate::geometry::Vec3;
 use crate::model::{Model, Ndf, NormalSampler, Smith};
-use crate::ndf::piecewise_lambda as routes;
+use crate::ndf::angular_profile::AngularProfile;
 use crate::spec::ModelSpec;
-use serde::{Deserialize, Serialize};
+/// The family's spec type (declared with every family's in `crate::spec`).
+pub use crate::spec::PiecewiseSpec;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// The default inversion tolerance of the samplers: the largest accepted |cdf(x) − ξ| (seed 000
 /// Algorithms 1–2 print 1e-5).
 pub const DEFAULT_TOLERANCE: f64 = 1e-12;
-
-/// An isotropic profile D_iso(θ) given by its values at breakpoints θ₀ = 0 < θ₁ < … < θₙ = π/2
-/// (seed 000, eq 4), linear in between. The values need not be normalized: the model divides
-/// them by c_iso (eq 5).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Profile {
-    /// The breakpoints θᵢ in radians: strictly increasing from 0 to π/2.
-    pub theta: Vec<f64>,
-    /// D_iso(θᵢ): finite, ≥ 0, not all zero.
-    pub value: Vec<f64>,
-}
-
-impl Profile {
-    /// A profile from breakpoints and values (validated when a model is built from it).
-    pub fn new(theta: Vec<f64>, value: Vec<f64>) -> Self {
-        Self { theta, value }
-    }
-
-    /// Values at n equally spaced breakpoints θᵢ = i·π/(2(n−1)) (the document's constant Δθ,
-    /// eq 28).
-    pub fn uniform(value: Vec<f64>) -> Self {
-        let n = value.len();
-        let theta = (0..n)
-            .map(|i| {
-                if i + 1 == n {
-                    FRAC_PI_2
-                } else {
-                    i as f64 * FRAC_PI_2 / (n.max(2) - 1) as f64
-                }
-            })
-            .collect();
-        Self { theta, value }
-    }
-
-    /// An isotropic NDF discretized at `n` equally spaced breakpoints (seed 000 §1.2: "D_x and
-    /// D_y can be discretized from any common NDFs"). `d_of_theta` gives D(θ).
-    pub fn discretize(d_of_theta: &dyn Fn(f64) -> f64, n: usize) -> Self {
-        let grid = Self::uniform(vec![0.0; n]).theta;
-        let value = grid.iter().map(|&t| d_of_theta(t)).collect();
-        Self { theta: grid, value }
-    }
-}
 
 /// The piecewise-linear NDF of seed 000 with one profile (isotropic) or two (the anisotropic
 /// blend of eq 1).
@@ -82,8 +41,8 @@ impl Profile {
 #[derive(Debug, Clone, PartialEq)]
 pub struct PiecewiseLinear {
     /// The profiles as given (for `spec`).
-    pub(super) x: Profile,
-    pub(super) y: Option<Profile>,
+    pub(super) x: AngularProfile,
+    pub(super) y: Option<AngularProfile>,
     /// c_iso of each profile (eq 5).
     pub(super) c_iso_x: f64,
     pub(super) c_iso_y: f64,
@@ -110,7 +69,7 @@ pub struct PiecewiseLinear {
 
 impl PiecewiseLinear {
     /// A validated piecewise-linear NDF: `x` alone is isotropic; with `y`, the blend of eq 1.
-    pub fn new(x: Profile, y: Option<Profile>) -> Result<Self, ParamError> {
+    pub fn new(x: AngularProfile, y: Option<AngularProfile>) -> Result<Self, ParamError> {
         let c_iso_x = validate("x", &x)?;
         let c_iso_y = match &y {
             Some(p) => validate("y", p)?,
@@ -363,7 +322,7 @@ impl PiecewiseLinear {
 
 /// c_iso by seed 000 eq 5 exactly as printed (a difference of end-point terms per segment;
 /// correct, but it cancels for short segments). `profile` is raw (unnormalized).
-pub fn c_iso_eq5_printed(profile: &Profile) -> f64 {
+pub fn c_iso_eq5_printed(profile: &AngularProfile) -> f64 {
     let (t, v) = (&profile.theta, &profile.value);
     let mut sum = 0.0;
     for i in 1..t.len() {
@@ -377,7 +336,7 @@ pub fn c_iso_eq5_printed(profile: &Profile) -> f64 {
 }
 
 /// Validates a profile (seed 000 eq 4 domain) and returns its c_iso (eq 5).
-fn validate(axis: &'static str, p: &Profile) -> Result<f64, ParamError> {
+fn validate(axis: &'static str, p: &AngularProfile) -> Result<f64, ParamError> {
     let bad = |index: usize, requirement: &'static str, value: f64| ParamError::InvalidProfile {
         axis,
         index,
@@ -432,7 +391,7 @@ fn validate(axis: &'static str, p: &Profile) -> Result<f64, ParamError> {
 }
 
 /// Linear interpolation of a raw profile at θ.
-fn interp(p: &Profile, theta: f64) -> f64 {
+fn interp(p: &AngularProfile, theta: f64) -> f64 {
     let n = p.theta.len();
     let i = p
         .theta
@@ -601,70 +560,28 @@ impl NormalSampler for PiecewiseLinear {
     }
 }
 
-impl Smith for PiecewiseLinear {
-    /// The "exact" route (see `lambda_routes`).
-    fn lambda(&self, w: Vec3) -> f64 {
-        routes::both_hemispheres(w, |t, c2| routes::lambda_exact_piecewise(self, t, c2))
-    }
-
-    /// `exact` (default; adaptive Gauss–Kronrod of the back-facing projected area, eq 10–13,
-    /// relative accuracy 1e-13), `domain_split` (eq 16, 23, 26 and the trapezoid rule of eq 28,
-    /// combined by eq 34 — the document's approximation), `domain_split_adaptive` (the same
-    /// split with the remaining integral of eq 27 by adaptive quadrature: exact), `slope_space`
-    /// (eq 30–32 corrected, nested adaptive quadrature over P2 along the azimuth of w).
-    fn lambda_routes(&self) -> Vec<&'static str> {
-        vec![
-            "exact",
-            "domain_split",
-            "domain_split_adaptive",
-            "slope_space",
-        ]
-    }
-
-    fn lambda_route(&self, w: Vec3, route: &str) -> Result<f64, QueryError> {
-        use routes::Remaining;
-        Ok(match route {
-            "exact" | "default" => self.lambda(w),
-            "domain_split" => routes::both_hemispheres(w, |t, c2| {
-                routes::domain_split(self, t, c2, Remaining::Trapezoid).lambda
-            }),
-            "domain_split_adaptive" => routes::both_hemispheres(w, |t, c2| {
-                routes::domain_split(self, t, c2, Remaining::Adaptive).lambda
-            }),
-            "slope_space" => {
-                routes::both_hemispheres(w, |t, c2| routes::lambda_slope_space(self, t, c2))
-            }
-            _ => {
-                return Err(QueryError::Route {
-                    route: route.to_string(),
-                    reason: format!(
-                        "piecewise-linear Λ routes: {}",
-                        self.lambda_routes().join(", ")
-                    ),
-                })
-            }
-        })
-    }
-}
-
-/// The spec of a piecewise-linear NDF: `{"family": "piecewise_linear", "x": {"theta": […],
-/// "value": […]}}`, with an optional profile `y` for the anisotropic blend.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PiecewiseSpec {
-    /// The profile D_x (alone: the isotropic D_iso).
-    pub x: Profile,
-    /// The profile D_y of the anisotropic blend (eq 1).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub y: Option<Profile>,
-}
-
-impl crate::spec::FamilySpec for PiecewiseSpec {
+impl FamilySpec for PiecewiseSpec {
     fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
         Ok(Box::new(PiecewiseLinear::new(
             self.x.clone(),
             self.y.clone(),
         )?))
+    }
+
+    /// The interior breakpoints of the profiles (both of the anisotropic blend, whose weights
+    /// depend on φ only): D has kinks there for every azimuth.
+    fn theta_kinks(&self) -> Vec<f64> {
+        let mut out: Vec<f64> = self
+            .x
+            .theta
+            .iter()
+            .chain(self.y.iter().flat_map(|p| p.theta.iter()))
+            .copied()
+            .filter(|t| *t > 0.0 && *t < FRAC_PI_2)
+            .collect();
+        out.sort_by(f64::total_cmp);
+        out.dedup();
+        out
     }
 }
 
@@ -682,7 +599,7 @@ impl Model for PiecewiseLinear {
 }
 
 /// The registry entry of the piecewise-linear NDF ([`crate::registry`]).
-pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+pub const INFO: FamilyInfo = FamilyInfo {
     name: "piecewise_linear",
     documents: &["000"],
     source: "seed 000 eq 1–5",
@@ -696,34 +613,9 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     stress_specs: &[],
     lambda_numerical: true,
     slow_sampler: true,
-    sampler_cost: crate::registry::SamplerCost {
-        normal_ns: 568.0,
-        visible_ns: 0.0,
-    },
     beckmann_limit: false,
     intrinsic_moments: false,
-    tail_exponent: crate::registry::no_tail,
-    theta_kinks: profile_kinks,
-    mean_slope: crate::registry::zero_mean,
 };
-
-/// The interior breakpoints of a piecewise-linear spec's profiles (both of the anisotropic
-/// blend, whose weights depend on φ only): D has kinks there for every azimuth.
-pub fn profile_kinks(spec: &crate::ModelSpec) -> Vec<f64> {
-    let crate::ModelSpec::PiecewiseLinear(PiecewiseSpec { x, y }) = spec else {
-        return Vec::new();
-    };
-    let mut out: Vec<f64> = x
-        .theta
-        .iter()
-        .chain(y.iter().flat_map(|p| p.theta.iter()))
-        .copied()
-        .filter(|t| *t > 0.0 && *t < std::f64::consts::FRAC_PI_2)
-        .collect();
-    out.sort_by(f64::total_cmp);
-    out.dedup();
-    out
-}
 
 #[cfg(test)]
 #[path = "piecewise_tests.rs"]

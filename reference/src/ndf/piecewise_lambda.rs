@@ -3,9 +3,13 @@
 //! (eq 30–32).
 //!
 //! Every route computes Λ(w) for w = (θ_o, φ_o) in the upper hemisphere; the NDF enters as
-//! D(θ, φ) = k_x cos²φ D_x(θ) + k_y sin²φ D_y(θ) (eq 1), and only cos 2φ_o matters.
+//! D(θ, φ) = k_x cos²φ D_x(θ) + k_y sin²φ D_y(θ) (eq 1), and only cos 2φ_o matters. The
+//! piecewise-linear model's `Smith` implementation, which names the routes, is here too: the
+//! routes read the model's tables, so the model's file (`ndf::piecewise`) does not name them.
 
+use crate::error::QueryError;
 use crate::geometry::Vec3;
+use crate::model::Smith;
 use crate::ndf::piecewise::{segment_cos_sin, segment_sin2, PiecewiseLinear};
 use crate::special::gauss_kronrod::integrate;
 use std::f64::consts::{FRAC_PI_2, TAU};
@@ -344,4 +348,47 @@ pub fn lambda_slope_space(p: &PiecewiseLinear, theta_o: f64, cos2phi: f64) -> f6
         }
     };
     integrate(&f, &cuts, 1e-12, 0.0).value
+}
+
+impl Smith for PiecewiseLinear {
+    /// The "exact" route (see `lambda_routes`).
+    fn lambda(&self, w: Vec3) -> f64 {
+        both_hemispheres(w, |t, c2| lambda_exact_piecewise(self, t, c2))
+    }
+
+    /// `exact` (default; adaptive Gauss–Kronrod of the back-facing projected area, eq 10–13,
+    /// relative accuracy 1e-13), `domain_split` (eq 16, 23, 26 and the trapezoid rule of eq 28,
+    /// combined by eq 34 — the document's approximation), `domain_split_adaptive` (the same
+    /// split with the remaining integral of eq 27 by adaptive quadrature: exact), `slope_space`
+    /// (eq 30–32 corrected, nested adaptive quadrature over P2 along the azimuth of w).
+    fn lambda_routes(&self) -> Vec<&'static str> {
+        vec![
+            "exact",
+            "domain_split",
+            "domain_split_adaptive",
+            "slope_space",
+        ]
+    }
+
+    fn lambda_route(&self, w: Vec3, route: &str) -> Result<f64, QueryError> {
+        Ok(match route {
+            "exact" | "default" => self.lambda(w),
+            "domain_split" => both_hemispheres(w, |t, c2| {
+                domain_split(self, t, c2, Remaining::Trapezoid).lambda
+            }),
+            "domain_split_adaptive" => both_hemispheres(w, |t, c2| {
+                domain_split(self, t, c2, Remaining::Adaptive).lambda
+            }),
+            "slope_space" => both_hemispheres(w, |t, c2| lambda_slope_space(self, t, c2)),
+            _ => {
+                return Err(QueryError::Route {
+                    route: route.to_string(),
+                    reason: format!(
+                        "piecewise-linear Λ routes: {}",
+                        self.lambda_routes().join(", ")
+                    ),
+                })
+            }
+        })
+    }
 }

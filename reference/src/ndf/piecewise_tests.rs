@@ -20,7 +20,7 @@ fn rng(seed: u64) -> impl FnMut() -> f64 {
 
 /// A random profile with `n` breakpoints (irregular), values in [0.2, 3), optionally 0 at
 /// θ = 0.
-pub(crate) fn random_profile(seed: u64, n: usize, zero_at_0: bool) -> Profile {
+pub(crate) fn random_profile(seed: u64, n: usize, zero_at_0: bool) -> AngularProfile {
     let mut r = rng(seed);
     let mut steps: Vec<f64> = (1..n).map(|_| 0.3 + r()).collect();
     let total: f64 = steps.iter().sum();
@@ -35,25 +35,25 @@ pub(crate) fn random_profile(seed: u64, n: usize, zero_at_0: bool) -> Profile {
     if zero_at_0 {
         value[0] = 0.0;
     }
-    Profile { theta, value }
+    AngularProfile { theta, value }
 }
 
 /// Zero on [θ₂, θ₄] and at π/2: flat-zero segments and a zero end.
-pub(crate) fn flat_profile() -> Profile {
-    Profile::uniform(vec![2.0, 1.0, 0.0, 0.0, 0.0, 0.5, 1.0, 0.0])
+pub(crate) fn flat_profile() -> AngularProfile {
+    AngularProfile::uniform(vec![2.0, 1.0, 0.0, 0.0, 0.0, 0.5, 1.0, 0.0])
 }
 
-fn ggx_profile(alpha: f64, n: usize) -> Profile {
+fn ggx_profile(alpha: f64, n: usize) -> AngularProfile {
     let g = Ggx::new(alpha, alpha).unwrap();
-    Profile::discretize(&|t| g.d(from_spherical(t, 0.0)), n)
+    AngularProfile::discretize(&|t| g.d(from_spherical(t, 0.0)), n)
 }
 
-fn beckmann_profile(alpha: f64, n: usize) -> Profile {
+fn beckmann_profile(alpha: f64, n: usize) -> AngularProfile {
     let b = Beckmann::new(alpha, alpha).unwrap();
-    Profile::discretize(&|t| b.d(from_spherical(t, 0.0)), n)
+    AngularProfile::discretize(&|t| b.d(from_spherical(t, 0.0)), n)
 }
 
-pub(crate) fn pl(x: Profile, y: Option<Profile>) -> PiecewiseLinear {
+pub(crate) fn pl(x: AngularProfile, y: Option<AngularProfile>) -> PiecewiseLinear {
     PiecewiseLinear::new(x, y).unwrap()
 }
 
@@ -258,7 +258,7 @@ fn segment_integrals_match_quadrature_and_printed_eq5() {
 fn normalization_constants_match_quadrature() {
     for (label, m) in small_models().into_iter().chain(big_models()) {
         // c_iso (eq 5) against 2π ∫ D_raw cos θ sin θ dθ.
-        let raw = |p: &Profile| {
+        let raw = |p: &AngularProfile| {
             let f = |t: f64| interp(p, t) * t.cos() * t.sin();
             TAU * integrate_theta(&f, &p.theta, 1e-13)
         };
@@ -631,8 +631,8 @@ fn printed_b_aniso_uses_the_x_profile_twice() {
     // ERRATA-000 E2: the text after eq 9 defines B^aniso = cos²φ D_y(0) b^x + sin²φ D_x(0)
     // b^x; Algorithm 2 line 2 has b^y in the second term. With the text's B the segment
     // integral is not the conditional mass of the segment.
-    let x = Profile::uniform(vec![1.0, 2.0, 0.5, 1.5, 0.2]);
-    let y = Profile::uniform(vec![3.0, 0.1, 2.5, 0.3, 1.0]);
+    let x = AngularProfile::uniform(vec![1.0, 2.0, 0.5, 1.5, 0.2]);
+    let y = AngularProfile::uniform(vec![3.0, 0.1, 2.5, 0.3, 1.0]);
     let m = pl(x.clone(), Some(y.clone()));
     let (phi, k) = (0.9f64, 1usize);
     let (wx, wy) = (m.kx * phi.cos().powi(2), m.ky * phi.sin().powi(2));
@@ -769,54 +769,75 @@ fn sampler_is_robust_at_breakpoints_and_flat_zeros() {
 
 #[test]
 fn parameters_are_validated() {
-    let good = Profile::uniform(vec![1.0, 2.0, 0.5]);
-    let bad = |p: Profile| PiecewiseLinear::new(p, None).unwrap_err();
+    let good = AngularProfile::uniform(vec![1.0, 2.0, 0.5]);
+    let bad = |p: AngularProfile| PiecewiseLinear::new(p, None).unwrap_err();
     let is = |e: ParamError, want: &str| match e {
         ParamError::InvalidProfile { requirement, .. } => {
             assert!(requirement.contains(want), "{requirement}")
         }
         e => panic!("{e}"),
     };
-    is(bad(Profile::new(vec![0.0], vec![1.0])), "at least 2");
+    is(bad(AngularProfile::new(vec![0.0], vec![1.0])), "at least 2");
     is(
-        bad(Profile::new(vec![0.0, FRAC_PI_2], vec![1.0])),
+        bad(AngularProfile::new(vec![0.0, FRAC_PI_2], vec![1.0])),
         "as many",
     );
     is(
-        bad(Profile::new(vec![0.1, FRAC_PI_2], vec![1.0, 1.0])),
+        bad(AngularProfile::new(vec![0.1, FRAC_PI_2], vec![1.0, 1.0])),
         "first",
     );
-    is(bad(Profile::new(vec![0.0, 1.5], vec![1.0, 1.0])), "last");
     is(
-        bad(Profile::new(vec![0.0, 1.0, 1.0, FRAC_PI_2], vec![1.0; 4])),
+        bad(AngularProfile::new(vec![0.0, 1.5], vec![1.0, 1.0])),
+        "last",
+    );
+    is(
+        bad(AngularProfile::new(
+            vec![0.0, 1.0, 1.0, FRAC_PI_2],
+            vec![1.0; 4],
+        )),
         "increasing",
     );
     is(
-        bad(Profile::new(vec![0.0, f64::NAN, FRAC_PI_2], vec![1.0; 3])),
+        bad(AngularProfile::new(
+            vec![0.0, f64::NAN, FRAC_PI_2],
+            vec![1.0; 3],
+        )),
         "increasing",
     );
     is(
-        bad(Profile::new(vec![0.0, FRAC_PI_2], vec![1.0, -1.0])),
+        bad(AngularProfile::new(vec![0.0, FRAC_PI_2], vec![1.0, -1.0])),
         "≥ 0",
     );
     is(
-        bad(Profile::new(vec![0.0, FRAC_PI_2], vec![f64::NAN, 1.0])),
+        bad(AngularProfile::new(
+            vec![0.0, FRAC_PI_2],
+            vec![f64::NAN, 1.0],
+        )),
         "≥ 0",
     );
     is(
-        bad(Profile::new(vec![0.0, FRAC_PI_2], vec![f64::INFINITY, 1.0])),
+        bad(AngularProfile::new(
+            vec![0.0, FRAC_PI_2],
+            vec![f64::INFINITY, 1.0],
+        )),
         "≥ 0",
     );
     is(
-        bad(Profile::new(vec![0.0, FRAC_PI_2], vec![0.0, 0.0])),
+        bad(AngularProfile::new(vec![0.0, FRAC_PI_2], vec![0.0, 0.0])),
         "not all zero",
     );
     is(
-        bad(Profile::new(vec![0.0, FRAC_PI_2], vec![1e308, 1e308])),
+        bad(AngularProfile::new(
+            vec![0.0, FRAC_PI_2],
+            vec![1e308, 1e308],
+        )),
         "not all zero",
     );
-    let e =
-        PiecewiseLinear::new(good.clone(), Some(Profile::new(vec![0.0], vec![1.0]))).unwrap_err();
+    let e = PiecewiseLinear::new(
+        good.clone(),
+        Some(AngularProfile::new(vec![0.0], vec![1.0])),
+    )
+    .unwrap_err();
     assert!(matches!(e, ParamError::InvalidProfile { axis: "y", .. }));
     let m = pl(good, None);
     assert!(m.clone().with_tolerance(-1.0).is_err());
@@ -824,12 +845,12 @@ fn parameters_are_validated() {
     assert_eq!(m.with_tolerance(1e-8).unwrap().tolerance(), 1e-8);
     // Tiny and large (finite) values are fine: only the shape matters.
     for scale in [1e-300, 1e300] {
-        let p = Profile::uniform(vec![scale, 2.0 * scale, 0.5 * scale]);
+        let p = AngularProfile::uniform(vec![scale, 2.0 * scale, 0.5 * scale]);
         let m = pl(p, None);
         assert!(
             rel_err(
                 m.d_x(0.0),
-                pl(Profile::uniform(vec![1.0, 2.0, 0.5]), None).d_x(0.0)
+                pl(AngularProfile::uniform(vec![1.0, 2.0, 0.5]), None).d_x(0.0)
             ) < 1e-14
         );
     }
@@ -962,11 +983,8 @@ mod accuracy_table {
     }
 
     #[test]
+    #[cfg_attr(not(mfh_extensive), ignore = "extensive tier: set MFH_EXTENSIVE=1")]
     fn accuracy_table_piecewise() {
-        if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (docs/testing.md, \"The extensive tier\")");
-            return;
-        }
         let mut out = ReportTable::new("seed000");
         let models: Vec<(&str, PiecewiseLinear)> =
             small_models().into_iter().chain(big_models()).collect();

@@ -2,13 +2,19 @@
 //! fixed-variance member, isotropic and anisotropic.
 
 use crate::error::{ParamError, QueryError};
+use crate::family::{
+    resolve_roughness, roughness_fields, student_smith_limit, FamilyInfo, FamilySpec,
+};
 use crate::geometry::{normal_from_slopes, Vec3};
 use crate::model::{
     check_alpha, elliptic_direction, lambda_both_hemispheres, scale_along, standardized_cotangent,
     Model, Ndf, NormalSampler, SlopeDistribution, Smith,
 };
+use crate::ndf::beckmann::Beckmann;
 use crate::ndf::student_lambda as routes;
 use crate::spec::ModelSpec;
+/// The members' spec types (declared with every family's in `crate::spec`).
+pub use crate::spec::{FixedVarianceSpec, GeneralSpec, HyperCauchySpec, StdSpec};
 use crate::special::hyp2f1::BetaCfTable;
 use std::f64::consts::PI;
 
@@ -336,87 +342,63 @@ impl SlopeDistribution for Student {
     }
 }
 
-/// Declares the spec type of a Student member parameterized by γ and roughness (STD,
-/// Hyper-Cauchy, fixed variance: the same fields, a different member; `beckmann_at_inf` says
-/// whether `gamma: "inf"` builds the Beckmann limit, seed 001 §4).
-macro_rules! student_spec {
-    ($(#[$doc:meta])* $name:ident, $member:expr, $variant:ident, beckmann_at_inf: $inf:expr) => {
-        $(#[$doc])*
-        #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-        #[serde(deny_unknown_fields)]
-        pub struct $name {
-            /// Shape γ (a number, or the string `"inf"`).
-            #[serde(with = "crate::spec::gamma_serde")]
-            pub gamma: f64,
-            /// Isotropic roughness.
-            #[serde(default, skip_serializing_if = "Option::is_none")]
-            pub alpha: Option<f64>,
-            /// Roughness along x.
-            #[serde(default, skip_serializing_if = "Option::is_none")]
-            pub alpha_x: Option<f64>,
-            /// Roughness along y.
-            #[serde(default, skip_serializing_if = "Option::is_none")]
-            pub alpha_y: Option<f64>,
-        }
-
-        impl crate::spec::FamilySpec for $name {
+/// Implements [`FamilySpec`] for the spec type of a Student member parameterized by γ and
+/// roughness (STD, Hyper-Cauchy, fixed variance: the same fields, a different member;
+/// `beckmann_at_inf` says whether `gamma: "inf"` builds the Beckmann limit, seed 001 §4).
+macro_rules! student_family_spec {
+    ($spec:ident, $member:expr, $variant:ident, beckmann_at_inf: $inf:expr) => {
+        impl FamilySpec for $spec {
             fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
-                let (ax, ay) =
-                    crate::spec::resolve_roughness(self.alpha, self.alpha_x, self.alpha_y)?;
+                let (ax, ay) = resolve_roughness(self.alpha, self.alpha_x, self.alpha_y)?;
                 if $inf && self.gamma == f64::INFINITY {
-                    let limit = crate::ndf::Beckmann::new(ax, ay)?;
-                    Ok(Box::new(limit.described_as(ModelSpec::$variant(self.clone()))))
+                    let limit = Beckmann::new(ax, ay)?;
+                    Ok(Box::new(
+                        limit.described_as(ModelSpec::$variant(self.clone())),
+                    ))
                 } else {
                     Ok(Box::new(Student::new($member, self.gamma, ax, ay)?))
                 }
             }
 
             fn smith_limit(&self) -> Option<(&'static str, f64)> {
-                crate::spec::student_smith_limit("gamma", self.gamma)
+                student_smith_limit("gamma", self.gamma)
+            }
+
+            /// γ (seed 001 eq 7–9); none at γ = ∞ (Beckmann: no heavy tail).
+            fn tail_exponent(&self) -> Option<f64> {
+                Some(self.gamma).filter(|g| g.is_finite())
             }
         }
     };
 }
 
-student_spec!(
-    /// The spec of an STD model (seed 001, f = 1/(γ−1)): `{"family": "std", "gamma": 2.5,
-    /// "alpha": 0.3}`; `gamma: "inf"` is Beckmann.
-    StdSpec, Member::Std, Std, beckmann_at_inf: true
-);
-student_spec!(
-    /// The spec of a Hyper-Cauchy model (seed 001 eq 8, f = 1), γ > 1.
-    HyperCauchySpec, Member::HyperCauchy, HyperCauchy, beckmann_at_inf: false
-);
-student_spec!(
-    /// The spec of the fixed-variance Student member (seed 001 eq 9, f = 1/(γ−2)), γ > 2;
-    /// `gamma: "inf"` is Beckmann.
-    FixedVarianceSpec, Member::FixedVariance, StudentFixedVariance, beckmann_at_inf: true
+student_family_spec!(StdSpec, Member::Std, Std, beckmann_at_inf: true);
+student_family_spec!(HyperCauchySpec, Member::HyperCauchy, HyperCauchy, beckmann_at_inf: false);
+student_family_spec!(
+    FixedVarianceSpec,
+    Member::FixedVariance,
+    StudentFixedVariance,
+    beckmann_at_inf: true
 );
 
-/// The spec of the general isotropic family D^G(B, C) (seed 001 eq 1–2):
-/// `{"family": "student_general", "b": 4, "c": 2.5}`.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GeneralSpec {
-    /// B > 0.
-    pub b: f64,
-    /// C > 1.
-    pub c: f64,
-}
-
-impl crate::spec::FamilySpec for GeneralSpec {
+impl FamilySpec for GeneralSpec {
     fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
         Ok(Box::new(Student::general(self.b, self.c)?))
     }
 
     fn smith_limit(&self) -> Option<(&'static str, f64)> {
-        crate::spec::student_smith_limit("c", self.c)
+        student_smith_limit("c", self.c)
+    }
+
+    /// C (seed 001 eq 2).
+    fn tail_exponent(&self) -> Option<f64> {
+        Some(self.c)
     }
 }
 
 impl Model for Student {
     fn spec(&self) -> ModelSpec {
-        let (alpha, alpha_x, alpha_y) = crate::spec::roughness_fields(self.alpha_x, self.alpha_y);
+        let (alpha, alpha_x, alpha_y) = roughness_fields(self.alpha_x, self.alpha_y);
         let gamma = self.c;
         match self.member {
             Member::Std => ModelSpec::Std(StdSpec {
@@ -450,7 +432,7 @@ impl Model for Student {
 }
 
 /// The registry entry of STD ([`crate::registry`]).
-pub const STD_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+pub const STD_INFO: FamilyInfo = FamilyInfo {
     name: "std",
     documents: &["001"],
     source: "seed 001 eq 1–7 (f = 1/(γ−1)), Table 1",
@@ -464,19 +446,12 @@ pub const STD_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     stress_specs: &[],
     lambda_numerical: false,
     slow_sampler: false,
-    sampler_cost: crate::registry::SamplerCost {
-        normal_ns: 44.6,
-        visible_ns: 0.0,
-    },
     beckmann_limit: true,
     intrinsic_moments: false,
-    tail_exponent: student_tail_exponent,
-    theta_kinks: crate::registry::no_kinks,
-    mean_slope: crate::registry::zero_mean,
 };
 
 /// The registry entry of Hyper-Cauchy ([`crate::registry`]).
-pub const HYPER_CAUCHY_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+pub const HYPER_CAUCHY_INFO: FamilyInfo = FamilyInfo {
     name: "hyper_cauchy",
     documents: &["001"],
     source: "seed 001 eq 8 (f = 1)",
@@ -487,19 +462,12 @@ pub const HYPER_CAUCHY_INFO: crate::registry::FamilyInfo = crate::registry::Fami
     stress_specs: &[],
     lambda_numerical: false,
     slow_sampler: false,
-    sampler_cost: crate::registry::SamplerCost {
-        normal_ns: 46.1,
-        visible_ns: 0.0,
-    },
     beckmann_limit: false,
     intrinsic_moments: false,
-    tail_exponent: student_tail_exponent,
-    theta_kinks: crate::registry::no_kinks,
-    mean_slope: crate::registry::zero_mean,
 };
 
 /// The registry entry of the fixed-variance Student member ([`crate::registry`]).
-pub const FIXED_VARIANCE_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+pub const FIXED_VARIANCE_INFO: FamilyInfo = FamilyInfo {
     name: "student_fixed_variance",
     documents: &["001"],
     source: "seed 001 eq 9 (f = 1/(γ−2))",
@@ -510,19 +478,12 @@ pub const FIXED_VARIANCE_INFO: crate::registry::FamilyInfo = crate::registry::Fa
     stress_specs: &[],
     lambda_numerical: false,
     slow_sampler: false,
-    sampler_cost: crate::registry::SamplerCost {
-        normal_ns: 42.3,
-        visible_ns: 0.0,
-    },
     beckmann_limit: false,
     intrinsic_moments: false,
-    tail_exponent: student_tail_exponent,
-    theta_kinks: crate::registry::no_kinks,
-    mean_slope: crate::registry::zero_mean,
 };
 
 /// The registry entry of the general Student family ([`crate::registry`]).
-pub const GENERAL_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+pub const GENERAL_INFO: FamilyInfo = FamilyInfo {
     name: "student_general",
     documents: &["001"],
     source: "seed 001 eq 1–2 (D^G(B, C))",
@@ -533,31 +494,9 @@ pub const GENERAL_INFO: crate::registry::FamilyInfo = crate::registry::FamilyInf
     stress_specs: &[],
     lambda_numerical: false,
     slow_sampler: false,
-    sampler_cost: crate::registry::SamplerCost {
-        normal_ns: 43.3,
-        visible_ns: 0.0,
-    },
     beckmann_limit: false,
     intrinsic_moments: false,
-    tail_exponent: student_tail_exponent,
-    theta_kinks: crate::registry::no_kinks,
-    mean_slope: crate::registry::zero_mean,
 };
-
-/// The exponent C of the slope marginal of a Student-family spec: γ for STD and Hyper-Cauchy
-/// and the fixed-variance member (seed 001 eq 7–9), `c` for the general member (eq 2).
-pub fn student_tail_exponent(spec: &crate::ModelSpec) -> Option<f64> {
-    use crate::ModelSpec as S;
-    match spec {
-        S::Std(StdSpec { gamma, .. })
-        | S::HyperCauchy(HyperCauchySpec { gamma, .. })
-        | S::StudentFixedVariance(FixedVarianceSpec { gamma, .. }) => {
-            Some(*gamma).filter(|g| g.is_finite())
-        }
-        S::StudentGeneral(s) => Some(s.c),
-        _ => None,
-    }
-}
 
 #[cfg(test)]
 mod tests {
@@ -912,11 +851,8 @@ mod accuracy_table {
     use std::f64::consts::FRAC_PI_2;
 
     #[test]
+    #[cfg_attr(not(mfh_extensive), ignore = "extensive tier: set MFH_EXTENSIVE=1")]
     fn accuracy_table() {
-        if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (docs/testing.md, \"The extensive tier\")");
-            return;
-        }
         let gammas = [1.6, 2.0, 2.5, 3.0, 3.5, 4.0, 7.5, 20.0, 100.0, 1e4];
         let thetas: Vec<f64> = (1..=40)
             .map(|i| FRAC_PI_2 * i as f64 / 41.0)

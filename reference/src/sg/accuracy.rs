@@ -6,8 +6,8 @@
 
 use super::asg::tests::{asg_at, integral_oracle};
 use super::circular::{decompose_sg, fiber_direction, von_mises_integral_scaled};
+use super::isotropic::f_a;
 use super::oracle::{cuts, directions, integrate_cut};
-use super::sg::f_a;
 use super::{Asg, CircularGaussian, Sg};
 use crate::geometry::{dot, from_spherical, Vec3};
 use crate::test_support::{rel_err, tline, ReportTable};

@@ -2,8 +2,8 @@
 //! integral over the sphere, the ASG × ASG product and the ASG–SG convolution.
 
 use super::circular::bessel_i0_scaled;
+use super::isotropic::Sg;
 use super::quadrature::{integrate, integrate_directions, Lobe};
-use super::sg::Sg;
 use super::{add, normalize, scale, unit_axis, UNIT_TOLERANCE};
 use crate::error::{ParamError, QueryError};
 use crate::geometry::{dot, Vec3};
@@ -735,12 +735,9 @@ pub(crate) mod tests {
     }
 
     #[test]
+    #[cfg_attr(not(mfh_extensive), ignore = "extensive tier: set MFH_EXTENSIVE=1")]
     fn convolution_l2_error_sweep() {
         // The extensive tier: the whole grid behind ERRATA.md, E5.
-        if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (docs/testing.md, \"The extensive tier\")");
-            return;
-        }
         let pieces = [0.0, 0.25 * PI, FRAC_PI_2, 0.75 * PI, PI];
         // The bounds the measured sweep justifies (`Asg::convolve_sg`'s documentation,
         // ERRATA.md E5): 4.6 % at λ = μ = 3, ν = 10 and 0.53 % at ν = 100 (±25 %); every

@@ -12,13 +12,12 @@
 mod accuracy;
 pub mod asg;
 pub mod circular;
+pub mod isotropic;
 pub(crate) mod quadrature;
-#[allow(clippy::module_inception)]
-pub mod sg;
 
 pub use asg::Asg;
 pub use circular::CircularGaussian;
-pub use sg::Sg;
+pub use isotropic::Sg;
 
 use crate::geometry::{dot, Vec3};
 

@@ -3,10 +3,13 @@
 //! (eq 12–69), evaluated without cancellation from θ = 0 to π/2 and for near-singular Σ.
 
 use crate::error::{ParamError, QueryError};
+use crate::family::{FamilyInfo, FamilySpec};
 use crate::geometry::Vec3;
 use crate::model::{Model, Ndf, SlopeDistribution, Smith, VisibleMoments, VisibleSlopeMoments};
 use crate::slopes::pseudocode::{self, Transcription};
 use crate::slopes::ramp::{normal_loss, ramp_moments};
+/// The family's spec type (declared with every family's in `crate::spec`).
+pub use crate::spec::GaussianSlopesSpec;
 use crate::spec::ModelSpec;
 use std::f64::consts::TAU;
 
@@ -343,20 +346,13 @@ impl VisibleSlopeMoments for GaussianSlopes {
     }
 }
 
-/// The spec of a Gaussian distribution of slopes:
-/// `{"family": "gaussian_slopes", "mean": [0, 0], "cov": [[0.1, 0], [0, 0.2]]}`.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GaussianSlopesSpec {
-    /// The mean slope s̄ = `[s̄x, s̄y]`.
-    pub mean: [f64; 2],
-    /// The covariance Σ = `[[σx², cxy], [cxy, σy²]]`, symmetric positive definite.
-    pub cov: [[f64; 2]; 2],
-}
-
-impl crate::spec::FamilySpec for GaussianSlopesSpec {
+impl FamilySpec for GaussianSlopesSpec {
     fn build(&self) -> Result<Box<dyn Model>, crate::ParamError> {
         Ok(Box::new(GaussianSlopes::new(self.mean, self.cov)?))
+    }
+
+    fn mean_slope(&self) -> [f64; 2] {
+        self.mean
     }
 }
 
@@ -618,7 +614,7 @@ impl Cov2 {
 mod tests;
 
 /// The registry entry of Gaussian slopes ([`crate::registry`]).
-pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
+pub const INFO: FamilyInfo = FamilyInfo {
     name: "gaussian_slopes",
     documents: &["002"],
     source: "seed 002 eq 1 (slope sign of eq 11)",
@@ -634,18 +630,6 @@ pub const INFO: crate::registry::FamilyInfo = crate::registry::FamilyInfo {
     )],
     lambda_numerical: false,
     slow_sampler: false,
-    sampler_cost: crate::registry::NO_SAMPLER,
     beckmann_limit: false,
     intrinsic_moments: true,
-    tail_exponent: crate::registry::no_tail,
-    theta_kinks: crate::registry::no_kinks,
-    mean_slope: spec_mean,
 };
-
-/// The mean slope of a Gaussian-slopes spec.
-pub fn spec_mean(spec: &crate::ModelSpec) -> [f64; 2] {
-    match spec {
-        crate::ModelSpec::GaussianSlopes(s) => s.mean,
-        _ => [0.0, 0.0],
-    }
-}

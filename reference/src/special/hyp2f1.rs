@@ -403,6 +403,21 @@ pub fn hyp2f1_lambda_algorithm2_corrected(c: f64, z: f64) -> f64 {
     }
 }
 
+/// Λ_C(x) where no route needs computing, shared by every Λ_C route (`student_tail`'s and
+/// [`lambda_algorithm2_corrected`]): NaN outside the domain (C ≤ 3/2, x NaN or < 0), +∞
+/// at x = 0 (grazing), 0 at x = +∞ (normal incidence); None inside (0, ∞).
+pub fn lambda_edges(c: f64, x: f64) -> Option<f64> {
+    if !(c > 1.5) || x.is_nan() || x < 0.0 {
+        Some(f64::NAN)
+    } else if x == 0.0 {
+        Some(f64::INFINITY)
+    } else if x == f64::INFINITY {
+        Some(0.0)
+    } else {
+        None
+    }
+}
+
 /// Λ_C(x) by seed 001 eq 21 with ₂F₁ from the corrected Algorithm 2
 /// (`hyp2f1_lambda_algorithm2_corrected`), the difference of eq 21 taken where it cancels:
 ///
@@ -421,7 +436,7 @@ pub fn hyp2f1_lambda_algorithm2_corrected(c: f64, z: f64) -> f64 {
 /// against the stable route: see `tests::algorithm2_corrected_at_the_stress_gammas`. NaN where
 /// the series would need more than `ALGORITHM2_MAX_TERMS` terms.
 pub fn lambda_algorithm2_corrected(c: f64, x: f64) -> f64 {
-    if let Some(edge) = super::student_tail::lambda_edges(c, x) {
+    if let Some(edge) = lambda_edges(c, x) {
         return edge;
     }
     let x2 = x * x;

@@ -27,8 +27,8 @@
 
 use super::beckmann_fit::PIECES;
 use super::hyp2f1::{
-    beta_cf_delta_tabulated, beta_cf_k_denominator, pfaff_series, student_norm, use_pfaff,
-    BetaCfTable,
+    beta_cf_delta_tabulated, beta_cf_k_denominator, lambda_edges, pfaff_series, student_norm,
+    use_pfaff, BetaCfTable,
 };
 use std::f64::consts::PI;
 
@@ -49,21 +49,6 @@ pub fn student_lambda(c: f64, x: f64) -> f64 {
 /// `hyp2f1::student_norm(c)`, which a model computes once): the same value, bit for bit.
 pub fn student_lambda_with_norm(c: f64, n: f64, x: f64) -> f64 {
     student_lambda_tabulated(c, n, None, x)
-}
-
-/// Λ_C(x) where no route needs computing, shared by every Λ_C route (this module's and
-/// `hyp2f1::lambda_algorithm2_corrected`): NaN outside the domain (C ≤ 3/2, x NaN or < 0), +∞
-/// at x = 0 (grazing), 0 at x = +∞ (normal incidence); None inside (0, ∞).
-pub fn lambda_edges(c: f64, x: f64) -> Option<f64> {
-    if !(c > 1.5) || x.is_nan() || x < 0.0 {
-        Some(f64::NAN)
-    } else if x == 0.0 {
-        Some(f64::INFINITY)
-    } else if x == f64::INFINITY {
-        Some(0.0)
-    } else {
-        None
-    }
 }
 
 /// `student_lambda_with_norm` with the continued fraction's coefficients read from `table`

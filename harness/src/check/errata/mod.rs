@@ -35,13 +35,13 @@ use crate::subject::Subject;
 use crate::tolerance::{Tolerance, ERRATUM, ERRATUM_ASYMPTOTIC, ERRATUM_VISIBLE_MOMENTS};
 use mfh_reference::geometry::{dot, from_spherical};
 use mfh_reference::ndf::gtr::Gtr;
-use mfh_reference::ndf::piecewise::{PiecewiseLinear, Profile};
 use mfh_reference::ndf::piecewise_lambda::{domain_split, Remaining};
 use mfh_reference::ndf::student::{Member, Student};
 use mfh_reference::ndf::student_lambda::eq33_prefactor;
+use mfh_reference::ndf::{AngularProfile, PiecewiseLinear};
 use mfh_reference::sg::asg::Asg;
 use mfh_reference::sg::circular::fiber_direction;
-use mfh_reference::sg::sg::{f_h, Sg};
+use mfh_reference::sg::isotropic::{f_h, Sg};
 use mfh_reference::slopes::gaussian::GaussianSlopes;
 use mfh_reference::special::gamma_ratio::gamma_half_ratio;
 use mfh_reference::special::hyp2f1::{

@@ -3,6 +3,7 @@
 
 use super::*;
 use mfh_reference::errata::seed000;
+use mfh_reference::family::FamilySpec;
 
 const PL_X: [f64; 6] = [3.0, 2.2, 1.4, 0.9, 0.3, 0.05];
 const PL_Y: [f64; 5] = [1.0, 0.95, 0.7, 0.2, 0.02];
@@ -22,8 +23,8 @@ fn pl_spec() -> Value {
 
 fn pl() -> Result<PiecewiseLinear, String> {
     PiecewiseLinear::new(
-        Profile::uniform(PL_X.to_vec()),
-        Some(Profile::uniform(PL_Y.to_vec())),
+        AngularProfile::uniform(PL_X.to_vec()),
+        Some(AngularProfile::uniform(PL_Y.to_vec())),
     )
     .map_err(|e| e.to_string())
 }
@@ -257,7 +258,7 @@ fn e000_14() -> Result<Shown, String> {
     };
     // Cut at the profiles' breakpoints, where D has kinks (22 s without, in the audit).
     let spec = m.spec();
-    let kinks = (mfh_reference::registry::info(&spec).theta_kinks)(&spec);
+    let kinks = spec.theta_kinks();
     let at_kinks = |_: f64| kinks.clone();
     let cuts = || {
         Some(crate::oracle::quadrature::Cuts {
@@ -287,7 +288,7 @@ fn e000_15() -> Result<Shown, String> {
     let (so, co) = theta.sin_cos();
     let spec = pl_spec();
     let spec: ModelSpec = serde_json::from_value(spec).map_err(|e| e.to_string())?;
-    let kinks = (mfh_reference::registry::info(&spec).theta_kinks)(&spec);
+    let kinks = spec.theta_kinks();
     let projected = |printed: bool| {
         // Cut each polar integral at the kinks of D and where the indicator switches
         // (so sin θ cos δ + co cos θ = 0, tan θ = co/(so·(−cos δ)) for cos δ < 0): the

@@ -1,4 +1,4 @@
-use super::sg::SRC_INTEGRAL;
+use super::isotropic::SRC_INTEGRAL;
 use super::*;
 use crate::check::RunContext;
 use crate::tolerance::CLOSED_FORM;
@@ -81,11 +81,8 @@ mod dump {
     use super::*;
 
     #[test]
+    #[cfg_attr(not(mfh_extensive), ignore = "extensive tier: set MFH_EXTENSIVE=1")]
     fn standard() {
-        if std::env::var_os("MFH_EXTENSIVE").is_none() {
-            eprintln!("skipped: extensive tier, run with MFH_EXTENSIVE=1 (docs/testing.md, \"The extensive tier\")");
-            return;
-        }
         let ctx = crate::check::RunContext { seed: 1 };
         for p in plan(Profile::Standard, true, true, "") {
             let r = (p.run)(&ctx);

@@ -1,6 +1,6 @@
-//! Spherical Gaussians (seed 003, §1–§2, after Wang et al. 2009): evaluation, integral, inner
-//! and vector products, ε-support, the clamped-cosine fit, the lobe warp from half vectors to
-//! light directions, and the spherical-cap integral.
+//! Isotropic spherical Gaussians (seed 003, §1–§2, after Wang et al. 2009): evaluation,
+//! integral, inner and vector products, ε-support, the clamped-cosine fit, the lobe warp from
+//! half vectors to light directions, and the spherical-cap integral.
 
 use super::quadrature::{integrate_directions, Lobe};
 use super::{add, frame_around, normalize, scale, sub, unit_axis};
