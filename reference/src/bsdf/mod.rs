@@ -58,6 +58,7 @@
 
 pub mod conductor;
 pub mod dielectric;
+pub mod error;
 pub mod fresnel;
 pub mod microfacet;
 pub mod spec;
@@ -69,9 +70,10 @@ mod tests;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
+pub use error::BsdfError;
 pub use fresnel::FresnelModel;
 pub use microfacet::{Microfacet, Sampling};
-pub use spec::{BsdfError, BsdfSpec, ConductorSpec, DielectricSpec};
+pub use spec::{BsdfSpec, ConductorSpec, DielectricSpec};
 
 use crate::geometry::Vec3;
 
