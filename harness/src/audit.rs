@@ -38,6 +38,8 @@ pub struct Audit<'a> {
     slope_moments: bool,
     theta_max: f64,
     against: Option<String>,
+    /// `MFH_SEED` when it is set but not a seed: an error record, as the CLI's exit 2.
+    seed_error: Option<String>,
 }
 
 impl<'a> Audit<'a> {
@@ -45,10 +47,7 @@ impl<'a> Audit<'a> {
     /// both G2 forms, normal sampling, visible-normal sampling where it has that), at the quick
     /// profile, with the default seed (`MFH_SEED` overrides it).
     pub fn of<M: Ndf + 'a>(model: &'a M) -> Self {
-        let seed = std::env::var("MFH_SEED")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(DEFAULT_SEED);
+        let (seed, seed_error) = seed_from_env(std::env::var("MFH_SEED").ok());
         Self {
             model: Arc::new(model),
             name: std::any::type_name::<M>().to_string(),
@@ -64,6 +63,7 @@ impl<'a> Audit<'a> {
             slope_moments: false,
             theta_max: FRAC_PI_2,
             against: None,
+            seed_error,
         }
     }
 
@@ -155,6 +155,9 @@ impl<'a> Audit<'a> {
         let subject = Subject::user(self.model.clone(), &self.name, self.hints.clone());
         let why = format!("model `{}`", self.name);
         let mut errors = Vec::new();
+        if let Some(message) = &self.seed_error {
+            errors.push(config_error(&subject.label, message.clone()));
+        }
         if !(self.theta_max > 0.0 && self.theta_max <= FRAC_PI_2) {
             errors.push(config_error(
                 &subject.label,
@@ -187,8 +190,11 @@ impl<'a> Audit<'a> {
         (plan, errors)
     }
 
-    /// Runs the audit.
-    pub fn run(&self) -> AuditReport {
+    /// Runs the audit. Consumes the builder, so that
+    /// `Audit::of(&m).profile(Profile::Ci).run().passed()` is a valid tail expression of a
+    /// function that owns `m` (a borrowing `run` left the builder a temporary that outlived
+    /// `m`: E0597 on edition 2021).
+    pub fn run(self) -> AuditReport {
         let t = Instant::now();
         let (plan, mut errors) = self.plan();
         let (mut records, k, alpha) = run_plan(&plan, &self.options);
@@ -208,8 +214,45 @@ impl<'a> Audit<'a> {
     }
 }
 
+/// The audit seed from `MFH_SEED`'s value: the default when unset; when set but not a seed,
+/// the default and the error the audit reports as a failing `audit.configuration` record
+/// (the CLI refuses it with exit 2).
+fn seed_from_env(value: Option<String>) -> (u64, Option<String>) {
+    match value {
+        None => (DEFAULT_SEED, None),
+        Some(text) => match text.trim().parse::<u64>() {
+            Ok(seed) => (seed, None),
+            Err(_) => (
+                DEFAULT_SEED,
+                Some(format!(
+                    "MFH_SEED = {text:?} is not a seed (an integer in 0..=18446744073709551615)"
+                )),
+            ),
+        },
+    }
+}
+
 fn config_error(model: &serde_json::Value, message: String) -> CheckRecord {
     let mut r = CheckRecord::new("audit.configuration", model.clone(), json!({}), "");
     r.verdict = Verdict::Error { message };
     r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_unparsable_mfh_seed_is_an_error_naming_it() {
+        assert_eq!(seed_from_env(None), (DEFAULT_SEED, None));
+        assert_eq!(seed_from_env(Some(" 42 ".into())), (42, None));
+        let (seed, error) = seed_from_env(Some("0x2a".into()));
+        assert_eq!(seed, DEFAULT_SEED);
+        let error = error.expect("an error");
+        assert!(
+            error.contains("MFH_SEED") && error.contains("0x2a"),
+            "{error}"
+        );
+        assert!(seed_from_env(Some("-1".into())).1.is_some());
+    }
 }

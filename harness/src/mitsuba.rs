@@ -51,8 +51,87 @@ const PLUGIN_TAGS: &[&str] = &[
 /// BSDFs that only wrap others.
 const WRAPPERS: &[&str] = &["twosided", "blendbsdf", "mask", "bumpmap", "normalmap"];
 
+/// The deepest nesting of elements a scene may have. Mitsuba scenes nest a handful of levels;
+/// the XML parser recurses once per level, and ~20 000 levels (well under the 1 MiB size
+/// limit) overflowed its stack (exit 134) before this bound.
+pub const MAX_XML_DEPTH: usize = 128;
+
+/// Where (line, column, 1-based) the nesting of elements first exceeds `limit`, scanning the
+/// text without building a tree: comments, CDATA, processing instructions and declarations
+/// are skipped, quoted attribute values may hold `>`, `<x/>` does not nest. Malformed text
+/// is left to the parser's own error.
+fn too_deep(text: &str, limit: usize) -> Option<(usize, usize)> {
+    let b = text.as_bytes();
+    let skip_to = |from: usize, end: &[u8]| {
+        b[from..]
+            .windows(end.len())
+            .position(|w| w == end)
+            .map_or(b.len(), |p| from + p + end.len())
+    };
+    let mut depth = 0usize;
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] != b'<' {
+            i += 1;
+            continue;
+        }
+        let rest = &b[i..];
+        if rest.starts_with(b"<!--") {
+            i = skip_to(i + 4, b"-->");
+        } else if rest.starts_with(b"<![CDATA[") {
+            i = skip_to(i + 9, b"]]>");
+        } else if rest.starts_with(b"<?") {
+            i = skip_to(i + 2, b"?>");
+        } else if rest.starts_with(b"<!") {
+            i = skip_to(i + 2, b">");
+        } else if rest.starts_with(b"</") {
+            depth = depth.saturating_sub(1);
+            i = skip_to(i + 2, b">");
+        } else {
+            let start = i;
+            let mut quote = None;
+            let mut j = i + 1;
+            while j < b.len() {
+                match (quote, b[j]) {
+                    (None, q @ (b'"' | b'\'')) => quote = Some(q),
+                    (Some(q), c) if c == q => quote = None,
+                    (None, b'>') => break,
+                    _ => {}
+                }
+                j += 1;
+            }
+            if j < b.len() && b[j - 1] != b'/' {
+                depth += 1;
+                if depth > limit {
+                    let line = 1 + b[..start].iter().filter(|&&c| c == b'\n').count();
+                    let column = start
+                        - b[..start]
+                            .iter()
+                            .rposition(|&c| c == b'\n')
+                            .map_or(0, |p| p + 1)
+                        + 1;
+                    return Some((line, column));
+                }
+            }
+            i = j + 1;
+        }
+    }
+    None
+}
+
 /// Parses a Mitsuba 3 XML scene; `origin` names the file in errors and the scene.
 pub fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
+    if let Some((line, column)) = too_deep(text, MAX_XML_DEPTH) {
+        return Err(SceneError::Syntax {
+            origin: origin.to_string(),
+            line,
+            column,
+            message: format!(
+                "elements nested more than {MAX_XML_DEPTH} deep (a Mitsuba scene nests a few \
+                 levels; the XML parser recurses per level)"
+            ),
+        });
+    }
     let doc = Document::parse(text).map_err(|e| {
         let pos = e.pos();
         SceneError::Syntax {
@@ -516,6 +595,27 @@ fn microfacet_spec(distribution: &str, alpha_u: f64, alpha_v: f64) -> ModelSpec 
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn nesting_beyond_the_bound_is_a_syntax_error_not_a_stack_overflow() {
+        let deep = format!(
+            "<scene version=\"3.0.0\">{}{}</scene>",
+            "<a>".repeat(20_000),
+            "</a>".repeat(20_000)
+        );
+        let e = parse(&deep, "deep.xml").unwrap_err().to_string();
+        assert!(
+            e.contains("deep.xml:1:") && e.contains("nested more than 128"),
+            "{e}"
+        );
+        let ok = format!(
+            "<!-- <a><a> --><scene a='>'>{}<b/>{}</scene>",
+            "<c>".repeat(100),
+            "</c>".repeat(100)
+        );
+        assert_eq!(too_deep(&ok, MAX_XML_DEPTH), None);
+        assert_eq!(too_deep("<a>\n <b>", 1), Some((2, 2)));
+    }
+
     use super::*;
 
     fn scene(body: &str) -> Result<Scene, SceneError> {

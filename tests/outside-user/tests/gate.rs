@@ -73,6 +73,19 @@ fn gate(g: &Gated) -> mfh_harness::run::AuditReport {
         .run()
 }
 
+/// The natural form on edition 2021 (this crate's): the gate as the tail expression of a
+/// function that owns its model. With a borrowing `run` the builder was a temporary that
+/// outlived the model (E0597); this test compiling is half the proof, passing the other half.
+fn gate_owned(m: Microfacet) -> bool {
+    let g = Gated(m);
+    Audit::of(&g).profile(Profile::Ci).run().passed()
+}
+
+#[test]
+fn the_gate_is_a_tail_expression_over_an_owned_model() {
+    assert!(gate_owned(Microfacet::new(Family::Ggx, 0.3)));
+}
+
 #[test]
 fn the_renderers_correct_models_pass() {
     for m in [
