@@ -3,8 +3,8 @@
 //! every module has a layer; no circle of imports between top-level modules or between the
 //! sinks of `report/`; only the CLI knows clap; checks and oracles do no file I/O.
 //!
-//! Every non-test line of every file is read: `#[cfg(test)]` items (brace-matched) and
-//! comments are dropped, nothing else.
+//! Every non-test line of every file is read: comments, literals and `#[cfg(test)]` items are
+//! blanked by `tests/support/rust_source.rs`, nothing else; `use` groups are expanded.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -83,87 +83,46 @@ fn module_of(file: &Path) -> String {
         .to_string()
 }
 
-/// The source without comments and without `#[cfg(test)]` items: after the attribute, the
-/// item runs to its matching closing brace (or to its `;` if it has no body). Braces in
-/// string and character literals are not counted.
+#[path = "../../tests/support/rust_source.rs"]
+mod rust_source;
+
+/// The code of a file: comments, literals and `#[cfg(test)]` items blanked
+/// (`tests/support/rust_source.rs`, the reader the reference crate's layering test uses too).
 fn code(text: &str) -> String {
-    let lines: Vec<&str> = text
-        .lines()
-        .map(|l| {
-            let t = l.trim_start();
-            if t.starts_with("//") {
-                ""
-            } else {
-                l
-            }
-        })
-        .collect();
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < lines.len() {
-        if lines[i].trim() == "#[cfg(test)]" {
-            i += 1;
-            let mut depth = 0i64;
-            let mut opened = false;
-            while i < lines.len() {
-                let l = strip_literals(lines[i]);
-                depth += l.matches('{').count() as i64 - l.matches('}').count() as i64;
-                opened |= l.contains('{');
-                i += 1;
-                if (opened && depth <= 0) || (!opened && l.trim_end().ends_with(';')) {
-                    break;
-                }
-            }
-            continue;
-        }
-        out.push(lines[i]);
-        i += 1;
-    }
-    out.join("\n")
+    rust_source::without_test_items(&rust_source::code_only(text))
 }
 
-/// A line without its string and char literals and its trailing comment.
-fn strip_literals(line: &str) -> String {
-    let mut out = String::new();
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match c {
-            '"' => {
-                while let Some(d) = chars.next() {
-                    if d == '\\' {
-                        chars.next();
-                    } else if d == '"' {
-                        break;
-                    }
-                }
+/// The segment after `prefix` of every path in `code` that starts with it: in `use` trees
+/// (groups such as `crate::{a, b}` expanded) and in paths written inline (`crate::a::f()`).
+fn targets(code: &str, prefix: &[&str]) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for (_, tree, _) in rust_source::use_statements_at(code) {
+        for path in rust_source::expand_use(&tree) {
+            if path.len() > prefix.len() && path.iter().zip(prefix).all(|(a, b)| a == b) {
+                out.insert(path[prefix.len()].clone());
             }
-            '\'' if matches!(chars.clone().nth(1), Some('\'')) => {
-                chars.next();
-                chars.next();
-            }
-            '/' if chars.peek() == Some(&'/') => break,
-            _ => out.push(c),
+        }
+    }
+    let written = format!("{}::", prefix.join("::"));
+    for (i, _) in code.match_indices(&written) {
+        let ident: String = code[i + written.len()..]
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
+        if !ident.is_empty() {
+            out.insert(ident);
         }
     }
     out
-}
-
-/// The identifiers that follow each occurrence of `prefix` in `text`.
-fn targets<'a>(text: &'a str, prefix: &'a str) -> impl Iterator<Item = String> + 'a {
-    text.match_indices(prefix).map(move |(i, _)| {
-        text[i + prefix.len()..]
-            .chars()
-            .take_while(|c| c.is_alphanumeric() || *c == '_')
-            .collect()
-    })
 }
 
 /// The top-level modules a file imports (through `crate::`), its own excluded.
 fn imports(file: &Path) -> BTreeSet<String> {
     let own = module_of(file);
     let text = code(&std::fs::read_to_string(file).expect("readable"));
-    targets(&text, "crate::")
-        .filter(|t| *t != own && !t.is_empty())
+    targets(&text, &["crate"])
+        .into_iter()
+        .filter(|t| *t != own)
         .collect()
 }
 
@@ -299,8 +258,9 @@ fn no_circle_of_imports_between_the_sinks() {
             continue;
         }
         let text = code(&std::fs::read_to_string(file).expect("readable"));
-        let used: BTreeSet<String> = targets(&text, "super::")
-            .chain(targets(&text, "crate::report::"))
+        let used: BTreeSet<String> = targets(&text, &["super"])
+            .into_iter()
+            .chain(targets(&text, &["crate", "report"]))
             .filter(|t| *t != name && t != "mod" && names.contains(t))
             .collect();
         graph.entry(name).or_default().extend(used);
@@ -314,10 +274,14 @@ fn no_circle_of_imports_between_the_sinks() {
 
 #[test]
 fn the_reader_drops_test_items_and_comments_only() {
-    let text = "use crate::a;\n#[cfg(test)]\nmod tests {\n    fn f() { let s = \"}\"; }\n    use crate::b;\n}\n// crate::c\nuse crate::d;\n#[cfg(test)]\nuse crate::e;\nfn g() {}\n";
+    let text = "use crate::a;\n#[cfg(test)]\nmod tests {\n    fn f() { let s = \"}\"; }\n    \
+                use crate::b;\n}\n// crate::c\nuse crate::d;\n#[cfg(test)]\nuse crate::e;\n\
+                /* crate::f */ fn g() { let r = r#\"{ crate::h\"#; crate::i::j(); }\n\
+                use crate::{k, l::m};\n";
     let c = code(text);
-    assert!(c.contains("crate::a") && c.contains("crate::d") && c.contains("fn g"));
-    assert!(!c.contains("crate::b") && !c.contains("crate::c") && !c.contains("crate::e"));
+    let found = targets(&c, &["crate"]);
+    let expected: BTreeSet<String> = ["a", "d", "i", "k", "l"].map(String::from).into();
+    assert_eq!(found, expected, "in:\n{c}");
     let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     g.entry("a".into()).or_default().insert("b".into());
     g.entry("b".into()).or_default().insert("a".into());
