@@ -1,10 +1,9 @@
 //! The rough conductor: Walter 2007's microfacet reflection with the Fresnel term of a complex
 //! index n + ik (exact, or Schlick's approximation), one-sided (lit from outside only).
 
-use super::dielectric::finite_or_zero;
 use super::fresnel::{self, FresnelModel};
-use super::microfacet::{reflect, Microfacet};
-use super::{finite, Bsdf, BsdfError, BsdfSample};
+use super::microfacet::{reflect, reflection_half_vector, Microfacet};
+use super::{finite, finite_or_zero, Bsdf, BsdfError, BsdfSample};
 use crate::geometry::{dot, Vec3};
 
 /// The largest n and k accepted (measured metals have n, k < 15 in the visible; the bound only
@@ -67,12 +66,9 @@ impl Conductor {
         if !finite(wi) || !finite(wo) || !(wi[2] > 0.0) || !(wo[2] > 0.0) {
             return (0.0, 0.0);
         }
-        let h = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
-        let len = dot(h, h).sqrt();
-        if !(len > 0.0) {
+        let Some((m, len)) = reflection_half_vector(wi, wo) else {
             return (0.0, 0.0);
-        }
-        let m = [h[0] / len, h[1] / len, h[2] / len];
+        };
         let (cim, com) = (dot(wi, m), dot(wo, m));
         if !(cim > 0.0) || !(com > 0.0) {
             return (0.0, 0.0);
@@ -127,11 +123,6 @@ impl Bsdf for Conductor {
         if !finite(wo) || !(wo[2] > 0.0) {
             return None;
         }
-        let (value, pdf) = self.evaluate(wi, wo);
-        (pdf > 0.0).then(|| BsdfSample {
-            wo,
-            pdf,
-            weight: value / pdf,
-        })
+        BsdfSample::at(wo, self.evaluate(wi, wo))
     }
 }

@@ -3,8 +3,8 @@
 //! reflection.
 
 use super::fresnel;
-use super::microfacet::{reflect, refract, Microfacet};
-use super::{finite, Bsdf, BsdfError, BsdfSample, Transport};
+use super::microfacet::{reflect, reflection_half_vector, refract, Microfacet};
+use super::{finite, finite_or_zero, Bsdf, BsdfError, BsdfSample, Transport};
 use crate::geometry::{dot, Vec3};
 
 /// The smallest and largest relative index accepted, and the least |η − 1|: at η = 1 the
@@ -99,13 +99,9 @@ impl Dielectric {
         let eta_o = self.index(wo);
         if ci * co > 0.0 {
             // Reflection, eq 13.
-            let h = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
-            let len = dot(h, h).sqrt();
-            if !(len > 0.0) {
+            let Some((m, len)) = reflection_half_vector(wi, wo) else {
                 return (0.0, 0.0);
-            }
-            let s = 1.0f64.copysign(ci) / len;
-            let m = [s * h[0], s * h[1], s * h[2]];
+            };
             let (cim, com) = (dot(wi, m), dot(wo, m));
             if !(m[2] > 0.0) || !(cim * ci > 0.0) || !(com * co > 0.0) {
                 return (0.0, 0.0);
@@ -164,16 +160,6 @@ impl Dielectric {
     }
 }
 
-/// `x` if finite, else 0 (an overflowing D at α = 1e-7 must not leak ∞).
-#[inline]
-pub(crate) fn finite_or_zero(x: f64) -> f64 {
-    if x.is_finite() {
-        x
-    } else {
-        0.0
-    }
-}
-
 /// Validates a relative index (field `eta`).
 pub(crate) fn check_eta(eta: f64) -> Result<f64, BsdfError> {
     if !(ETA_MIN..=ETA_MAX).contains(&eta) {
@@ -223,12 +209,7 @@ impl Bsdf for Dielectric {
         if !finite(wo) || (wo[2] * ci > 0.0) != reflected || wo[2] == 0.0 {
             return None;
         }
-        let (value, pdf) = self.evaluate(wi, wo);
-        (pdf > 0.0).then(|| BsdfSample {
-            wo,
-            pdf,
-            weight: value / pdf,
-        })
+        BsdfSample::at(wo, self.evaluate(wi, wo))
     }
 
     fn eta(&self) -> Option<f64> {

@@ -265,6 +265,19 @@ impl Microfacet {
     }
 }
 
+/// The reflection half vector of Walter eq 13, h_r = sign(wi·n)(wi + wo)/|wi + wo| (on wi's
+/// side of the surface), and |wi + wo|; `None` when wi + wo is 0 or not finite.
+#[inline]
+pub fn reflection_half_vector(wi: Vec3, wo: Vec3) -> Option<(Vec3, f64)> {
+    let h = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+    let len = dot(h, h).sqrt();
+    if !(len > 0.0) || !len.is_finite() {
+        return None;
+    }
+    let s = 1.0f64.copysign(wi[2]) / len;
+    Some(([s * h[0], s * h[1], s * h[2]], len))
+}
+
 /// The mirror direction of `wi` about `m`: 2(wi·m)m − wi.
 #[inline]
 pub fn reflect(wi: Vec3, m: Vec3) -> Vec3 {

@@ -89,6 +89,18 @@ pub struct BsdfSample {
     pub weight: f64,
 }
 
+impl BsdfSample {
+    /// The sample at `wo` from eval and pdf evaluated there (so the three agree to the last
+    /// bit); `None` where the pdf is 0 (a direction the BSDF cannot sample is a failed sample).
+    pub fn at(wo: Vec3, (value, pdf): (f64, f64)) -> Option<Self> {
+        (pdf > 0.0).then(|| Self {
+            wo,
+            pdf,
+            weight: value / pdf,
+        })
+    }
+}
+
 /// The transport convention of a transmitting BSDF (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -255,6 +267,16 @@ delegate_bsdf!(&T, Box<T>, std::sync::Arc<T>);
 #[inline]
 pub(crate) fn finite(w: Vec3) -> bool {
     w.iter().all(|c| c.is_finite())
+}
+
+/// `x` if finite, else 0 (an overflowing D at α = 1e-7 must not leak ∞).
+#[inline]
+pub(crate) fn finite_or_zero(x: f64) -> f64 {
+    if x.is_finite() {
+        x
+    } else {
+        0.0
+    }
 }
 
 /// `s · v`.
