@@ -13,13 +13,15 @@
 //!     .assert_pass();
 //! ```
 
-use crate::check::{against, PlannedCheck, Profile};
+use crate::check::{self, against, PlannedCheck, Profile};
 use crate::plan::{plan_model, Effects};
 use crate::record::{CheckRecord, Verdict};
 use crate::run::DEFAULT_SEED;
 use crate::run::{run_plan, AuditOptions, AuditReport};
 use crate::scene::Sampling;
+use crate::subject::bsdf::BsdfSubject;
 use crate::subject::{Hints, Subject};
+use mfh_reference::bsdf::{Bsdf, BsdfSpec};
 use mfh_reference::{Masking, ModelSpec, Ndf};
 use serde_json::json;
 use std::f64::consts::FRAC_PI_2;
@@ -30,6 +32,8 @@ use std::time::Instant;
 /// An audit of one model, configured by its builder methods and carried out by [`Audit::run`].
 pub struct Audit<'a> {
     model: Arc<dyn Ndf + 'a>,
+    /// The BSDF under audit ([`Audit::of_bsdf`]); then `model` is unused.
+    bsdf: Option<Arc<dyn Bsdf + 'a>>,
     name: String,
     hints: Hints,
     options: AuditOptions,
@@ -50,6 +54,7 @@ impl<'a> Audit<'a> {
         let (seed, seed_error) = seed_from_env(std::env::var("MFH_SEED").ok());
         Self {
             model: Arc::new(model),
+            bsdf: None,
             name: std::any::type_name::<M>().to_string(),
             hints: Hints::default(),
             options: AuditOptions {
@@ -65,6 +70,36 @@ impl<'a> Audit<'a> {
             against: None,
             seed_error,
         }
+    }
+
+    /// An audit of a whole BSDF `bsdf` (reflection and refraction, sampled and evaluated; see
+    /// [`mfh_reference::bsdf`] for the conventions): the chi-square of its sampling over the
+    /// whole sphere, the consistency of its sample weights, its failure rate, albedo, energy,
+    /// reciprocity and stability at the hard cases; `.against` takes a reference BSDF spec
+    /// (`{"bsdf": "dielectric", "eta": 1.5, "ndf": {...}}`). The NDF options (masking,
+    /// sampling, slope moments, θ max, hints) do not apply.
+    ///
+    /// ```
+    /// use mfh_harness::{Audit, Profile};
+    /// use mfh_reference::bsdf::BsdfSpec;
+    /// let spec: BsdfSpec = serde_json::from_str(
+    ///     r#"{"bsdf":"conductor","n":0.2,"k":3.0,"ndf":{"family":"ggx","alpha":0.5}}"#,
+    /// ).unwrap();
+    /// let conductor = spec.build().unwrap();
+    /// assert!(Audit::of_bsdf(&conductor).profile(Profile::Ci).run().passed());
+    /// ```
+    pub fn of_bsdf<B: Bsdf + 'a>(bsdf: &'a B) -> Self {
+        struct NoNdf;
+        impl Ndf for NoNdf {
+            fn d(&self, _: mfh_reference::Vec3) -> f64 {
+                0.0
+            }
+        }
+        // `&NoNdf` is promoted to a 'static constant: the NDF side plans nothing here.
+        let mut audit = Audit::of(&NoNdf);
+        audit.bsdf = Some(Arc::new(bsdf));
+        audit.name = std::any::type_name::<B>().to_string();
+        audit
     }
 
     /// The name records give the model (default: its Rust type name).
@@ -118,7 +153,8 @@ impl<'a> Audit<'a> {
     }
 
     /// Also compare the model value by value with the reference closed forms of `spec`
-    /// (JSON, e.g. `{"family":"ggx","alpha":0.3}`).
+    /// (JSON, e.g. `{"family":"ggx","alpha":0.3}`; for [`Audit::of_bsdf`] a reference BSDF
+    /// spec, e.g. `{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}`).
     pub fn against(mut self, spec: &str) -> Self {
         self.against = Some(spec.to_string());
         self
@@ -152,6 +188,9 @@ impl<'a> Audit<'a> {
     /// The planned checks, each with the reason it is planned, and any configuration error as
     /// a record that fails.
     pub fn plan(&self) -> (Vec<PlannedCheck<'a>>, Vec<CheckRecord>) {
+        if let Some(bsdf) = &self.bsdf {
+            return self.plan_bsdf(bsdf.clone());
+        }
         let subject = Subject::user(self.model.clone(), &self.name, self.hints.clone());
         let why = format!("model `{}`", self.name);
         let mut errors = Vec::new();
@@ -184,6 +223,39 @@ impl<'a> Audit<'a> {
                 Err(e) => errors.push(config_error(
                     &subject.label,
                     format!("against: the reference spec {text} is invalid: {e}"),
+                )),
+            }
+        }
+        (plan, errors)
+    }
+
+    /// The plan of a BSDF audit.
+    fn plan_bsdf(&self, bsdf: Arc<dyn Bsdf + 'a>) -> (Vec<PlannedCheck<'a>>, Vec<CheckRecord>) {
+        let subject = BsdfSubject::user(bsdf, &self.name);
+        let why = format!("BSDF `{}`", self.name);
+        let mut errors = Vec::new();
+        if let Some(message) = &self.seed_error {
+            errors.push(config_error(&subject.label, message.clone()));
+        }
+        let mut plan = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            check::bsdf::plan(&subject, self.options.profile, &why)
+        }))
+        .unwrap_or_else(|_| {
+            errors.push(config_error(
+                &subject.label,
+                "the BSDF panicked while the audit was planned".into(),
+            ));
+            Vec::new()
+        });
+        if let Some(text) = &self.against {
+            match serde_json::from_str::<BsdfSpec>(text)
+                .map_err(|e| e.to_string())
+                .and_then(|s| s.validate().map(|_| s).map_err(|e| e.to_string()))
+            {
+                Ok(spec) => plan.extend(check::bsdf::plan_against(&subject, &spec, &why)),
+                Err(e) => errors.push(config_error(
+                    &subject.label,
+                    format!("against: the reference BSDF spec {text} is invalid: {e}"),
                 )),
             }
         }

@@ -216,6 +216,28 @@ pub enum RecordData {
         /// Expected counts per cell (pdf mass × samples).
         expected: Vec<f64>,
     },
+    /// The observed and expected counts of a BSDF's chi-square test over the whole sphere: each
+    /// hemisphere on the grid of [`RecordData::Chi2Table`] (the lower one mirrored through the
+    /// surface: its row 0 is at the horizon, its last row at −z), the expected counts those of
+    /// the successful samples.
+    SphereChi2Table {
+        /// cos θ-rows R of each hemisphere.
+        rows: usize,
+        /// φ-columns 2R.
+        columns: usize,
+        /// Samples drawn (failed ones included).
+        samples: u64,
+        /// The seed of the random streams.
+        seed: u64,
+        /// Observed counts per cell above the surface (reflection from outside).
+        upper_observed: Vec<u64>,
+        /// Expected counts per cell above the surface.
+        upper_expected: Vec<f64>,
+        /// Observed counts per cell below the surface, mirrored.
+        lower_observed: Vec<u64>,
+        /// Expected counts per cell below the surface, mirrored.
+        lower_expected: Vec<f64>,
+    },
     /// A Kolmogorov–Smirnov marginal: the model's CDF and an empirical CDF at `x`.
     KsMarginal {
         /// The marginal (`cos_theta` or `phi`).

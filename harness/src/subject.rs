@@ -3,6 +3,8 @@
 //! its registry entry and spec for a reference model, the user's hints, and what the oracles
 //! measure from D itself. Checks never ask a subject for a family name to decide what to do.
 
+pub mod bsdf;
+
 use crate::oracle::lobe::{self, Lobe, Options};
 use crate::oracle::smith_lambda::LambdaSubject;
 use mfh_reference::family::{FamilyInfo, FamilySpec};

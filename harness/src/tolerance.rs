@@ -6,9 +6,14 @@
 //! and their table are in `tolerance/expected.rs`, and the chi-square oracle's numeric
 //! tolerances in `tolerance/chi2.rs`, both re-exported here.
 
+mod bsdf;
 mod chi2;
 mod expected;
 
+pub use bsdf::{
+    BSDF_AGAINST_REFERENCE, BSDF_ENERGY, BSDF_RECIPROCITY, BSDF_SAMPLE_CONSISTENCY,
+    BSDF_SAMPLE_DIRECTION, BSDF_STABILITY,
+};
 pub use chi2::{
     CELL_ABSOLUTE_TOLERANCE, CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE,
     MASS_TOLERANCE, MIN_EXPECTED, REMOTE_CELL_ABSOLUTE_TOLERANCE,
@@ -287,6 +292,12 @@ pub const TABLE: &[Tolerance] = &[
     SG_CONVOLUTION_L2,
     PIECEWISE_TRAPEZOID,
     SLOPE_MOMENT_CLAIM,
+    BSDF_SAMPLE_CONSISTENCY,
+    BSDF_RECIPROCITY,
+    BSDF_AGAINST_REFERENCE,
+    BSDF_SAMPLE_DIRECTION,
+    BSDF_ENERGY,
+    BSDF_STABILITY,
 ];
 
 /// `pdf_wm` against the density of the sampling map (finite differences of `sample_wm`).

@@ -3,6 +3,7 @@
 //! panics and never asserts; only the audit's verdicts decide.
 
 pub mod against;
+pub mod bsdf;
 pub mod claims;
 pub mod ds;
 pub mod errata;

@@ -42,6 +42,8 @@ pub const MAX_DEPTH: u32 = 10;
 
 pub use super::Estimate;
 
+pub mod global;
+
 /// The 15 nodes and K15 / G7 weights on [a, b] (G7 weight 0 at the Kronrod-only nodes).
 fn rule(a: f64, b: f64) -> ([f64; 15], [f64; 15], [f64; 15]) {
     let (c, h) = (0.5 * (a + b), 0.5 * (b - a));

@@ -12,6 +12,7 @@ pub mod monte_carlo;
 pub mod precise;
 pub mod quadrature;
 pub mod smith_lambda;
+pub mod sphere_chi2;
 pub mod student_t;
 pub mod visible_moments;
 

@@ -76,7 +76,7 @@ pub fn case_name(case: &Value) -> String {
 /// The folder (relative to the output folder) a record's artefacts go to, if it has data.
 pub fn relative_folder(record: &CheckRecord) -> Option<PathBuf> {
     let kind = match record.data.as_ref()? {
-        RecordData::Chi2Table { .. } => "chi2",
+        RecordData::Chi2Table { .. } | RecordData::SphereChi2Table { .. } => "chi2",
         RecordData::KsMarginal { .. } => "ks",
         RecordData::Curve { .. } => "curves",
     };
@@ -97,8 +97,48 @@ pub fn file_names(data: &RecordData) -> &'static [&'static str] {
             #[cfg(feature = "html")]
             "chi2_difference.svg",
         ],
+        RecordData::SphereChi2Table { .. } => &[
+            "upper_chi2_observed.json",
+            "upper_chi2_expected.json",
+            "lower_chi2_observed.json",
+            "lower_chi2_expected.json",
+            #[cfg(feature = "html")]
+            "upper_chi2_observed.svg",
+            #[cfg(feature = "html")]
+            "upper_chi2_expected.svg",
+            #[cfg(feature = "html")]
+            "upper_chi2_difference.svg",
+            #[cfg(feature = "html")]
+            "lower_chi2_observed.svg",
+            #[cfg(feature = "html")]
+            "lower_chi2_expected.svg",
+            #[cfg(feature = "html")]
+            "lower_chi2_difference.svg",
+        ],
         RecordData::KsMarginal { .. } => &["ks_marginal.json"],
         RecordData::Curve { .. } => &["curve.json"],
+    }
+}
+
+/// The hemispheres of a sphere table: (file prefix, title suffix, observed, expected).
+pub fn hemispheres(data: &RecordData) -> Vec<(&'static str, &'static str, &[u64], &[f64])> {
+    match data {
+        RecordData::SphereChi2Table {
+            upper_observed,
+            upper_expected,
+            lower_observed,
+            lower_expected,
+            ..
+        } => vec![
+            ("upper", "above the surface", upper_observed, upper_expected),
+            (
+                "lower",
+                "below the surface (mirrored)",
+                lower_observed,
+                lower_expected,
+            ),
+        ],
+        _ => Vec::new(),
     }
 }
 
@@ -272,6 +312,49 @@ pub fn write_record_data(
             files.extend(chi2_heat_maps(title, *rows, *columns, observed, expected)?);
             #[cfg(not(feature = "html"))]
             let _ = title;
+        }
+        RecordData::SphereChi2Table {
+            rows,
+            columns,
+            samples,
+            seed,
+            ..
+        } => {
+            // The names are the `file_names` entries, which must be 'static: the prefixed
+            // names are matched back from that list.
+            let names = file_names(data);
+            let named = |n: String| -> &'static str {
+                names
+                    .iter()
+                    .copied()
+                    .find(|x| *x == n)
+                    .unwrap_or("chi2.json")
+            };
+            for (prefix, side, observed, expected) in hemispheres(data) {
+                for (name, text) in chi2_tables(
+                    generated_by,
+                    *rows,
+                    *columns,
+                    *samples,
+                    *seed,
+                    observed,
+                    expected,
+                ) {
+                    files.push((named(format!("{prefix}_{name}")), text));
+                }
+                #[cfg(feature = "html")]
+                for (name, svg) in chi2_heat_maps(
+                    &format!("{title} · {side}"),
+                    *rows,
+                    *columns,
+                    observed,
+                    expected,
+                )? {
+                    files.push((named(format!("{prefix}_{name}")), svg));
+                }
+                #[cfg(not(feature = "html"))]
+                let _ = (title, side);
+            }
         }
         RecordData::KsMarginal { .. } => {
             files.push(("ks_marginal.json", format!("{:#}\n", json!(data))));

@@ -26,6 +26,22 @@ pub(crate) fn data_plots(r: &CheckRecord) -> Result<String, PlotError> {
                 .map(|(name, svg)| img(svg, &format!("{} {name}", r.check)))
                 .collect())
         }
+        Some(data @ RecordData::SphereChi2Table { rows, columns, .. }) => {
+            let mut tags = String::new();
+            for (_, side, observed, expected) in super::artefacts::hemispheres(data) {
+                let maps = chi2_heat_maps(
+                    &format!("{title} · {side}"),
+                    *rows,
+                    *columns,
+                    observed,
+                    expected,
+                )?;
+                for (name, svg) in &maps {
+                    tags.push_str(&img(svg, &format!("{} {side} {name}", r.check)));
+                }
+            }
+            Ok(tags)
+        }
         Some(RecordData::KsMarginal {
             marginal,
             x,

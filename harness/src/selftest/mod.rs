@@ -12,6 +12,7 @@
 //! rejection fraction must lie in the 99 % binomial interval of α and the p-values must be
 //! uniform.
 
+pub mod bsdf_mutant;
 pub mod calibrate;
 pub mod catalog;
 pub mod mutant;

@@ -166,7 +166,29 @@ pub fn expected_mass_in_batch(
         }
         per_cell.push(pieces);
     }
-    let f = |pt: &[[f64; 2]], out: &mut [f64]| {
+    let f = in_angles(pdf);
+    let pieces = integrate_rectangles_batch(&f, &rectangles);
+    let mut at = 0;
+    let estimates: Vec<Estimate> = per_cell
+        .iter()
+        .map(|&n| {
+            let mut sum = Estimate::default();
+            for e in &pieces[at..at + n] {
+                sum.value += e.value;
+                sum.error_bound += e.error_bound;
+                sum.evaluations += e.evaluations;
+            }
+            at += n;
+            sum
+        })
+        .collect();
+    Expected::of_cells(&estimates)
+}
+
+/// A batch density over directions as a batch integrand over (φ, θ): pdf(direction) · sin θ,
+/// evaluated in parallel chunks of 16 384 points.
+fn in_angles<'p>(pdf: &'p BatchPdf<'p>) -> impl Fn(&[[f64; 2]], &mut [f64]) + 'p {
+    move |pt: &[[f64; 2]], out: &mut [f64]| {
         const CHUNK: usize = 16_384;
         out.par_chunks_mut(CHUNK)
             .zip(pt.par_chunks(CHUNK))
@@ -190,14 +212,42 @@ pub fn expected_mass_in_batch(
                     *o *= s;
                 }
             });
-    };
-    let pieces = integrate_rectangles_batch(&f, &rectangles);
+    }
+}
+
+/// [`expected_mass_in_batch`] by globally adaptive cubature
+/// ([`crate::oracle::cubature::global`]): the cells' pieces (cut as there) compete for one
+/// summed error `target` within `budget` evaluations — for densities with steps (a BSDF's),
+/// where the locally adaptive form bisects every piece a step crosses to its depth limit.
+/// Returns the masses and whether the target was met (else the bound is what the budget bought).
+pub fn expected_mass_global(
+    pdf: &BatchPdf<'_>,
+    grid: HemisphereGrid,
+    lobe: &Lobe,
+    target: f64,
+    budget: u64,
+) -> (Expected, bool) {
+    let polar = lobe.polar_cuts_with(FRAC_PI_2, &[]);
+    let azimuth = lobe.azimuth_cuts();
+    let mut rectangles = Vec::new();
+    let mut per_cell = Vec::with_capacity(grid.cells());
+    for i in 0..grid.cells() {
+        let (thetas, phis, pieces) = cell_pieces(grid, i, &polar, &azimuth);
+        for p in phis.windows(2) {
+            for t in thetas.windows(2) {
+                rectangles.push(([p[0], p[1]], [t[0], t[1]]));
+            }
+        }
+        per_cell.push(pieces);
+    }
+    let f = in_angles(pdf);
+    let result = crate::oracle::cubature::global::integrate_global(&f, &rectangles, target, budget);
     let mut at = 0;
     let estimates: Vec<Estimate> = per_cell
         .iter()
         .map(|&n| {
             let mut sum = Estimate::default();
-            for e in &pieces[at..at + n] {
+            for e in &result.estimates[at..at + n] {
                 sum.value += e.value;
                 sum.error_bound += e.error_bound;
                 sum.evaluations += e.evaluations;
@@ -206,7 +256,9 @@ pub fn expected_mass_in_batch(
             sum
         })
         .collect();
-    Expected::of_cells(&estimates)
+    let mut e = Expected::of_cells(&estimates);
+    e.evaluations = result.evaluations;
+    (e, result.converged)
 }
 
 /// The cut points strictly inside `range`, with its ends.

@@ -99,7 +99,7 @@ fn sanity(
 }
 
 /// Σ (O − E)² / E over the pooled bins; returns (statistic, bins, pooled cells).
-pub(super) fn pooled_statistic(observed: &[u64], expected: &[f64]) -> (f64, usize, usize) {
+pub(crate) fn pooled_statistic(observed: &[u64], expected: &[f64]) -> (f64, usize, usize) {
     let mut bins: Vec<(f64, f64)> = Vec::with_capacity(expected.len());
     let (mut pool_o, mut pool_e, mut pooled) = (0.0, 0.0, 0);
     for (&o, &e) in observed.iter().zip(expected) {

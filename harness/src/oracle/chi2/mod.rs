@@ -39,7 +39,8 @@ mod judge;
 
 pub use binning::{observe, observe_batch, observe_blocks, Observed, CHUNK};
 pub use expected::{
-    expected_mass, expected_mass_in, expected_mass_in_batch, expected_mass_to, Expected,
+    expected_mass, expected_mass_global, expected_mass_in, expected_mass_in_batch,
+    expected_mass_to, Expected,
 };
 
 use crate::oracle::domain::{DomainError, HemisphereGrid};
@@ -47,8 +48,7 @@ use crate::oracle::lobe::{self, Lobe};
 use crate::tolerance::CELL_RELATIVE_TOLERANCE;
 use binning::scalar_batch;
 use judge::judge;
-#[cfg(test)]
-use judge::pooled_statistic;
+pub(crate) use judge::pooled_statistic;
 use mfh_reference::geometry::Vec3;
 use mfh_reference::NormalSampler;
 use std::time::Instant;

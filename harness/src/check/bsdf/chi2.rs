@@ -1,0 +1,100 @@
+//! `bsdf.chi2`: the directions `sample` returns against `pdf` over the whole sphere, at one
+//! incidence ([`crate::oracle::sphere_chi2`]).
+
+use super::{BsdfSubject, Incidence, Integrals, SOURCE};
+use crate::check::{applied, covers, Check, PlannedCheck, Profile};
+use crate::oracle::chi2::{Chi2Config, Verdict as Chi2Verdict};
+use crate::oracle::sphere_chi2::sphere_chi2_against;
+use crate::record::{Measured, OracleValue, RecordData, Verdict};
+use crate::tolerance::STATISTICAL_ALPHA;
+use mfh_reference::geometry::Vec3;
+use serde_json::{json, Value};
+use std::sync::Arc;
+
+/// Cells of each hemisphere: R z-rows × 2R φ-columns.
+pub const RESOLUTION: usize = 16;
+
+/// Plans the chi-square of `subject` at `incidence`.
+pub fn plan<'a>(
+    subject: &Arc<BsdfSubject<'a>>,
+    incidence: Incidence,
+    shared: &Arc<Integrals>,
+    profile: Profile,
+    why: &str,
+) -> PlannedCheck<'a> {
+    let samples = profile.chi2_samples();
+    let mut case = incidence.case();
+    case["samples"] = json!(samples);
+    case["resolution"] = json!(RESOLUTION);
+    let s = subject.clone();
+    let shared = shared.clone();
+    Check::new("bsdf.chi2", subject.label.clone(), case, SOURCE)
+        .why(format!("{why}: the BSDF's sampling over the whole sphere"))
+        .covers(vec![covers(subject.family(), "bsdf_sample", "default")])
+        .statistical()
+        .run(move |r, ctx| {
+            let bsdf = s.bsdf.as_ref();
+            let wi = incidence.wi;
+            let config = Chi2Config {
+                resolution: RESOLUTION,
+                samples,
+                seed: ctx.seed,
+                alpha: STATISTICAL_ALPHA.value,
+            };
+            let (masses, spent) = shared.pdf_masses(bsdf);
+            let result = sphere_chi2_against(
+                &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| {
+                    let mut samples = vec![None; u.len()];
+                    bsdf.sample_batch(wi, u, &mut samples);
+                    for (o, s) in out.iter_mut().zip(samples) {
+                        *o = s.filter(|s| s.pdf > 0.0).map(|s| s.wo);
+                    }
+                },
+                masses.clone(),
+                &config,
+            );
+            r.cost.samples = samples;
+            r.cost.evaluations += spent;
+            r.tolerance = Some(applied(&STATISTICAL_ALPHA));
+            r.oracle = Some(OracleValue {
+                value: result.mass(),
+                uncertainty: result.mass_error_bound(),
+                kind: "error_bound",
+            });
+            if let Value::Object(case) = &mut r.case {
+                case.insert("pdf_mass".into(), json!(result.mass()));
+                case.insert("failed_samples".into(), json!(result.observed.failed));
+            }
+            let expected = result.expected_counts();
+            let cells = result.observed.upper.len();
+            r.data = Some(RecordData::SphereChi2Table {
+                rows: result.resolution,
+                columns: 2 * result.resolution,
+                samples,
+                seed: ctx.seed,
+                upper_observed: result.observed.upper.clone(),
+                upper_expected: expected[..cells].to_vec(),
+                lower_observed: result.observed.lower.clone(),
+                lower_expected: expected[cells..].to_vec(),
+            });
+            if result.sanity_failure {
+                r.verdict = Verdict::Fail;
+                if let Value::Object(case) = &mut r.case {
+                    case.insert("sanity_failure".into(), json!(result.reason));
+                }
+            } else {
+                r.measured = Some(Measured::PValue {
+                    p: result.p_value,
+                    statistic: result.statistic,
+                    dof: result.dof,
+                    alpha: STATISTICAL_ALPHA.value,
+                });
+                r.verdict = if result.verdict == Chi2Verdict::Pass {
+                    Verdict::Pass
+                } else {
+                    Verdict::Fail
+                };
+            }
+            Ok(())
+        })
+}

@@ -1,0 +1,243 @@
+//! The checks of a whole BSDF (reflection and refraction, Fresnel, Jacobians, sample weights),
+//! planned from the [`Bsdf`] capability alone, for mfh's reference BSDFs and a renderer's own:
+//!
+//! | check | file | oracle |
+//! |---|---|---|
+//! | `bsdf.chi2` | `chi2.rs` | sampled wo against `pdf` over the whole sphere ([`crate::oracle::sphere_chi2`]) |
+//! | `bsdf.sample_consistency` | `consistency.rs` | the sample's pdf and weight against `pdf` and `eval/pdf` at its wo |
+//! | `bsdf.failure_rate` | `consistency.rs` | the rate of failed samples against 1 − ∫ pdf (cubature) |
+//! | `bsdf.albedo` | `albedo.rs` | ∫ eval by cubature against the mean sampled weight (Monte Carlo) |
+//! | `bsdf.energy` | `albedo.rs` | ∫ eval ≤ 1 where the transport makes that a law |
+//! | `bsdf.reciprocity` | `reciprocity.rs` | f(wi, wo) against f(wo, wi) with the transport's η² |
+//! | `bsdf.stability` | `stability.rs` | finite, non-negative, sampled where valued, at the hard cases |
+//! | `bsdf.against` | `against.rs` | eval, pdf and sampled wo against a reference BSDF |
+//!
+//! Incidences ([`incidences`]): normal, oblique and grazing (cos θi = 0.05) from outside; for a
+//! transmitting BSDF also from inside and beyond the critical angle on the denser side (total
+//! internal reflection). Conventions (which direction is which, the cosine in `eval`, the
+//! transport) are those of [`mfh_reference::bsdf`].
+
+mod against;
+mod albedo;
+mod chi2;
+mod consistency;
+mod reciprocity;
+mod stability;
+
+pub use against::plan_against;
+
+use super::{PlannedCheck, Profile};
+use crate::oracle::chi2::Expected;
+use crate::oracle::domain::HemisphereGrid;
+use crate::oracle::sphere_chi2::{expected_sphere, mass_target};
+use crate::oracle::Estimate;
+use crate::random::stream;
+use crate::subject::bsdf::BsdfSubject;
+use mfh_reference::bsdf::{Bsdf, BsdfSample};
+use mfh_reference::geometry::Vec3;
+use rayon::prelude::*;
+use serde_json::{json, Value};
+use std::sync::{Arc, OnceLock};
+
+/// The source every BSDF check cites.
+pub const SOURCE: &str = "Walter et al. 2007 (seed 001 [13]) eq 13–23; Walter §5.3 (sampling)";
+
+/// Samples per random stream of the BSDF checks.
+const CHUNK: u64 = 1 << 16;
+
+/// An incidence at which the direction-dependent checks run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Incidence {
+    /// What it is (`normal`, `oblique`, `grazing`, `inside`, `total_internal_reflection`).
+    pub name: &'static str,
+    /// The direction (unit; z < 0 from inside).
+    pub wi: Vec3,
+}
+
+impl Incidence {
+    fn at(name: &'static str, cos_theta: f64, inside: bool) -> Self {
+        // An azimuth off the grid's column edges and off the axes of an anisotropic lobe.
+        let phi: f64 = 0.3;
+        let s = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        let z = if inside { -cos_theta } else { cos_theta };
+        Self {
+            name,
+            wi: [s * phi.cos(), s * phi.sin(), z],
+        }
+    }
+
+    /// The record's case fields.
+    pub fn case(&self) -> Value {
+        json!({
+            "incidence": self.name,
+            "cos_theta_i": self.wi[2],
+            "wi": self.wi,
+        })
+    }
+}
+
+/// The incidences of a BSDF: normal (cos θ = 1 − 5e-7), oblique (θ = 0.9) and grazing (cos θ =
+/// 0.05) from outside; for a transmitting BSDF of relative index η, from inside at θ = 0.5 and,
+/// on the denser side, beyond the critical angle θc = asin(η_thin/η_dense) by a third of what is
+/// left to grazing (total internal reflection for every microfacet near the macro-normal).
+pub fn incidences(bsdf: &dyn Bsdf) -> Vec<Incidence> {
+    let mut out = vec![
+        Incidence::at("normal", 1.0 - 5e-7, false),
+        Incidence::at("oblique", 0.9f64.cos(), false),
+        Incidence::at("grazing", 0.05, false),
+    ];
+    if let Some(eta) = bsdf.eta() {
+        out.push(Incidence::at("inside", 0.5f64.cos(), true));
+        let ratio = eta.min(1.0 / eta);
+        let critical = ratio.asin();
+        let theta = critical + (std::f64::consts::FRAC_PI_2 - critical) / 3.0;
+        out.push(Incidence::at(
+            "total_internal_reflection",
+            theta.cos(),
+            eta > 1.0,
+        ));
+    }
+    out
+}
+
+/// Plans every BSDF check of `subject` at `profile`; `why` says what called for them.
+pub fn plan<'a>(
+    subject: &Arc<BsdfSubject<'a>>,
+    profile: Profile,
+    why: &str,
+) -> Vec<PlannedCheck<'a>> {
+    let incidences = incidences(subject.bsdf.as_ref());
+    let mut out = Vec::new();
+    for inc in &incidences {
+        let shared = Integrals::new(inc.wi, profile.chi2_samples());
+        out.push(chi2::plan(subject, *inc, &shared, profile, why));
+        out.extend(consistency::plan(subject, *inc, &shared, profile, why));
+        out.extend(albedo::plan(subject, *inc, &shared, profile, why));
+    }
+    out.push(reciprocity::plan(subject, why));
+    out.extend(stability::plan(subject, why));
+    out
+}
+
+/// The samples of one incidence from the record's streams, chunk by chunk in parallel, each
+/// chunk folded into an accumulator by `push(acc, index, u, sample)`; the accumulators in chunk
+/// order (so a result folded from them is the same whatever the thread count).
+pub fn fold_samples<A: Send>(
+    bsdf: &dyn Bsdf,
+    wi: Vec3,
+    samples: u64,
+    seed: u64,
+    init: impl Fn() -> A + Sync,
+    push: impl Fn(&mut A, u64, [f64; 3], Option<BsdfSample>) + Sync,
+) -> Vec<A> {
+    const BLOCK: usize = 1024;
+    (0..samples.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|chunk| {
+            let mut rng = stream(seed, chunk);
+            let mut acc = init();
+            let (start, end) = (chunk * CHUNK, ((chunk + 1) * CHUNK).min(samples));
+            let mut u = vec![[0.0; 3]; BLOCK];
+            let mut out = vec![None; BLOCK];
+            let mut index = start;
+            while index < end {
+                let n = BLOCK.min((end - index) as usize);
+                for v in &mut u[..n] {
+                    *v = [rng.uniform(), rng.uniform(), rng.uniform()];
+                }
+                out[..n].iter_mut().for_each(|o| *o = None);
+                bsdf.sample_batch(wi, &u[..n], &mut out[..n]);
+                for k in 0..n {
+                    push(&mut acc, index + k as u64, u[k], out[k]);
+                }
+                index += n as u64;
+            }
+            acc
+        })
+        .collect()
+}
+
+/// The integrals over the sphere that the checks of one incidence share, each computed once by
+/// whichever check needs it first (the others wait for it): the pdf's cell masses (the
+/// chi-square's expected counts and the failure rate's 1 − ∫ pdf) and ∫ eval (the albedo and
+/// the energy). Each is an adaptive cubature of a BSDF with kinks, seconds of work.
+pub struct Integrals {
+    wi: Vec3,
+    samples: u64,
+    pdf: OnceLock<((Expected, Expected), u64)>,
+    eval: OnceLock<Estimate>,
+}
+
+impl Integrals {
+    /// The integrals at `wi`, to the accuracy a chi-square of `samples` samples needs.
+    pub fn new(wi: Vec3, samples: u64) -> Arc<Self> {
+        Arc::new(Self {
+            wi,
+            samples,
+            pdf: OnceLock::new(),
+            eval: OnceLock::new(),
+        })
+    }
+
+    /// The pdf's masses over the cells of both hemispheres (upper, lower) on the chi-square's
+    /// grid, to the [`mass_target`] of its samples, and the evaluations they cost (counted once).
+    pub fn pdf_masses(&self, bsdf: &dyn Bsdf) -> (&(Expected, Expected), u64) {
+        let mut spent = 0;
+        let masses = self.pdf.get_or_init(|| {
+            let grid = HemisphereGrid::new(chi2::RESOLUTION).expect("R ≥ 1");
+            let e = expected_sphere(&pdf_at(bsdf, self.wi), grid, mass_target(self.samples));
+            spent = e.0.evaluations + e.1.evaluations;
+            (e, spent)
+        });
+        (&masses.0, spent)
+    }
+
+    /// ∫ pdf dωo with its error bound.
+    pub fn pdf_mass(&self, bsdf: &dyn Bsdf) -> Estimate {
+        let ((upper, lower), spent) = self.pdf_masses(bsdf);
+        Estimate {
+            value: upper.total + lower.total,
+            error_bound: upper.error_bound + lower.error_bound,
+            evaluations: spent,
+        }
+    }
+
+    /// ∫ eval dωo (the albedo) with its error bound, on the same grid and tolerance (evaluations
+    /// counted by the first caller only).
+    pub fn albedo(&self, bsdf: &dyn Bsdf) -> Estimate {
+        let mut first = false;
+        let mut e = *self.eval.get_or_init(|| {
+            first = true;
+            let grid = HemisphereGrid::new(chi2::RESOLUTION).expect("R ≥ 1");
+            let (u, l) = expected_sphere(&eval_at(bsdf, self.wi), grid, mass_target(self.samples));
+            Estimate {
+                value: u.total + l.total,
+                error_bound: u.error_bound + l.error_bound,
+                evaluations: u.evaluations + l.evaluations,
+            }
+        });
+        if !first {
+            e.evaluations = 0;
+        }
+        e
+    }
+}
+
+/// `bsdf.pdf_batch` at one incidence, as a batch density over wo.
+pub fn pdf_at<'b>(bsdf: &'b dyn Bsdf, wi: Vec3) -> impl Fn(&[Vec3], &mut [f64]) + Sync + 'b {
+    move |wo: &[Vec3], out: &mut [f64]| {
+        let wis = vec![wi; wo.len()];
+        bsdf.pdf_batch(&wis, wo, out);
+    }
+}
+
+/// `bsdf.eval_batch` at one incidence, as a batch density over wo.
+pub fn eval_at<'b>(bsdf: &'b dyn Bsdf, wi: Vec3) -> impl Fn(&[Vec3], &mut [f64]) + Sync + 'b {
+    move |wo: &[Vec3], out: &mut [f64]| {
+        let wis = vec![wi; wo.len()];
+        bsdf.eval_batch(&wis, wo, out);
+    }
+}
+
+#[cfg(test)]
+mod tests;

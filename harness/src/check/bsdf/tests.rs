@@ -1,0 +1,128 @@
+use super::*;
+use crate::check::RunContext;
+use crate::record::{CheckRecord, Verdict};
+use mfh_reference::bsdf::BsdfSpec;
+
+fn spec(text: &str) -> BsdfSpec {
+    serde_json::from_str(text).unwrap()
+}
+
+fn run(plan: &[PlannedCheck<'_>]) -> Vec<CheckRecord> {
+    plan.iter()
+        .enumerate()
+        .map(|(i, p)| {
+            (p.run)(&RunContext {
+                seed: 11 + i as u64,
+            })
+        })
+        .collect()
+}
+
+fn failures(records: &[CheckRecord]) -> Vec<String> {
+    records
+        .iter()
+        .filter(|r| r.verdict.is_failure())
+        .map(|r| format!("{} {} {:?} {:?}", r.check, r.case, r.verdict, r.measured))
+        .collect()
+}
+
+/// Every BSDF mutant is killed by a check its entry names, through the public gate at the ci
+/// profile (the Šidák level of the whole audit): at seed 7, and at two more seeds in the
+/// extensive tier (`MFH_EXTENSIVE=1`).
+#[test]
+fn every_bsdf_mutant_is_killed_by_its_named_check() {
+    use crate::selftest::bsdf_mutant::{BsdfDefect, MutatedBsdf};
+    use crate::{Audit, Profile};
+    let mut missed = Vec::new();
+    let seeds: &[u64] = if cfg!(mfh_extensive) {
+        &[7, 8, 9]
+    } else {
+        &[7]
+    };
+    for (defect, &seed) in BsdfDefect::ALL
+        .iter()
+        .flat_map(|d| seeds.iter().map(move |s| (*d, s)))
+    {
+        let m = MutatedBsdf::new(defect);
+        let report = Audit::of_bsdf(&m).profile(Profile::Ci).seed(seed).run();
+        let killers: Vec<&str> = report
+            .records
+            .iter()
+            .filter(|r| r.verdict.is_failure())
+            .map(|r| r.check.as_str())
+            .collect();
+        let mut killers = killers;
+        killers.sort_unstable();
+        killers.dedup();
+        println!("{:40} seed {seed}: killed by {killers:?}", defect.id());
+        if !defect.killers().iter().any(|k| killers.contains(k)) {
+            missed.push(format!(
+                "{} seed {seed}: killed by {killers:?}",
+                defect.id()
+            ));
+        }
+    }
+    assert!(missed.is_empty(), "{missed:#?}");
+}
+
+#[test]
+fn the_reference_bsdfs_pass_every_check() {
+    for text in [
+        r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}"#,
+        r#"{"bsdf":"dielectric","eta":0.6,"ndf":{"family":"beckmann","alpha_x":0.2,"alpha_y":0.5},"masking":"uncorrelated","sampling":"normals","transport":"importance"}"#,
+        r#"{"bsdf":"conductor","n":0.2,"k":3.0,"ndf":{"family":"ggx","alpha":0.5},"fresnel":"schlick"}"#,
+    ] {
+        // Through the gate: the statistical checks at the audit's Šidák level.
+        let b = spec(text).build().unwrap();
+        let report = crate::Audit::of_bsdf(&b).profile(Profile::Ci).run();
+        let records = report.records;
+        assert!(records.len() > 10, "{text}: {}", records.len());
+        assert_eq!(failures(&records), Vec::<String>::new(), "{text}");
+        let checks: std::collections::BTreeSet<_> =
+            records.iter().map(|r| r.check.as_str()).collect();
+        for c in [
+            "bsdf.chi2",
+            "bsdf.sample_consistency",
+            "bsdf.failure_rate",
+            "bsdf.albedo",
+            "bsdf.energy",
+            "bsdf.reciprocity",
+            "bsdf.stability",
+        ] {
+            assert!(checks.contains(c), "{text}: {c} not planned");
+        }
+    }
+}
+
+#[test]
+fn a_transmitting_bsdf_is_checked_from_inside_and_beyond_the_critical_angle() {
+    let b = spec(r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}"#)
+        .build()
+        .unwrap();
+    let names: Vec<_> = incidences(b.as_ref()).iter().map(|i| i.name).collect();
+    assert_eq!(
+        names,
+        [
+            "normal",
+            "oblique",
+            "grazing",
+            "inside",
+            "total_internal_reflection"
+        ]
+    );
+    let tir = incidences(b.as_ref())[4].wi;
+    // Inside (z < 0), beyond the critical angle asin(1/1.5).
+    assert!(tir[2] < 0.0 && (-tir[2]).acos() > (1.0f64 / 1.5).asin());
+}
+
+#[test]
+fn the_reference_against_itself_agrees_and_a_different_eta_does_not() {
+    let text = r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}"#;
+    let subject = BsdfSubject::reference(&spec(text)).unwrap();
+    let records = run(&plan_against(&subject, &spec(text), "test"));
+    assert_eq!(records.len(), 3);
+    assert_eq!(failures(&records), Vec::<String>::new());
+    let other = spec(r#"{"bsdf":"dielectric","eta":1.33,"ndf":{"family":"ggx","alpha":0.3}}"#);
+    let records = run(&plan_against(&subject, &other, "test"));
+    assert!(records.iter().all(|r| r.verdict == Verdict::Fail));
+}

@@ -1,0 +1,391 @@
+//! Chi-square goodness-of-fit test of a BSDF's sampled directions against its pdf over the
+//! **whole sphere** (reflection and transmission hemispheres), at one incidence.
+//!
+//! Procedure:
+//!
+//! 1. **Observed counts.** `samples` directions are drawn with u ∈ [0, 1)³ from the
+//!    counter-based stream of each fixed chunk of [`CHUNK`] sample indices (three uniforms a
+//!    sample, [`crate::random::Stream::uniform`]), handed to the sampler a block at a time, and
+//!    binned: a direction with z ≥ 0 into the upper [`HemisphereGrid`] (R z-rows × 2R
+//!    φ-columns), one with z < 0 into the same grid of the lower hemisphere mirrored through
+//!    the surface (cell of (x, y, −z)). A sample the sampler declares failed (`None`) is counted
+//!    apart. Counts are integers summed per chunk: identical whatever the thread count.
+//! 2. **Expected masses.** In each hemisphere the pdf's lobe is measured from the pdf alone
+//!    ([`crate::oracle::lobe`]: a reflection lobe about the mirror direction and a
+//!    transmission lobe about the refracted one are off-axis modes it finds), and every cell is
+//!    integrated by globally adaptive product cubature with an error bound
+//!    ([`expected_mass_global`]) to a summed bound of 1/N per hemisphere ([`mass_target`]: all
+//!    expected counts together off by at most one sample) within [`MASS_BUDGET`] evaluations: a
+//!    BSDF's pdf has kinks and steps where a side condition switches a lobe off (a half vector
+//!    crossing the horizon, total internal reflection), which no cut can place for a model
+//!    known only through its pdf, and which a locally adaptive rule bisects to its depth limit.
+//! 3. **Sanity failures first** (no p-value): a sampled direction that is non-finite or not of
+//!    unit length, a non-finite or negative cell mass, a total mass above 1 by more than
+//!    [`MASS_TOLERANCE`] (a pdf of a sampler that cannot fail integrates to at most 1), samples
+//!    in a cell whose expected mass is 0, no successful sample.
+//! 4. **The test is conditional on success.** The successful samples are compared with the
+//!    masses normalized by the total mass (the sampler's distribution given that it returned a
+//!    direction). Whether the *rate* of failures equals 1 − ∫ pdf is a separate test
+//!    (`bsdf.sample_consistency` in the checks): folding it in here would let the cubature's
+//!    error in the total mass (up to 1e-4 relative, × 10⁶ samples = 100 counts) decide the test.
+//! 5. **Pooling and p-value** as the NDF chi-square ([`crate::oracle::chi2`]): cells expecting
+//!    fewer than [`crate::tolerance::MIN_EXPECTED`] samples are pooled, dof = bins − 1, p = Q(dof/2, χ²/2).
+
+use crate::oracle::chi2::{expected_mass_global, pooled_statistic, Chi2Config, Expected, Verdict};
+use crate::oracle::domain::{CellFinder, HemisphereGrid};
+use crate::oracle::lobe;
+use crate::random::stream;
+use crate::tolerance::MASS_TOLERANCE;
+use mfh_reference::geometry::Vec3;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Samples per random stream (the unit of work and of seeding).
+pub const CHUNK: u64 = 1 << 16;
+/// Samples handed to the sampler at once, within a chunk (the counts do not depend on it).
+const BLOCK: usize = 1024;
+
+/// A batch BSDF sampler at one incidence: writes the direction of `u[k]` (or `None`, a failed
+/// sample) into `out[k]`.
+pub type SphereSampler<'a> = dyn Fn(&[[f64; 3]], &mut [Option<Vec3>]) + Sync + 'a;
+/// A batch density over the sphere at one incidence: writes pdf(wo[k]) into `out[k]`.
+pub type SpherePdf<'a> = dyn Fn(&[Vec3], &mut [f64]) + Sync + 'a;
+
+/// The observed counts over the sphere.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SphereObserved {
+    /// Counts per cell of the upper hemisphere (row-major, row 0 at the horizon).
+    pub upper: Vec<u64>,
+    /// Counts per cell of the lower hemisphere, mirrored (row 0 at the horizon).
+    pub lower: Vec<u64>,
+    /// Samples the sampler declared failed.
+    pub failed: u64,
+    /// Returned directions that are non-finite or not of unit length.
+    pub invalid: u64,
+    /// The first of those (lowest index) and the direction.
+    pub first_invalid: Option<(u64, Vec3)>,
+}
+
+impl SphereObserved {
+    fn zero(cells: usize) -> Self {
+        Self {
+            upper: vec![0; cells],
+            lower: vec![0; cells],
+            ..Self::default()
+        }
+    }
+
+    fn merge(mut self, other: Self) -> Self {
+        for (a, b) in self.upper.iter_mut().zip(&other.upper) {
+            *a += b;
+        }
+        for (a, b) in self.lower.iter_mut().zip(&other.lower) {
+            *a += b;
+        }
+        self.failed += other.failed;
+        self.invalid += other.invalid;
+        self.first_invalid = match (self.first_invalid, other.first_invalid) {
+            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
+            (a, b) => a.or(b),
+        };
+        self
+    }
+
+    /// Successful samples (binned).
+    pub fn binned(&self) -> u64 {
+        self.upper.iter().chain(&self.lower).sum()
+    }
+}
+
+/// The result of a whole-sphere chi-square test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SphereChi2Result {
+    /// R: each hemisphere has R z-rows × 2R φ-columns.
+    pub resolution: usize,
+    /// The χ² statistic (NaN after a sanity failure).
+    pub statistic: f64,
+    /// Degrees of freedom (0 after a sanity failure).
+    pub dof: usize,
+    /// Q(dof/2, χ²/2) (0 after a sanity failure).
+    pub p_value: f64,
+    /// The level the verdict was taken at.
+    pub alpha: f64,
+    /// Pass or fail.
+    pub verdict: Verdict,
+    /// Why it failed (a sanity failure or the rejection), if it did.
+    pub reason: Option<String>,
+    /// Whether the failure is a sanity failure (no p-value).
+    pub sanity_failure: bool,
+    /// Samples drawn.
+    pub samples: u64,
+    /// The seed of the random streams.
+    pub seed: u64,
+    /// The counts.
+    pub observed: SphereObserved,
+    /// The masses of the upper and lower hemispheres' cells.
+    pub expected_upper: Expected,
+    /// See `expected_upper`.
+    pub expected_lower: Expected,
+    /// Wall time of sampling and binning, seconds.
+    pub sampling_seconds: f64,
+    /// Wall time of the expected masses, seconds.
+    pub integration_seconds: f64,
+}
+
+impl SphereChi2Result {
+    /// The pdf's integral over the sphere.
+    pub fn mass(&self) -> f64 {
+        self.expected_upper.total + self.expected_lower.total
+    }
+
+    /// The error bound of [`SphereChi2Result::mass`].
+    pub fn mass_error_bound(&self) -> f64 {
+        self.expected_upper.error_bound + self.expected_lower.error_bound
+    }
+
+    /// Pdf evaluations spent on the expected masses.
+    pub fn evaluations(&self) -> u64 {
+        self.expected_upper.evaluations + self.expected_lower.evaluations
+    }
+
+    /// The expected counts of the successful samples (upper cells, then lower cells): the masses
+    /// normalized by the total, times the binned samples.
+    pub fn expected_counts(&self) -> Vec<f64> {
+        let n = self.observed.binned() as f64;
+        let total = self.mass();
+        self.expected_upper
+            .mass
+            .iter()
+            .chain(&self.expected_lower.mass)
+            .map(|m| if total > 0.0 { m / total * n } else { 0.0 })
+            .collect()
+    }
+}
+
+/// Draws `samples` directions through `sample` and bins them over the sphere (step 1).
+pub fn observe_sphere(
+    sample: &SphereSampler<'_>,
+    grid: HemisphereGrid,
+    samples: u64,
+    seed: u64,
+) -> SphereObserved {
+    let finder = CellFinder::new(grid);
+    let chunks = samples.div_ceil(CHUNK);
+    (0..chunks)
+        .into_par_iter()
+        .map(|chunk| {
+            let mut rng = stream(seed, chunk);
+            let mut obs = SphereObserved::zero(grid.cells());
+            let (start, end) = (chunk * CHUNK, ((chunk + 1) * CHUNK).min(samples));
+            let mut u = vec![[0.0; 3]; BLOCK];
+            let mut out = vec![None; BLOCK];
+            let mut index = start;
+            while index < end {
+                let n = BLOCK.min((end - index) as usize);
+                for v in &mut u[..n] {
+                    *v = [rng.uniform(), rng.uniform(), rng.uniform()];
+                }
+                out[..n].iter_mut().for_each(|o| *o = None);
+                sample(&u[..n], &mut out[..n]);
+                for (k, wo) in out[..n].iter().enumerate() {
+                    let Some(w) = *wo else {
+                        obs.failed += 1;
+                        continue;
+                    };
+                    let (cells, mirrored) = if w[2] >= 0.0 {
+                        (&mut obs.upper, w)
+                    } else {
+                        (&mut obs.lower, [w[0], w[1], -w[2]])
+                    };
+                    match finder.cell_of(mirrored) {
+                        Ok(c) => cells[c] += 1,
+                        Err(_) => {
+                            obs.invalid += 1;
+                            if obs.first_invalid.is_none() {
+                                obs.first_invalid = Some((index + k as u64, w));
+                            }
+                        }
+                    }
+                }
+                index += n as u64;
+            }
+            obs
+        })
+        .reduce(|| SphereObserved::zero(grid.cells()), SphereObserved::merge)
+}
+
+/// The summed error bound the expected masses of one hemisphere aim at for `samples` samples:
+/// 1/N, so that all the expected counts of a hemisphere together are off by at most one sample
+/// (a chi-square of N samples cannot see that), with a floor of 1e-9.
+pub fn mass_target(samples: u64) -> f64 {
+    (1.0 / samples.max(1) as f64).max(1e-9)
+}
+
+/// The evaluation budget of the expected masses of one hemisphere: 2·10⁷ pdf evaluations
+/// (about 2 s of a reference BSDF); past it the masses keep the bound they reached, which the
+/// record reports.
+pub const MASS_BUDGET: u64 = 20_000_000;
+
+/// The masses of the cells of one hemisphere (`lower`: mirrored) of the density `pdf` (step 2),
+/// by globally adaptive cubature to the summed error `target` within [`MASS_BUDGET`]
+/// evaluations ([`expected_mass_global`]).
+pub fn expected_hemisphere(
+    pdf: &SpherePdf<'_>,
+    grid: HemisphereGrid,
+    lower: bool,
+    target: f64,
+) -> Expected {
+    let mirrored = |w: &[Vec3], out: &mut [f64]| {
+        if lower {
+            let m: Vec<Vec3> = w.iter().map(|v| [v[0], v[1], -v[2]]).collect();
+            pdf(&m, out);
+        } else {
+            pdf(w, out);
+        }
+    };
+    let lobe = lobe::measure_with_batch(&mirrored, &lobe::Options::default());
+    let (mut e, _converged) = expected_mass_global(&mirrored, grid, &lobe, target, MASS_BUDGET);
+    e.evaluations += lobe.evaluations;
+    e
+}
+
+/// The expected masses of both hemispheres (upper, lower) of `pdf` on `grid` (step 2), each to
+/// the summed error `target`.
+pub fn expected_sphere(
+    pdf: &SpherePdf<'_>,
+    grid: HemisphereGrid,
+    target: f64,
+) -> (Expected, Expected) {
+    (
+        expected_hemisphere(pdf, grid, false, target),
+        expected_hemisphere(pdf, grid, true, target),
+    )
+}
+
+/// Tests `sample` against `pdf` over the sphere.
+pub fn sphere_chi2(
+    sample: &SphereSampler<'_>,
+    pdf: &SpherePdf<'_>,
+    config: &Chi2Config,
+) -> SphereChi2Result {
+    let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
+    let t = Instant::now();
+    let expected = expected_sphere(pdf, grid, mass_target(config.samples));
+    let integration_seconds = t.elapsed().as_secs_f64();
+    let mut r = sphere_chi2_against(sample, expected, config);
+    r.integration_seconds = integration_seconds;
+    r
+}
+
+/// [`sphere_chi2`] against expected masses already integrated on the grid of
+/// `config.resolution` (by [`expected_sphere`] to [`mass_target`]); `integration_seconds`
+/// of the result is 0.
+pub fn sphere_chi2_against(
+    sample: &SphereSampler<'_>,
+    (expected_upper, expected_lower): (Expected, Expected),
+    config: &Chi2Config,
+) -> SphereChi2Result {
+    let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
+    let t = Instant::now();
+    let observed = observe_sphere(sample, grid, config.samples, config.seed);
+    let sampling_seconds = t.elapsed().as_secs_f64();
+    let integration_seconds = 0.0;
+    let mut result = SphereChi2Result {
+        resolution: grid.rows(),
+        statistic: f64::NAN,
+        dof: 0,
+        p_value: 0.0,
+        alpha: config.alpha,
+        verdict: Verdict::Fail,
+        reason: None,
+        sanity_failure: true,
+        samples: config.samples,
+        seed: config.seed,
+        observed,
+        expected_upper,
+        expected_lower,
+        sampling_seconds,
+        integration_seconds,
+    };
+    if let Some(reason) = sanity(&result) {
+        result.reason = Some(reason);
+        return result;
+    }
+    let observed: Vec<u64> = result
+        .observed
+        .upper
+        .iter()
+        .chain(&result.observed.lower)
+        .copied()
+        .collect();
+    let (statistic, bins, _) = pooled_statistic(&observed, &result.expected_counts());
+    if bins < 2 {
+        result.reason = Some(format!(
+            "only {bins} bin(s) after pooling; more samples or a finer grid are needed"
+        ));
+        return result;
+    }
+    result.sanity_failure = false;
+    result.statistic = statistic;
+    result.dof = bins - 1;
+    result.p_value =
+        statrs::function::gamma::checked_gamma_ur(0.5 * result.dof as f64, 0.5 * statistic)
+            .unwrap_or(f64::NAN);
+    if result.p_value >= config.alpha {
+        result.verdict = Verdict::Pass;
+    } else {
+        result.reason = Some(format!(
+            "p-value {:.3e} below α = {:.3e}",
+            result.p_value, config.alpha
+        ));
+    }
+    result
+}
+
+/// The sanity failures of step 3, in order.
+fn sanity(r: &SphereChi2Result) -> Option<String> {
+    let o = &r.observed;
+    if let Some((index, w)) = o.first_invalid {
+        return Some(format!(
+            "{} sampled directions are non-finite or not of unit length (within {}); the \
+             first, sample {index}: {w:?}",
+            o.invalid,
+            crate::oracle::domain::UNIT_TOLERANCE
+        ));
+    }
+    let masses = r.expected_upper.mass.iter().chain(&r.expected_lower.mass);
+    if let Some((cell, m)) = masses
+        .enumerate()
+        .find(|(_, m)| !(m.is_finite() && **m >= 0.0))
+    {
+        return Some(format!("pdf mass over cell {cell} is {m}"));
+    }
+    let mass = r.mass();
+    if !(mass <= 1.0 + MASS_TOLERANCE + r.mass_error_bound()) {
+        return Some(format!(
+            "the pdf integrates to {mass} (± {:.1e}) over the sphere: more than 1 + {MASS_TOLERANCE}",
+            r.mass_error_bound()
+        ));
+    }
+    if o.binned() == 0 {
+        return Some(format!(
+            "every one of {} samples failed (pdf mass {mass})",
+            r.samples
+        ));
+    }
+    let cells = r.expected_upper.mass.len();
+    let observed = o.upper.iter().chain(&o.lower);
+    let expected = r.expected_upper.mass.iter().chain(&r.expected_lower.mass);
+    observed
+        .zip(expected)
+        .enumerate()
+        .find(|(_, (&n, &m))| m == 0.0 && n > 0)
+        .map(|(c, (&n, _))| {
+            let (side, cell) = if c < cells {
+                ("upper", c)
+            } else {
+                ("lower", c - cells)
+            };
+            format!("{n} samples in cell {cell} of the {side} hemisphere, where the pdf is zero")
+        })
+}
