@@ -1,6 +1,10 @@
 //! The `mfh` command line: parse, call the library, map errors to exit codes.
 
 fn main() {
+    // SIGTERM / SIGINT / SIGHUP end the external children's process groups before mfh exits.
+    if let Err(e) = mfh_harness::cli::signals::install() {
+        eprintln!("mfh: cannot watch for SIGTERM / SIGINT ({e}): a signal may leave children");
+    }
     // Standard output and error are passed unlocked: audit checks run on worker threads, and
     // a panic message or `MFH_TRACE` line printed there must not wait on a lock main holds.
     let code = mfh_harness::cli::run(
@@ -9,5 +13,5 @@ fn main() {
         &mut std::io::stdout(),
         &mut std::io::stderr(),
     );
-    std::process::exit(code);
+    mfh_harness::cli::signals::exit(code);
 }

@@ -7,7 +7,7 @@
 #[path = "external/common.rs"]
 mod common;
 
-use common::{example, require_numpy, root, run};
+use common::{alive, example, require_numpy, root, run, wait_for_pid};
 use mfh_harness::external::{ExternalError, ExternalModel};
 use mfh_reference::model::{NormalSampler, Smith};
 use mfh_reference::ndf::{Beckmann, Ggx};
@@ -153,15 +153,6 @@ fn e_excerpt(text: &str) -> String {
 
 /// What a misbehaviour must produce.
 type Expect = fn(&ExternalError) -> bool;
-
-fn alive(pid: u32) -> bool {
-    std::fs::read_to_string(format!("/proc/{pid}/stat"))
-        .map(|s| {
-            let state = s.rsplit(')').next().unwrap_or("").trim_start();
-            !state.starts_with('Z') && !state.starts_with('X')
-        })
-        .unwrap_or(false)
-}
 
 /// Whether `e` is a malformed answer to the first `d` request whose reason contains `what`.
 fn malformed_d(e: &ExternalError, what: &str) -> bool {
@@ -386,4 +377,57 @@ fn audit_external_cli_bad_input_exits_2() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("--timeout"), "{err}");
     let _ = std::fs::remove_dir_all(out);
+}
+
+/// A child that floods stderr (hundreds of megabytes a second, far more than any pipe holds)
+/// and never answers: the timeout error names the request and quotes the end of the flood, so
+/// the reader kept draining stderr (the child never blocked on it) and kept only its tail.
+#[test]
+fn a_child_flooding_stderr_times_out_quoting_its_stderr_tail() {
+    let marker = "mfh-stderr-flood-marker";
+    let t = Instant::now();
+    // A compound command, so that `sh` stays (keeping stdout open) and `yes` never sees it.
+    let result = start(&format!("while :; do yes {marker}; done >&2"), 1.0);
+    let e = match result {
+        Ok(_) => panic!("a child that never answers described itself"),
+        Err(e) => e,
+    };
+    let text = e.to_string();
+    assert!(
+        matches!(&e, ExternalError::Timeout { request, stderr, .. }
+            if request.starts_with("describe") && stderr.contains(marker)),
+        "{}",
+        e_excerpt(&text)
+    );
+    assert!(
+        text.contains("no answer within 1 s"),
+        "{}",
+        e_excerpt(&text)
+    );
+    // The quote is bounded whatever the child wrote.
+    assert!(text.len() < 4096, "{} bytes", text.len());
+    assert!(t.elapsed() < Duration::from_secs(10), "{:?}", t.elapsed());
+}
+
+/// Dropping a model ends its child's whole process group: here a `sleep` that the command
+/// started beside the (well-behaved) child, and that nothing else would end.
+#[test]
+fn dropping_a_model_ends_its_childs_process_group() {
+    let pid_file = std::env::temp_dir().join(format!("mfh-drop-group-{}.pid", std::process::id()));
+    let _ = std::fs::remove_file(&pid_file);
+    let cmd = format!(
+        "sleep 1000 & echo $! > '{}'; exec {}",
+        pid_file.display(),
+        example("ggx.py", "")
+    );
+    let model = start(&cmd, 30.0).unwrap_or_else(|e| panic!("{e}"));
+    let pid = wait_for_pid(&pid_file, Duration::from_secs(10));
+    assert!(alive(pid), "the sleep {pid} did not start");
+    drop(model);
+    let t = Instant::now();
+    while alive(pid) && t.elapsed() < Duration::from_secs(5) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let _ = std::fs::remove_file(&pid_file);
+    assert!(!alive(pid), "the sleep {pid} outlived the dropped model");
 }

@@ -13,6 +13,7 @@ pub mod external;
 pub mod plan;
 pub mod progress;
 pub mod selftest;
+pub mod signals;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::ffi::OsString;

@@ -2,9 +2,11 @@
 //! (JSON lines over stdin / stdout, [`protocol`]) is one more implementation of the capability
 //! traits ([`model::ExternalModel`]), audited by [`crate::audit::Audit`] like a Rust model.
 
+pub mod group;
 pub mod model;
 pub mod process;
 pub mod protocol;
+pub mod stderr_tail;
 
 pub use model::ExternalModel;
 pub use process::{ExternalError, DEFAULT_TIMEOUT_SECONDS};

@@ -1,16 +1,19 @@
-//! The child process: started with `sh -c`, spoken to by JSON lines (in the protocol version
-//! it chose at `describe`), read with a timeout, killed and reaped on drop.
+//! The child process: started with `sh -c` in a process group of its own, spoken to by JSON
+//! lines (in the protocol version it chose at `describe`), read with a timeout; its group is
+//! ended (SIGTERM, then SIGKILL) and it is reaped after an error and on drop.
 //!
 //! Reading stdout with a timeout needs a reader thread and a channel (std has no timed read on
 //! a pipe); writing goes through a writer thread too, so that a child that stops reading its
-//! stdin cannot block mfh on a full pipe. Both threads end when the child's pipes close, which
-//! killing the child guarantees.
+//! stdin cannot block mfh on a full pipe, and stderr is drained by a third
+//! ([`super::stderr_tail`]). The threads end when the child's pipes close, which ending its
+//! group guarantees.
 
+use super::group::{self, Group};
 use super::protocol::{quote_non_finite, Answer, Description, Request, VERSIONS};
+use super::stderr_tail::Drain;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
-use std::sync::{Arc, Mutex};
 use std::thread;
 use std::time::Duration;
 
@@ -22,9 +25,6 @@ pub const DEFAULT_TIMEOUT_SECONDS: f64 = 10.0;
 /// the memory one answer takes (the line, then its decoded numbers, ≤ 3/4 of it in version 2).
 /// A batch of 65 536 directions is ≈ 4 MB as version-1 text, 2.1 MB as version-2 base64.
 pub const MAX_LINE_BYTES: u64 = 64 << 20;
-
-/// How much of the child's stderr is kept for error messages (bytes, the last ones).
-const STDERR_TAIL_BYTES: usize = 2000;
 
 /// What went wrong talking to the child; each names the request and what came back.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -38,13 +38,16 @@ pub enum ExternalError {
         reason: String,
     },
     /// No answer within the timeout.
-    #[error("request {request}: no answer within {seconds} s (the child was killed){stderr}")]
+    #[error(
+        "request {request}: no answer within {seconds} s (the child's process group was \
+         ended){stderr}"
+    )]
     Timeout {
         /// The request (op, id, items).
         request: String,
         /// The timeout.
         seconds: f64,
-        /// The tail of the child's stderr.
+        /// The tail of the child's stderr ("; its stderr ends: …", or empty).
         stderr: String,
     },
     /// The child exited (or closed stdout) before answering.
@@ -117,9 +120,10 @@ enum Line {
 pub struct Session {
     command: String,
     child: Child,
+    group: Group,
     to_child: Option<Sender<Vec<u8>>>,
     lines: Receiver<Line>,
-    stderr: Arc<Mutex<Vec<u8>>>,
+    stderr: Drain,
     timeout: Duration,
     next_id: u64,
     failed: bool,
@@ -127,14 +131,12 @@ pub struct Session {
 }
 
 impl Session {
-    /// Starts `command` with `sh -c`, its stdin and stdout piped, its stderr captured (the last
-    /// bytes are quoted in errors).
+    /// Starts `command` with `sh -c` in a process group of its own, its stdin and stdout piped,
+    /// its stderr drained (the last lines are quoted in errors).
     pub fn start(command: &str, timeout: Duration) -> Result<Self, ExternalError> {
         let mut builder = Command::new("sh");
         builder.arg("-c").arg(command);
-        // Its own process group, so that killing it also ends what `sh -c` started.
-        #[cfg(unix)]
-        std::os::unix::process::CommandExt::process_group(&mut builder, 0);
+        group::own_group(&mut builder);
         let mut child = builder
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
@@ -144,19 +146,24 @@ impl Session {
                 command: command.to_string(),
                 reason: e.to_string(),
             })?;
-        let stdin = child.stdin.take().expect("piped");
-        let stdout = child.stdout.take().expect("piped");
-        let stderr_pipe = child.stderr.take().expect("piped");
+        let mut group = Group::of(&child);
+        let pipes = (child.stdin.take(), child.stdout.take(), child.stderr.take());
+        let (Some(stdin), Some(stdout), Some(stderr_pipe)) = pipes else {
+            group.end(&mut child);
+            return Err(ExternalError::Spawn {
+                command: command.to_string(),
+                reason: "its standard streams were not piped".to_string(),
+            });
+        };
         let (tx_line, lines) = mpsc::channel();
         thread::spawn(move || read_lines(stdout, tx_line));
         let (to_child, rx_write) = mpsc::channel::<Vec<u8>>();
         thread::spawn(move || write_lines(stdin, rx_write));
-        let stderr = Arc::new(Mutex::new(Vec::new()));
-        let tail = stderr.clone();
-        thread::spawn(move || keep_tail(stderr_pipe, tail));
+        let stderr = Drain::start(stderr_pipe);
         Ok(Self {
             command: command.to_string(),
             child,
+            group,
             to_child: Some(to_child),
             lines,
             stderr,
@@ -261,7 +268,7 @@ impl Session {
                 return Err(ExternalError::Timeout {
                     request: label.to_string(),
                     seconds: self.timeout.as_secs_f64(),
-                    stderr: self.stderr_tail(),
+                    stderr: self.stderr.quote(),
                 });
             }
         };
@@ -310,39 +317,18 @@ impl Session {
         ExternalError::Exited {
             request: label.to_string(),
             status,
-            stderr: self.stderr_tail(),
+            stderr: self.stderr.quote(),
         }
     }
 
-    fn stderr_tail(&self) -> String {
-        // Give the stderr thread a moment to collect the child's last words.
-        thread::sleep(Duration::from_millis(20));
-        let tail = self.stderr.lock().map(|t| t.clone()).unwrap_or_default();
-        let text = String::from_utf8_lossy(&tail).trim().to_string();
-        if text.is_empty() {
-            String::new()
-        } else {
-            format!("; its stderr ends: {text}")
-        }
-    }
-
+    /// Closes the child's stdin and ends its process group (what it started too); reaps it.
     fn kill(&mut self) {
         self.to_child = None;
-        if let Ok(None) = self.child.try_wait() {
-            // std has no killpg: the `kill` utility ends the whole group (the shell's children).
-            #[cfg(unix)]
-            let _ = Command::new("kill")
-                .args(["-KILL", "--", &format!("-{}", self.child.id())])
-                .stdin(Stdio::null())
-                .stdout(Stdio::null())
-                .stderr(Stdio::null())
-                .status();
-        }
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        self.group.end(&mut self.child);
     }
 
-    /// Asks the child to exit, waits up to the timeout, then kills it; reaps it in any case.
+    /// Asks the child to exit, waits up to the timeout (at most 2 s), then ends its process
+    /// group (what it left running too); reaps it in any case.
     pub fn shutdown(&mut self) {
         if !self.failed {
             if let Some(tx) = &self.to_child {
@@ -357,7 +343,7 @@ impl Session {
         let deadline = std::time::Instant::now() + self.timeout.min(Duration::from_secs(2));
         while std::time::Instant::now() < deadline {
             if let Ok(Some(_)) = self.child.try_wait() {
-                return;
+                break;
             }
             thread::sleep(Duration::from_millis(5));
         }
@@ -402,20 +388,6 @@ fn write_lines(mut stdin: ChildStdin, rx: Receiver<Vec<u8>>) {
     for bytes in rx {
         if stdin.write_all(&bytes).and_then(|_| stdin.flush()).is_err() {
             return;
-        }
-    }
-}
-
-fn keep_tail(mut pipe: impl Read, tail: Arc<Mutex<Vec<u8>>>) {
-    let mut buf = [0u8; 4096];
-    while let Ok(n) = pipe.read(&mut buf) {
-        if n == 0 {
-            return;
-        }
-        if let Ok(mut t) = tail.lock() {
-            t.extend_from_slice(&buf[..n]);
-            let excess = t.len().saturating_sub(STDERR_TAIL_BYTES);
-            t.drain(..excess);
         }
     }
 }

@@ -6,6 +6,7 @@
 #![allow(dead_code)] // each test file uses its own subset
 
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 /// The repository root.
 pub fn root() -> PathBuf {
@@ -40,4 +41,34 @@ pub fn require_numpy() {
         "numpy is missing (CI=true, or it was removed since the build): .ci/run installs it \
          (python3 -m pip install numpy)"
     );
+}
+
+/// Whether process `pid` is running (a zombie is not: it has ended, only its parent has not
+/// reaped it yet).
+pub fn alive(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .map(|s| {
+            let state = s.rsplit(')').next().unwrap_or("").trim_start();
+            !state.starts_with('Z') && !state.starts_with('X')
+        })
+        .unwrap_or(false)
+}
+
+/// The pid a child wrote into `file` (`echo $! > file`), waiting up to `limit` for it.
+pub fn wait_for_pid(file: &Path, limit: Duration) -> u32 {
+    let t = Instant::now();
+    loop {
+        if let Some(pid) = std::fs::read_to_string(file)
+            .ok()
+            .and_then(|s| s.trim().parse().ok())
+        {
+            return pid;
+        }
+        assert!(
+            t.elapsed() < limit,
+            "no pid in {} after {limit:?}",
+            file.display()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
