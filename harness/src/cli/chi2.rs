@@ -245,50 +245,52 @@ fn report(
         }
     }
     let artefacts: Vec<String> = artefacts.iter().map(|p| p.display().to_string()).collect();
-    let written = if args.json {
-        record["artefacts"] = serde_json::json!(artefacts);
-        writeln!(stdout, "{record}")
-    } else {
-        let r = result;
-        let reason = r.reason.as_ref().map(|r| r.to_string());
-        writeln!(
-            stdout,
-            "model {spec_text}\n\
+    let written = super::write_stdout("chi2", stdout, stderr, |stdout| {
+        if args.json {
+            record["artefacts"] = serde_json::json!(artefacts);
+            writeln!(stdout, "{record}")
+        } else {
+            let r = result;
+            let reason = r.reason.as_ref().map(|r| r.to_string());
+            writeln!(
+                stdout,
+                "model {spec_text}\n\
              grid {} φ × {} cos θ cells, {} samples, seed {}\n\
              statistic {:.4}, dof {}, p-value {:.6e}, pooled cells {}\n\
              expected mass {:.12} (cubature error bound {:.2e} counts)\n\
              sampling+binning {:.3e} samples/s ({:.3} s), expected-count integration {:.3} s\n\
              verdict {} at α = {:e}{}\n{}\
              reproduce: {}",
-            2 * r.resolution,
-            r.resolution,
-            r.samples,
-            r.seed,
-            r.statistic,
-            r.dof,
-            r.p_value,
-            r.pooled_cells,
-            r.expected_mass,
-            r.expected_error_bound,
-            r.samples_per_second(),
-            r.sampling_seconds,
-            r.integration_seconds,
-            if r.verdict == Verdict::Pass {
-                "pass"
-            } else {
-                "FAIL"
-            },
-            r.alpha,
-            reason.map(|r| format!(": {r}")).unwrap_or_default(),
-            artefacts
-                .iter()
-                .map(|a| format!("wrote {a}\n"))
-                .collect::<String>(),
-            reproduce,
-        )
-    };
-    if let Err(e) = written.and_then(|_| stdout.flush()) {
-        return bad(stderr, format!("cannot write output: {e}"));
+                2 * r.resolution,
+                r.resolution,
+                r.samples,
+                r.seed,
+                r.statistic,
+                r.dof,
+                r.p_value,
+                r.pooled_cells,
+                r.expected_mass,
+                r.expected_error_bound,
+                r.samples_per_second(),
+                r.sampling_seconds,
+                r.integration_seconds,
+                if r.verdict == Verdict::Pass {
+                    "pass"
+                } else {
+                    "FAIL"
+                },
+                r.alpha,
+                reason.map(|r| format!(": {r}")).unwrap_or_default(),
+                artefacts
+                    .iter()
+                    .map(|a| format!("wrote {a}\n"))
+                    .collect::<String>(),
+                reproduce,
+            )
+        }
+    });
+    if let Err(code) = written {
+        return code;
     }
     match result.verdict {
         Verdict::Pass => EXIT_PASS,

@@ -88,13 +88,18 @@ pub fn run(args: ExternalArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
             return EXIT_BAD_INPUT;
         }
     };
-    if args.json {
-        let _ = writeln!(stdout, "{}", crate::report::json::to_string(&report));
-    } else {
-        let _ = write!(stdout, "{}", crate::report::terminal::render(&report, 20));
-        for p in written {
-            let _ = writeln!(stdout, "wrote {}", p.display());
+    let printed = super::write_stdout("audit-external", stdout, stderr, |stdout| {
+        if args.json {
+            return writeln!(stdout, "{}", crate::report::json::to_string(&report));
         }
+        write!(stdout, "{}", crate::report::terminal::render(&report, 20))?;
+        for p in written {
+            writeln!(stdout, "wrote {}", p.display())?;
+        }
+        Ok(())
+    });
+    if let Err(code) = printed {
+        return code;
     }
     if report.passed() {
         EXIT_PASS
