@@ -27,7 +27,7 @@ pub struct Chi2Args {
     /// Samples to draw: at least 5 per cell of the grid (10·R²), at most 2^32.
     #[arg(long, default_value_t = 1_000_000)]
     pub samples: u64,
-    /// Grid resolution R: R cos θ-rows × 2R φ-columns, 1 ≤ R ≤ 512.
+    /// Grid resolution R: R cos θ-rows × 2R φ-columns, 2 ≤ R ≤ 512.
     #[arg(long, default_value_t = 32)]
     pub resolution: usize,
     /// Seed of the random streams (default: MFH_SEED, else a fixed seed).
@@ -504,6 +504,51 @@ mod tests {
         let (code, _, err) = run_args(&["chi2", "--model", ggx, "--samples", "1e15"]);
         assert_eq!(code, 2);
         assert!(err.contains("--samples"), "{err}");
+    }
+
+    /// Issue 27: `--resolution 1 --samples 10` reported a correct sampler as FAIL (χ² NaN,
+    /// dof 0); too few cells or samples for a degree of freedom are bad input, exit 2, naming
+    /// the option and its limit. The least accepted run has degrees of freedom and passes.
+    #[test]
+    fn chi2_cli_refuses_a_grid_or_sample_count_without_degrees_of_freedom() {
+        let ggx = r#"{"family":"ggx","alpha":0.3}"#;
+        for (args, names) in [
+            (
+                vec!["--resolution", "1", "--samples", "10"],
+                vec!["--resolution", "[2, 512]"],
+            ),
+            (
+                vec!["--resolution", "2", "--samples", "10"],
+                vec!["--samples", "at least 40"],
+            ),
+            (
+                vec!["--resolution", "2", "--samples", "39"],
+                vec!["--samples", "at least 40"],
+            ),
+        ] {
+            let mut all = vec!["chi2", "--model", ggx, "--json"];
+            all.extend(args.iter().copied());
+            let (code, out, err) = run_args(&all);
+            assert_eq!(code, 2, "{args:?}: {out}{err}");
+            assert!(out.is_empty(), "{args:?}: {out}");
+            for n in names {
+                assert!(err.contains(n), "{args:?}: {err:?} lacks {n:?}");
+            }
+        }
+        let (code, out, err) = run_args(&[
+            "chi2",
+            "--model",
+            ggx,
+            "--json",
+            "--resolution",
+            "2",
+            "--samples",
+            "40",
+        ]);
+        assert_eq!(code, 0, "{out}{err}");
+        let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+        assert!(v["dof"].as_u64().unwrap() >= 1, "{v}");
+        assert!(v["statistic"].is_number(), "{v}");
     }
 
     #[test]
