@@ -69,15 +69,28 @@ pub struct MergeArgs {
 /// Runs `mfh merge`; returns the exit status (0 pass, 1 a check failed, 2 bad input).
 pub fn run_merge(args: MergeArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32 {
     match crate::merge::merge_dirs(&args.dirs) {
-        Ok(report) => finish_report(
-            &report,
-            &args.out,
-            args.json,
-            &args.baseline,
-            "merge",
-            stdout,
-            stderr,
-        ),
+        Ok(merged) => {
+            if !merged.corrected.is_empty() {
+                let _ = writeln!(
+                    stderr,
+                    "mfh merge: corrected {} stored verdict(s) that their records' numbers \
+                     contradict:",
+                    merged.corrected.len()
+                );
+                for line in &merged.corrected {
+                    let _ = writeln!(stderr, "  {line}");
+                }
+            }
+            finish_report(
+                &merged.report,
+                &args.out,
+                args.json,
+                &args.baseline,
+                "merge",
+                stdout,
+                stderr,
+            )
+        }
         Err(e) => {
             let _ = writeln!(stderr, "mfh merge: {e}");
             EXIT_BAD_INPUT
