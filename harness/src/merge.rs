@@ -4,11 +4,17 @@
 //! that the merged `report.json` equals the unsharded run's, timings aside (the merged wall
 //! time is the longest shard's: the shards ran in parallel).
 //!
+//! Every stored verdict is re-judged from the record's own numbers (measured error, tolerance,
+//! oracle uncertainty: [`CheckRecord::verdict_contradicts_measurement`], the rule
+//! `check::compare` passes by): a shard's report is a file anyone can edit, and a record that
+//! claims pass at an error of 1.0 against a tolerance of 1e-10 merges as the failure it is. The
+//! corrections are listed ([`Merged::corrected`]) for the CLI to print.
+//!
 //! Refused, with the shard folder named: a missing or duplicated shard, shards of different
 //! plans (fingerprint), seeds, profiles, scenes or mfh versions, another schema version.
 
 use crate::readback::{read_report, ReadError};
-use crate::record::{CheckRecord, SCHEMA_VERSION};
+use crate::record::{CheckRecord, Verdict, SCHEMA_VERSION};
 use crate::run::{judge_statistical, summarize, AuditReport};
 use crate::shard::{ShardInfo, SHARD_FILE};
 use std::path::{Path, PathBuf};
@@ -41,6 +47,36 @@ pub struct ShardReport {
     pub report: AuditReport,
     /// Its `shard.json`.
     pub info: ShardInfo,
+}
+
+/// The merged report and the stored verdicts merge corrected.
+#[derive(Debug, Clone)]
+pub struct Merged {
+    /// The unsharded report.
+    pub report: AuditReport,
+    /// One line per record whose stored verdict its numbers contradicted (now `fail`): the
+    /// shard folder, the plan index, the check, the stored verdict and the numbers.
+    pub corrected: Vec<String>,
+}
+
+/// Re-judges a record read from `dir` at plan index `index`: a verdict its numbers contradict
+/// becomes `fail`; returns the line that says so.
+fn rejudge(record: &mut CheckRecord, dir: &Path, index: usize) -> Option<String> {
+    if !record.verdict_contradicts_measurement() {
+        return None;
+    }
+    let error = record.measured.and_then(|m| m.error()).unwrap_or(f64::NAN);
+    let tolerance = record.tolerance.as_ref().map_or(f64::NAN, |t| t.value);
+    let slack = crate::record::allowed_error(0.0, record.oracle.as_ref());
+    let line = format!(
+        "{}: plan index {index} ({}): stored verdict {} contradicts measured error {error:e} \
+         against tolerance {tolerance:e} + oracle slack {slack:e}; re-judged as fail",
+        dir.display(),
+        record.check,
+        record.verdict.name(),
+    );
+    record.verdict = Verdict::Fail;
+    Some(line)
 }
 
 /// Reads `dir/report.json` and `dir/shard.json`.
@@ -78,8 +114,8 @@ pub fn read_shard(dir: &Path) -> Result<ShardReport, MergeError> {
     })
 }
 
-/// Merges shard reports (any order) into the unsharded report.
-pub fn merge(shards: Vec<ShardReport>) -> Result<AuditReport, MergeError> {
+/// Merges shard reports (any order) into the unsharded report, re-judging every stored verdict.
+pub fn merge(shards: Vec<ShardReport>) -> Result<Merged, MergeError> {
     let bad = |m: String| Err(MergeError::Inconsistent(m));
     let Some(first) = shards.first() else {
         return bad("no shard folders given".to_string());
@@ -162,11 +198,16 @@ pub fn merge(shards: Vec<ShardReport>) -> Result<AuditReport, MergeError> {
     }
     let mut slots: Vec<Option<CheckRecord>> = vec![None; plan_checks];
     let mut wall: f64 = 0.0;
+    let mut corrected = Vec::new();
     for s in &shards {
         wall = wall.max(s.report.summary.wall_seconds);
         for (&i, r) in s.info.indices.iter().zip(&s.report.records) {
             match slots.get_mut(i) {
-                Some(slot @ None) => *slot = Some(r.clone()),
+                Some(slot @ None) => {
+                    let mut r = r.clone();
+                    corrected.extend(rejudge(&mut r, &s.dir, i));
+                    *slot = Some(r);
+                }
                 _ => {
                     return bad(format!(
                         "{}: plan index {i} is out of range or run by two shards",
@@ -186,7 +227,7 @@ pub fn merge(shards: Vec<ShardReport>) -> Result<AuditReport, MergeError> {
     let statistical = judge_statistical(&mut records);
     let summary = summarize(&records, statistical, wall);
     let first = &shards[0];
-    Ok(AuditReport {
+    let report = AuditReport {
         schema_version: SCHEMA_VERSION,
         mfh_version: first.report.mfh_version,
         scene: first.report.scene.clone(),
@@ -196,11 +237,12 @@ pub fn merge(shards: Vec<ShardReport>) -> Result<AuditReport, MergeError> {
         summary,
         records,
         not_audited: first.report.not_audited.clone(),
-    })
+    };
+    Ok(Merged { report, corrected })
 }
 
 /// Reads and merges shard folders.
-pub fn merge_dirs(dirs: &[PathBuf]) -> Result<AuditReport, MergeError> {
+pub fn merge_dirs(dirs: &[PathBuf]) -> Result<Merged, MergeError> {
     let shards = dirs
         .iter()
         .map(|d| read_shard(d))

@@ -292,6 +292,47 @@ impl CheckRecord {
     pub fn is_statistical(&self) -> bool {
         matches!(self.measured, Some(Measured::PValue { .. }))
     }
+
+    /// Whether the measured error meets the tolerance: an absolute or relative error within
+    /// [`allowed_error`] (the tolerance plus the oracle's own error bound), a rate within the
+    /// tolerance of its expected exponent. A NaN error does not meet it. `None` where there is
+    /// no error and tolerance to judge: nothing measured, or a p-value (judged at the audit's
+    /// level by `run::judge_statistical`). This is the pass rule of `check::compare`, which
+    /// calls it, and what `mfh merge` re-judges stored verdicts by.
+    pub fn meets_tolerance(&self) -> Option<bool> {
+        let tolerance = self.tolerance.as_ref()?;
+        Some(match self.measured? {
+            Measured::Absolute { error } | Measured::Relative { error } => {
+                error <= allowed_error(tolerance.value, self.oracle.as_ref())
+            }
+            Measured::Rate { exponent, expected } => (exponent - expected).abs() <= tolerance.value,
+            Measured::PValue { .. } => return None,
+        })
+    }
+
+    /// Whether the stored verdict contradicts the record's own numbers
+    /// ([`CheckRecord::meets_tolerance`]): a pass or a skip whose measured error exceeds the
+    /// tolerance plus the oracle's slack (a failure called something else), or an expected
+    /// failure whose error is within it (nothing failed). A failure, an unexpected pass and an
+    /// error fail the audit whatever the numbers say, and a record without an error and
+    /// tolerance has nothing to contradict.
+    pub fn verdict_contradicts_measurement(&self) -> bool {
+        let Some(meets) = self.meets_tolerance() else {
+            return false;
+        };
+        match self.verdict {
+            Verdict::Pass | Verdict::Skipped { .. } => !meets,
+            Verdict::ExpectedFailure { .. } => meets,
+            Verdict::Fail | Verdict::UnexpectedPass { .. } | Verdict::Error { .. } => false,
+        }
+    }
+}
+
+/// The error a comparison with `oracle` may show and pass: `tolerance` plus the oracle's error
+/// bound relative to its value, |(o + u) − o| / |o| (absolute where o = 0). NaN when the oracle
+/// value is not finite, so that nothing passes against it.
+pub fn allowed_error(tolerance: f64, oracle: Option<&OracleValue>) -> f64 {
+    tolerance + oracle.map_or(0.0, |o| relative_error(o.value + o.uncertainty, o.value))
 }
 
 /// The relative difference |a − b| / |b| (absolute where b = 0).
@@ -300,5 +341,58 @@ pub fn relative_error(a: f64, b: f64) -> f64 {
         a.abs()
     } else {
         ((a - b) / b).abs()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A record measuring `error` against `tolerance` with an oracle of value 2 and error bound
+    /// `bound` (slack bound/2), its verdict `verdict`.
+    fn record(error: f64, tolerance: f64, bound: f64, verdict: Verdict) -> CheckRecord {
+        let mut r = CheckRecord::new("x.y", Value::Null, Value::Null, "");
+        r.oracle = Some(OracleValue {
+            value: 2.0,
+            uncertainty: bound,
+            kind: "error_bound",
+        });
+        r.measured = Some(Measured::Relative { error });
+        r.tolerance = Some(AppliedTolerance {
+            name: "t",
+            value: tolerance,
+            reason: "r",
+        });
+        r.verdict = verdict;
+        r
+    }
+
+    /// The rule merge re-judges by: the tolerance plus the oracle's relative bound.
+    #[test]
+    fn a_verdict_is_judged_by_its_error_tolerance_and_oracle_slack() {
+        assert_eq!(
+            record(1.0, 1e-10, 0.0, Verdict::Pass).meets_tolerance(),
+            Some(false)
+        );
+        assert!(record(1.0, 1e-10, 0.0, Verdict::Pass).verdict_contradicts_measurement());
+        // 1.5e-10 ≤ 1e-10 + 2e-10/2: within the oracle's slack.
+        assert!(!record(1.5e-10, 1e-10, 2e-10, Verdict::Pass).verdict_contradicts_measurement());
+        assert!(record(f64::NAN, 1e-10, 0.0, Verdict::Pass).verdict_contradicts_measurement());
+        let skipped = Verdict::Skipped { reason: "s".into() };
+        assert!(record(1.0, 1e-10, 0.0, skipped.clone()).verdict_contradicts_measurement());
+        assert!(!record(0.0, 1e-10, 0.0, skipped).verdict_contradicts_measurement());
+        let expected = Verdict::ExpectedFailure { reason: "e".into() };
+        assert!(record(0.0, 1e-10, 0.0, expected.clone()).verdict_contradicts_measurement());
+        assert!(!record(1.0, 1e-10, 0.0, expected).verdict_contradicts_measurement());
+        // A failure stays one whatever its numbers; p-values are judge_statistical's.
+        assert!(!record(0.0, 1e-10, 0.0, Verdict::Fail).verdict_contradicts_measurement());
+        let mut p = record(0.0, 1e-4, 0.0, Verdict::Pass);
+        p.measured = Some(Measured::PValue {
+            p: 0.0,
+            statistic: 1.0,
+            dof: 1,
+            alpha: 1e-4,
+        });
+        assert_eq!(p.meets_tolerance(), None);
     }
 }

@@ -22,9 +22,21 @@ pub const MAX_RESOLUTION: usize = 512;
 /// measured ≈ 10⁷ samples/s per core (GGX, 2 cores) the run is bounded by ≈ 4 minutes.
 pub const MAX_SAMPLES: u64 = 1 << 32;
 
-/// The smallest useful sample count for a grid of `cells` cells: [`MIN_EXPECTED`] samples per
-/// cell on average. Below it most cells are pooled and the statistic has (almost) no degrees
-/// of freedom, so a run would report a meaningless FAIL (χ² NaN) instead of a verdict.
+/// The smallest grid resolution R. The statistic has dof = bins − 1 and needs two bins of
+/// expected count ≥ [`MIN_EXPECTED`] (cells below it are pooled). At R = 1 the grid is two
+/// φ-halves: both must expect ≥ 5, which at the least sample count 10 is an exact equality that
+/// the cubature's round-off breaks (4.999… pools both cells into one bin: issue 27 measured
+/// `--resolution 1 --samples 10` on GGX as FAIL with χ² NaN and dof 0). R = 2 gives 8 cells,
+/// 4 of them (one per φ-quarter) in the upper cos θ-row where every reference lobe peaks.
+pub const MIN_RESOLUTION: usize = 2;
+
+/// The smallest useful sample count at resolution R: [`MIN_EXPECTED`] samples per cell on
+/// average over the 2R² cells, N ≥ MIN_EXPECTED · 2R² (= 10R²; 40 at R = 2). Derivation: a pdf
+/// spread evenly over the cells expects N/2R² per cell, so below this N no cell of an even pdf
+/// reaches the pooling minimum and every cell is pooled into one bin (dof 0, χ² NaN: a
+/// meaningless FAIL instead of a verdict); with R ≥ [`MIN_RESOLUTION`] it also exceeds the
+/// 2·MIN_EXPECTED = 10 that two bins need whatever the pdf. (No N gives every pdf a degree of
+/// freedom: a lobe inside one cell has none at any N.)
 pub fn min_samples(resolution: usize) -> u64 {
     let cells = 2 * (resolution as u64) * (resolution as u64);
     (MIN_EXPECTED as u64) * cells
@@ -139,13 +151,14 @@ pub fn validate(request: &Chi2Request) -> Result<Chi2Plan, Chi2InputError> {
         .build()
         .map_err(|e| Chi2InputError::Model(format!("invalid model parameters: {e}")))?;
     let r = request.resolution;
-    if !(1..=MAX_RESOLUTION).contains(&r) {
+    if !(MIN_RESOLUTION..=MAX_RESOLUTION).contains(&r) {
         return Err(out_of_range(
             "--resolution",
             r,
             format!(
-                "must be in [1, {MAX_RESOLUTION}] (2R² cells of 16 bytes each and an \
-                 integration time growing as R²)"
+                "must be in [{MIN_RESOLUTION}, {MAX_RESOLUTION}] (at least {MIN_RESOLUTION} for \
+                 two bins of {MIN_EXPECTED} expected counts, one degree of freedom; at most \
+                 2R² cells of 16 bytes each and an integration time growing as R²)"
             ),
         ));
     }

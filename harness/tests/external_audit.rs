@@ -240,3 +240,40 @@ fn chi2_cmd_without_the_capability_is_bad_input() {
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("sample_wm_visible"), "{stderr}");
 }
+
+/// Issue 27: a malformed or invalid `--against` is bad input found before anything runs: exit
+/// 2 at once, naming `--against`, and the child is never started (its command would create a
+/// marker file).
+#[test]
+fn a_bad_against_spec_is_refused_before_the_child_starts() {
+    let marker = temp("against-marker");
+    let _ = std::fs::remove_file(&marker);
+    let cmd = format!("touch {}", marker.display());
+    let out = temp("against-out");
+    for against in [
+        "not json",
+        r#"{"family":"ggx","alpha":-1}"#,
+        r#"{"family":"nope"}"#,
+    ] {
+        let t = Instant::now();
+        let (code, stdout, stderr) = run(&[
+            "audit-external",
+            "--cmd",
+            &cmd,
+            "--against",
+            against,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{against}: {stdout}{stderr}");
+        assert!(stderr.contains("--against"), "{against}: {stderr}");
+        assert!(stdout.is_empty(), "{against}: {stdout}");
+        assert!(
+            t.elapsed().as_secs_f64() < 1.0,
+            "{against}: {:?}",
+            t.elapsed()
+        );
+        assert!(!marker.exists(), "{against}: the child was started");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -338,7 +338,9 @@ fn chi2_requests_validate_within_the_stated_limits() {
                 match sampler_chi2::validate(&r) {
                     Ok(plan) => {
                         let c = &plan.config;
-                        prop_assert!((1..=MAX_RESOLUTION).contains(&c.resolution));
+                        prop_assert!(
+                            (sampler_chi2::MIN_RESOLUTION..=MAX_RESOLUTION).contains(&c.resolution)
+                        );
                         prop_assert!(c.samples <= MAX_SAMPLES);
                         prop_assert!(c.samples >= sampler_chi2::min_samples(c.resolution));
                         prop_assert!(c.alpha > 0.0 && c.alpha < 1.0);

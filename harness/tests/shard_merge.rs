@@ -247,3 +247,78 @@ fn sharded_then_merged_equals_unsharded_for_1_3_7_shards() {
     assert_eq!(c, 1, "{text}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 27: merge re-judges every stored verdict from the record's numbers. A shard whose
+/// passing record was edited to a measured error of 1.0 against a tolerance of 1e-10 (a failure
+/// with its verdict left at pass) merges as a fail, exit 1, and merge says how many verdicts it
+/// corrected; the unedited shard merges with no correction.
+#[test]
+fn merge_rejudges_a_verdict_its_numbers_contradict() {
+    let dir = temp("rejudge");
+    let scene = dir.join("scene.json");
+    std::fs::write(
+        &scene,
+        r#"{"name": "tiny", "materials": [{"name": "a", "model": {"family": "ggx", "alpha": 0.3}}]}"#,
+    )
+    .unwrap();
+    let shard = dir.join("shard");
+    let (code, text) = mfh(&[
+        "audit",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--profile",
+        "ci",
+        "--seed",
+        "5",
+        "--shard",
+        "1/1",
+        "--quiet",
+        "--out",
+        shard.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{text}");
+    let merged = dir.join("merged");
+    let (code, text) = mfh(&[
+        "merge",
+        shard.to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{text}");
+    assert!(!text.contains("corrected"), "{text}");
+
+    let path = shard.join("report.json");
+    let mut v = read(&path);
+    let records = v["records"].as_array_mut().unwrap();
+    let (index, r) = records
+        .iter_mut()
+        .enumerate()
+        .find(|(_, r)| r["verdict"] == "pass" && r["measured"]["error"].is_number())
+        .expect("a passing record with a measured error");
+    r["measured"]["error"] = Value::from(1.0);
+    r["tolerance"]["value"] = Value::from(1e-10);
+    let check = r["check"].as_str().unwrap().to_string();
+    std::fs::write(&path, v.to_string()).unwrap();
+    let (code, text) = mfh(&[
+        "merge",
+        shard.to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{text}");
+    assert!(text.contains("corrected 1 stored verdict(s)"), "{text}");
+    assert!(
+        text.contains(&format!(
+            "plan index {index} ({check}): stored verdict pass"
+        )),
+        "{text}"
+    );
+    let report = read(&merged.join("report.json"));
+    assert_eq!(report["records"][index]["verdict"], "fail");
+    assert_eq!(
+        report["summary"]["counts"]["fail"], 1,
+        "{}",
+        report["summary"]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -195,7 +195,7 @@ impl std::fmt::Debug for PlannedCheck<'_> {
 
 /// Fills `record` with the comparison of `value` against the oracle's estimate: relative error
 /// (absolute where the oracle is 0), pass when it is within `tolerance` plus the oracle's own
-/// relative error bound.
+/// relative error bound ([`CheckRecord::meets_tolerance`]).
 pub fn compare(record: &mut CheckRecord, value: f64, oracle: Estimate, tolerance: &Tolerance) {
     record.value = Some(value);
     record.oracle = Some(OracleValue {
@@ -205,16 +205,16 @@ pub fn compare(record: &mut CheckRecord, value: f64, oracle: Estimate, tolerance
     });
     record.cost.evaluations += oracle.evaluations;
     let error = relative_error(value, oracle.value);
-    let allowed = tolerance.value + relative_error(oracle.value + oracle.error_bound, oracle.value);
     record.measured = Some(if oracle.value == 0.0 {
         Measured::Absolute { error }
     } else {
         Measured::Relative { error }
     });
     record.tolerance = Some(applied(tolerance));
+    // The rule `mfh merge` re-judges stored verdicts by: one function for both.
     record.verdict = if !value.is_finite() || !oracle.value.is_finite() {
         Verdict::Fail
-    } else if error <= allowed {
+    } else if record.meets_tolerance() == Some(true) {
         Verdict::Pass
     } else {
         Verdict::Fail

@@ -69,15 +69,28 @@ pub struct MergeArgs {
 /// Runs `mfh merge`; returns the exit status (0 pass, 1 a check failed, 2 bad input).
 pub fn run_merge(args: MergeArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32 {
     match crate::merge::merge_dirs(&args.dirs) {
-        Ok(report) => finish_report(
-            &report,
-            &args.out,
-            args.json,
-            &args.baseline,
-            "merge",
-            stdout,
-            stderr,
-        ),
+        Ok(merged) => {
+            if !merged.corrected.is_empty() {
+                let _ = writeln!(
+                    stderr,
+                    "mfh merge: corrected {} stored verdict(s) that their records' numbers \
+                     contradict:",
+                    merged.corrected.len()
+                );
+                for line in &merged.corrected {
+                    let _ = writeln!(stderr, "  {line}");
+                }
+            }
+            finish_report(
+                &merged.report,
+                &args.out,
+                args.json,
+                &args.baseline,
+                "merge",
+                stdout,
+                stderr,
+            )
+        }
         Err(e) => {
             let _ = writeln!(stderr, "mfh merge: {e}");
             EXIT_BAD_INPUT
@@ -85,7 +98,8 @@ pub fn run_merge(args: MergeArgs, stdout: &mut dyn Write, stderr: &mut dyn Write
     }
 }
 
-/// Runs `mfh audit`; returns the exit status (0 pass, 1 a check failed, 2 bad input).
+/// Runs `mfh audit`; returns the exit status (0 pass, 1 a check failed, 2 bad input or an
+/// unwritable standard output).
 pub fn run(args: AuditArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32 {
     let scene = match load_scene(args.scene.as_deref()) {
         Ok(s) => s,
@@ -184,27 +198,34 @@ fn finish_report(
             return EXIT_BAD_INPUT;
         }
     };
-    if json {
-        let _ = writeln!(stdout, "{}", crate::report::json::to_string(report));
-    } else {
-        let _ = write!(stdout, "{}", crate::report::terminal::render(report, 20));
+    let printed = super::write_stdout(command, stdout, stderr, |stdout| {
+        if json {
+            return writeln!(stdout, "{}", crate::report::json::to_string(report));
+        }
+        write!(stdout, "{}", crate::report::terminal::render(report, 20))?;
         for n in &report.not_audited {
-            let _ = writeln!(stdout, "{n}");
+            writeln!(stdout, "{n}")?;
         }
         for p in written {
-            let _ = writeln!(stdout, "wrote {}", p.display());
+            writeln!(stdout, "wrote {}", p.display())?;
         }
+        Ok(())
+    });
+    if let Err(code) = printed {
+        return code;
     }
     let mut regressed = false;
     if let Some((name, old)) = old {
         let c = crate::baseline::compare(&old, report);
         regressed = !c.regressions.is_empty();
         let text = crate::baseline::render(&c, &name, 20);
-        let _ = if json {
-            write!(stderr, "{text}")
-        } else {
-            write!(stdout, "{text}")
-        };
+        if json {
+            let _ = write!(stderr, "{text}");
+        } else if let Err(code) =
+            super::write_stdout(command, stdout, stderr, |stdout| write!(stdout, "{text}"))
+        {
+            return code;
+        }
     }
     if !report.passed() || (regressed && baseline.fail_on_regression) {
         EXIT_FAIL

@@ -27,7 +27,7 @@ pub struct Chi2Args {
     /// Samples to draw: at least 5 per cell of the grid (10·R²), at most 2^32.
     #[arg(long, default_value_t = 1_000_000)]
     pub samples: u64,
-    /// Grid resolution R: R cos θ-rows × 2R φ-columns, 1 ≤ R ≤ 512.
+    /// Grid resolution R: R cos θ-rows × 2R φ-columns, 2 ≤ R ≤ 512.
     #[arg(long, default_value_t = 32)]
     pub resolution: usize,
     /// Seed of the random streams (default: MFH_SEED, else a fixed seed).
@@ -245,50 +245,52 @@ fn report(
         }
     }
     let artefacts: Vec<String> = artefacts.iter().map(|p| p.display().to_string()).collect();
-    let written = if args.json {
-        record["artefacts"] = serde_json::json!(artefacts);
-        writeln!(stdout, "{record}")
-    } else {
-        let r = result;
-        let reason = r.reason.as_ref().map(|r| r.to_string());
-        writeln!(
-            stdout,
-            "model {spec_text}\n\
+    let written = super::write_stdout("chi2", stdout, stderr, |stdout| {
+        if args.json {
+            record["artefacts"] = serde_json::json!(artefacts);
+            writeln!(stdout, "{record}")
+        } else {
+            let r = result;
+            let reason = r.reason.as_ref().map(|r| r.to_string());
+            writeln!(
+                stdout,
+                "model {spec_text}\n\
              grid {} φ × {} cos θ cells, {} samples, seed {}\n\
              statistic {:.4}, dof {}, p-value {:.6e}, pooled cells {}\n\
              expected mass {:.12} (cubature error bound {:.2e} counts)\n\
              sampling+binning {:.3e} samples/s ({:.3} s), expected-count integration {:.3} s\n\
              verdict {} at α = {:e}{}\n{}\
              reproduce: {}",
-            2 * r.resolution,
-            r.resolution,
-            r.samples,
-            r.seed,
-            r.statistic,
-            r.dof,
-            r.p_value,
-            r.pooled_cells,
-            r.expected_mass,
-            r.expected_error_bound,
-            r.samples_per_second(),
-            r.sampling_seconds,
-            r.integration_seconds,
-            if r.verdict == Verdict::Pass {
-                "pass"
-            } else {
-                "FAIL"
-            },
-            r.alpha,
-            reason.map(|r| format!(": {r}")).unwrap_or_default(),
-            artefacts
-                .iter()
-                .map(|a| format!("wrote {a}\n"))
-                .collect::<String>(),
-            reproduce,
-        )
-    };
-    if let Err(e) = written.and_then(|_| stdout.flush()) {
-        return bad(stderr, format!("cannot write output: {e}"));
+                2 * r.resolution,
+                r.resolution,
+                r.samples,
+                r.seed,
+                r.statistic,
+                r.dof,
+                r.p_value,
+                r.pooled_cells,
+                r.expected_mass,
+                r.expected_error_bound,
+                r.samples_per_second(),
+                r.sampling_seconds,
+                r.integration_seconds,
+                if r.verdict == Verdict::Pass {
+                    "pass"
+                } else {
+                    "FAIL"
+                },
+                r.alpha,
+                reason.map(|r| format!(": {r}")).unwrap_or_default(),
+                artefacts
+                    .iter()
+                    .map(|a| format!("wrote {a}\n"))
+                    .collect::<String>(),
+                reproduce,
+            )
+        }
+    });
+    if let Err(code) = written {
+        return code;
     }
     match result.verdict {
         Verdict::Pass => EXIT_PASS,
@@ -502,6 +504,51 @@ mod tests {
         let (code, _, err) = run_args(&["chi2", "--model", ggx, "--samples", "1e15"]);
         assert_eq!(code, 2);
         assert!(err.contains("--samples"), "{err}");
+    }
+
+    /// Issue 27: `--resolution 1 --samples 10` reported a correct sampler as FAIL (χ² NaN,
+    /// dof 0); too few cells or samples for a degree of freedom are bad input, exit 2, naming
+    /// the option and its limit. The least accepted run has degrees of freedom and passes.
+    #[test]
+    fn chi2_cli_refuses_a_grid_or_sample_count_without_degrees_of_freedom() {
+        let ggx = r#"{"family":"ggx","alpha":0.3}"#;
+        for (args, names) in [
+            (
+                vec!["--resolution", "1", "--samples", "10"],
+                vec!["--resolution", "[2, 512]"],
+            ),
+            (
+                vec!["--resolution", "2", "--samples", "10"],
+                vec!["--samples", "at least 40"],
+            ),
+            (
+                vec!["--resolution", "2", "--samples", "39"],
+                vec!["--samples", "at least 40"],
+            ),
+        ] {
+            let mut all = vec!["chi2", "--model", ggx, "--json"];
+            all.extend(args.iter().copied());
+            let (code, out, err) = run_args(&all);
+            assert_eq!(code, 2, "{args:?}: {out}{err}");
+            assert!(out.is_empty(), "{args:?}: {out}");
+            for n in names {
+                assert!(err.contains(n), "{args:?}: {err:?} lacks {n:?}");
+            }
+        }
+        let (code, out, err) = run_args(&[
+            "chi2",
+            "--model",
+            ggx,
+            "--json",
+            "--resolution",
+            "2",
+            "--samples",
+            "40",
+        ]);
+        assert_eq!(code, 0, "{out}{err}");
+        let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+        assert!(v["dof"].as_u64().unwrap() >= 1, "{v}");
+        assert!(v["statistic"].is_number(), "{v}");
     }
 
     #[test]

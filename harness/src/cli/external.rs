@@ -35,8 +35,9 @@ pub struct ExternalArgs {
 }
 
 /// Runs `mfh audit-external`: 0 pass, 1 a check failed (a protocol error during the audit is
-/// an `external.protocol` error record), 2 if the child cannot start or describe itself, or on
-/// bad options.
+/// an `external.protocol` error record), 2 if the child cannot start or describe itself, on
+/// bad options (every option is validated before the child starts) or an unwritable standard
+/// output.
 pub fn run(args: ExternalArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32 {
     let seed = match resolve_seed(args.seed) {
         Ok(s) => s,
@@ -52,6 +53,12 @@ pub fn run(args: ExternalArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
             args.timeout
         );
         return EXIT_BAD_INPUT;
+    }
+    if let Some(text) = &args.against {
+        if let Err(e) = reference_spec(text) {
+            let _ = writeln!(stderr, "mfh audit-external: --against: {e}");
+            return EXIT_BAD_INPUT;
+        }
     }
     let out = args.out;
     if let Err(e) = std::fs::create_dir_all(&out) {
@@ -88,17 +95,33 @@ pub fn run(args: ExternalArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
             return EXIT_BAD_INPUT;
         }
     };
-    if args.json {
-        let _ = writeln!(stdout, "{}", crate::report::json::to_string(&report));
-    } else {
-        let _ = write!(stdout, "{}", crate::report::terminal::render(&report, 20));
-        for p in written {
-            let _ = writeln!(stdout, "wrote {}", p.display());
+    let printed = super::write_stdout("audit-external", stdout, stderr, |stdout| {
+        if args.json {
+            return writeln!(stdout, "{}", crate::report::json::to_string(&report));
         }
+        write!(stdout, "{}", crate::report::terminal::render(&report, 20))?;
+        for p in written {
+            writeln!(stdout, "wrote {}", p.display())?;
+        }
+        Ok(())
+    });
+    if let Err(code) = printed {
+        return code;
     }
     if report.passed() {
         EXIT_PASS
     } else {
         EXIT_FAIL
     }
+}
+
+/// The `--against` text as a reference model: JSON of a `ModelSpec` whose parameters build a
+/// model (as `Audit::against` requires), or why not. Checked before the child starts, so that
+/// a typo costs no audit.
+fn reference_spec(text: &str) -> Result<mfh_reference::ModelSpec, String> {
+    let spec: mfh_reference::ModelSpec = serde_json::from_str(text)
+        .map_err(|e| format!("{text:?} is not a reference model spec (JSON): {e}"))?;
+    spec.build()
+        .map_err(|e| format!("the reference spec {text} is invalid: {e}"))?;
+    Ok(spec)
 }

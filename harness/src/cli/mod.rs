@@ -3,7 +3,7 @@
 //! library and mapping its errors to exit codes. The library knows nothing of clap.
 //!
 //! Exit codes: [`EXIT_PASS`] 0 success, [`EXIT_FAIL`] 1 failed checks, [`EXIT_BAD_INPUT`] 2 bad
-//! input.
+//! input, or an output that could not be written ([`write_stdout`]).
 
 pub mod audit;
 pub mod chi2;
@@ -25,7 +25,8 @@ pub const EXIT_PASS: i32 = 0;
 /// Exit status when a check failed.
 pub const EXIT_FAIL: i32 = 1;
 
-/// Exit status for bad input (unreadable files, malformed queries, invalid parameters).
+/// Exit status for bad input (unreadable files, malformed queries, invalid parameters) and for a
+/// standard output that cannot be written (a full disk, a closed pipe).
 pub const EXIT_BAD_INPUT: i32 = 2;
 
 /// mfh — verification and conformance harness for microfacet BSDF mathematics.
@@ -184,6 +185,25 @@ where
         Command::Cost(args) => cost::run(args, stdout, stderr),
         Command::Eval(args) => eval::run(args, stdin, stdout, stderr),
         Command::Selftest(args) => selftest::run(args, stdout, stderr),
+    }
+}
+
+/// Writes a command's output with `write` and flushes standard output; a write error (a full
+/// disk, a pipe closed by `head`) is reported on standard error as "mfh COMMAND: cannot write
+/// standard output: …" and is `Err(EXIT_BAD_INPUT)`: an output that did not arrive is not a
+/// success. Every command that prints its result goes through this one function.
+pub(crate) fn write_stdout(
+    command: &str,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), i32> {
+    match write(stdout).and_then(|()| stdout.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) => {
+            let _ = writeln!(stderr, "mfh {command}: cannot write standard output: {e}");
+            Err(EXIT_BAD_INPUT)
+        }
     }
 }
 

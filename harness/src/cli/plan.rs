@@ -29,7 +29,8 @@ pub enum PlanFormat {
     Table,
 }
 
-/// Runs `mfh plan`; returns the exit status (0, or 2 on bad input).
+/// Runs `mfh plan`; returns the exit status (0, or 2 on bad input or an unwritable standard
+/// output).
 pub fn run(args: PlanArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i32 {
     let scene = match load_scene(args.scene.as_deref()) {
         Ok(s) => s,
@@ -45,20 +46,24 @@ pub fn run(args: PlanArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
         let _ = writeln!(stderr, "mfh plan: {e}");
         return EXIT_BAD_INPUT;
     }
-    match args.format {
+    let written = super::write_stdout("plan", stdout, stderr, |stdout| match args.format {
         PlanFormat::Table => {
             let table = crate::report::plan_table::plan_table(&plan, &scene.not_audited);
-            let _ = write!(stdout, "{table}");
+            write!(stdout, "{table}")
         }
         PlanFormat::Jsonl => {
             for line in crate::plan::describe(&plan) {
-                let _ = writeln!(stdout, "{line}");
+                writeln!(stdout, "{line}")?;
             }
             for n in &scene.not_audited {
                 let line = serde_json::json!({"not_audited": n, "why": n.to_string()});
-                let _ = writeln!(stdout, "{line}");
+                writeln!(stdout, "{line}")?;
             }
+            Ok(())
         }
+    });
+    if let Err(code) = written {
+        return code;
     }
     let _ = writeln!(
         stderr,

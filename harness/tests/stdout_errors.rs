@@ -1,0 +1,112 @@
+//! An output that does not arrive is not a success (issue 27): `mfh plan` and `mfh audit
+//! --json` with standard output on /dev/full (every write fails with ENOSPC) or on a pipe whose
+//! reader has gone exit 2 with "cannot write standard output" on standard error, as `mfh eval`
+//! and `mfh chi2` do.
+
+use std::fs::File;
+use std::process::{Command, Stdio};
+
+/// A scene of one GGX material: its ci audit plans 10 checks and takes ~0.3 s in a debug build.
+fn tiny_scene() -> std::path::PathBuf {
+    let path = std::env::temp_dir().join(format!("mfh-stdout-scene-{}.json", std::process::id()));
+    std::fs::write(
+        &path,
+        r#"{"name": "tiny", "materials": [{"name": "a", "model": {"family": "ggx", "alpha": 0.3}}]}"#,
+    )
+    .unwrap();
+    path
+}
+
+fn out_dir(name: &str) -> String {
+    let dir = std::env::temp_dir().join(format!("mfh-stdout-{name}-{}", std::process::id()));
+    dir.to_str().unwrap().to_string()
+}
+
+/// Runs `mfh args…` with standard output on /dev/full: (exit status, standard error).
+fn to_dev_full(args: &[&str]) -> (Option<i32>, String) {
+    let full = File::create("/dev/full").expect("/dev/full opens for writing");
+    let out = Command::new(env!("CARGO_BIN_EXE_mfh"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::from(full))
+        .stderr(Stdio::piped())
+        .output()
+        .expect("mfh runs");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Runs `mfh args…` with standard output on a pipe whose reader is gone before mfh writes (as
+/// `| head -c100` after its 100 bytes, deterministically: a report that fits in the pipe's
+/// buffer before the reader leaves is delivered, and rightly a pass): (exit status, standard
+/// error).
+fn to_closed_pipe(args: &[&str]) -> (Option<i32>, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mfh"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("mfh runs");
+    // Dropping the only read end: every write of mfh's fails with EPIPE (Rust ignores SIGPIPE).
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("mfh ends");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn assert_write_error(command: &str, (code, stderr): (Option<i32>, String)) {
+    assert_eq!(code, Some(2), "{command}: {stderr}");
+    assert!(
+        stderr.contains(&format!("mfh {command}: cannot write standard output")),
+        "{command}: {stderr:?}"
+    );
+}
+
+#[test]
+fn plan_to_a_full_disk_exits_two() {
+    assert_write_error("plan", to_dev_full(&["plan"]));
+    assert_write_error("plan", to_dev_full(&["plan", "--format", "table"]));
+}
+
+#[test]
+fn audit_json_to_a_full_disk_or_a_closed_pipe_exits_two() {
+    let scene = tiny_scene();
+    let scene = scene.to_str().unwrap();
+    let out = out_dir("audit");
+    let args = [
+        "audit",
+        "--scene",
+        scene,
+        "--profile",
+        "ci",
+        "--json",
+        "--quiet",
+        "--out",
+        &out,
+    ];
+    assert_write_error("audit", to_dev_full(&args));
+    // The summary instead of the JSON goes through the same check.
+    let summary: Vec<&str> = args.iter().copied().filter(|&a| a != "--json").collect();
+    assert_write_error("audit", to_dev_full(&summary));
+    assert_write_error("audit", to_closed_pipe(&args));
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_file(scene);
+}
+
+/// A closed pipe is a write error for `mfh plan` too; a run whose output arrives is a pass.
+#[test]
+fn plan_to_a_closed_pipe_exits_two_and_to_a_reader_passes() {
+    assert_write_error("plan", to_closed_pipe(&["plan"]));
+    let out = Command::new(env!("CARGO_BIN_EXE_mfh"))
+        .arg("plan")
+        .stdin(Stdio::null())
+        .output()
+        .expect("mfh runs");
+    assert_eq!(out.status.code(), Some(0));
+    assert!(!out.stdout.is_empty());
+}
