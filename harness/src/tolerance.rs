@@ -26,6 +26,18 @@ pub struct Tolerance {
     pub reason: &'static str,
 }
 
+/// The largest relative error bound of an oracle, as a fraction of the tolerance it judges
+/// against, for which `check::compare` gives a verdict of pass: beyond it the oracle cannot
+/// tell a value within the tolerance from one outside it, and the record is an error.
+///
+/// 0.5: the slack a pass may take from the oracle is then at most half the tolerance, so a
+/// pass certifies the true error within 1.5× the stated tolerance (without the rule a user D
+/// scaled by 1e308 passed `smith.white_furnace`, issue 27). The oracles ask their quadrature
+/// for a hundredth of the tolerance they serve (the Λ oracle 1e-12 against `CLOSED_FORM`'s
+/// 1e-10), so a converged oracle sits 50× inside the fraction; in the default quick audit the
+/// largest bound of a passing record is 0.056 of its tolerance (`smith.white_furnace`).
+pub const ORACLE_BOUND_FRACTION: f64 = 0.5;
+
 /// Closed forms that are cancellation-free against adaptive quadrature of their definition.
 pub const CLOSED_FORM: Tolerance = Tolerance {
     name: "closed_form",
