@@ -41,6 +41,7 @@ const MASKING_CHECKS: &[&str] = &[
     "smith.white_furnace",
 ];
 const NORMAL_SAMPLING: &[&str] = &[
+    "sampling.batch_agrees",
     "sampling.chi2",
     "sampling.ks_marginals",
     "sampling.lambda_monte_carlo",

@@ -24,7 +24,7 @@ use crate::oracle::Estimate;
 use crate::record::{
     relative_error, AppliedTolerance, CheckRecord, Measured, OracleValue, Verdict,
 };
-use crate::tolerance::Tolerance;
+use crate::tolerance::{Tolerance, ORACLE_BOUND_FRACTION};
 use serde::{Deserialize, Deserializer, Serialize};
 use serde_json::Value;
 
@@ -195,7 +195,13 @@ impl std::fmt::Debug for PlannedCheck<'_> {
 
 /// Fills `record` with the comparison of `value` against the oracle's estimate: relative error
 /// (absolute where the oracle is 0), pass when it is within `tolerance` plus the oracle's own
-/// relative error bound ([`CheckRecord::meets_tolerance`]).
+/// relative error bound ([`CheckRecord::meets_tolerance`], the rule `mfh merge` re-judges by).
+///
+/// An oracle too uncertain to judge the record passes nothing: where its relative error bound
+/// (`error_bound/|value|`, the absolute bound where the value is 0) exceeds
+/// [`ORACLE_BOUND_FRACTION`] of the tolerance, or its value or bound is not finite, the verdict
+/// is an error ("oracle could not resolve"). A discrepancy beyond the tolerance plus the
+/// whole bound is still a failure: no value within the oracle's bound could meet it.
 pub fn compare(record: &mut CheckRecord, value: f64, oracle: Estimate, tolerance: &Tolerance) {
     record.value = Some(value);
     record.oracle = Some(OracleValue {
@@ -205,20 +211,51 @@ pub fn compare(record: &mut CheckRecord, value: f64, oracle: Estimate, tolerance
     });
     record.cost.evaluations += oracle.evaluations;
     let error = relative_error(value, oracle.value);
+    let bound = oracle_relative_bound(&oracle);
     record.measured = Some(if oracle.value == 0.0 {
         Measured::Absolute { error }
     } else {
         Measured::Relative { error }
     });
     record.tolerance = Some(applied(tolerance));
-    // The rule `mfh merge` re-judges stored verdicts by: one function for both.
-    record.verdict = if !value.is_finite() || !oracle.value.is_finite() {
+    let resolved = bound.is_finite() && bound <= ORACLE_BOUND_FRACTION * tolerance.value;
+    // The pass rule `mfh merge` re-judges stored verdicts by: one function for both.
+    record.verdict = if !oracle.value.is_finite() || !bound.is_finite() {
+        unresolved(bound, tolerance)
+    } else if !value.is_finite() || record.meets_tolerance() != Some(true) {
         Verdict::Fail
-    } else if record.meets_tolerance() == Some(true) {
-        Verdict::Pass
+    } else if !resolved {
+        unresolved(bound, tolerance)
     } else {
-        Verdict::Fail
+        Verdict::Pass
     };
+}
+
+/// The oracle's error bound relative to its value (absolute where the value is 0); NaN where
+/// the value or the bound is not finite or the bound is negative.
+pub fn oracle_relative_bound(oracle: &Estimate) -> f64 {
+    if !oracle.value.is_finite() || !oracle.error_bound.is_finite() || oracle.error_bound < 0.0 {
+        return f64::NAN;
+    }
+    if oracle.value == 0.0 {
+        oracle.error_bound
+    } else {
+        oracle.error_bound / oracle.value.abs()
+    }
+}
+
+/// How the message of a record whose oracle could not judge it begins.
+pub const UNRESOLVED: &str = "oracle could not resolve";
+
+/// The verdict of a record whose oracle is too uncertain to judge it.
+fn unresolved(bound: f64, tolerance: &Tolerance) -> Verdict {
+    Verdict::Error {
+        message: format!(
+            "{UNRESOLVED}: bound {bound:e} against tolerance {:e} ({}; at most \
+             {ORACLE_BOUND_FRACTION} of it)",
+            tolerance.value, tolerance.name
+        ),
+    }
 }
 
 /// Fills `record` with the comparison of two evaluations that must agree (no oracle error).
@@ -588,6 +625,80 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Issue 27: a D scaled by 1e308 made the white furnace's quadrature bound as large as
+    /// the error, and the record passed with a relative error of 1.6e308. The oracle cannot
+    /// judge it: the verdict is an error, never a pass.
+    #[test]
+    fn a_record_the_oracle_cannot_resolve_is_an_error_not_a_pass() {
+        // The white furnace alone: the other checks of a D this large run for minutes.
+        let records = run(smith::plan_white_furnace(&model(1e308, 1.0), 1.5, "test"));
+        let furnace: Vec<_> = records
+            .iter()
+            .filter(|r| r.check == "smith.white_furnace")
+            .collect();
+        assert!(!furnace.is_empty());
+        // θ = 0.6: the error (1.6e308) is within the bound, which cannot judge it: an error;
+        // θ = 1.3: the error is beyond even the bound: a failure. Neither passes.
+        for r in &furnace {
+            assert!(r.verdict.is_failure(), "{r:?}");
+        }
+        assert!(
+            furnace.iter().any(|r| matches!(
+                &r.verdict,
+                Verdict::Error { message } if message.starts_with(UNRESOLVED)
+            )),
+            "{furnace:?}"
+        );
+    }
+
+    /// `compare` directly: a bound above `ORACLE_BOUND_FRACTION` of the tolerance is an error
+    /// whatever the value; at or below it the bound is slack; a discrepancy beyond the
+    /// tolerance plus the whole bound fails; a non-finite oracle is an error.
+    #[test]
+    fn compare_refuses_an_oracle_too_uncertain_to_judge() {
+        let tol = crate::tolerance::CLOSED_FORM;
+        let judge = |value: f64, oracle: f64, bound: f64| {
+            let mut r = CheckRecord::new("t.t", Value::Null, Value::Null, "");
+            let e = Estimate {
+                value: oracle,
+                error_bound: bound,
+                evaluations: 1,
+            };
+            compare(&mut r, value, e, &tol);
+            r.verdict
+        };
+        let unresolved = |v: &Verdict| {
+            matches!(v, Verdict::Error { message }
+                if message.starts_with("oracle could not resolve: bound")
+                    && message.contains("against tolerance 1e-10"))
+        };
+        // Exact agreement, but the oracle knows its value only to 1e-9: error.
+        let v = judge(2.0, 2.0, 2e-9);
+        assert!(unresolved(&v), "{v:?}");
+        // The issue's record: error 1.6e308 hidden in a bound as large.
+        let v = judge(1.6e308, 1.0, f64::MAX);
+        assert!(unresolved(&v), "{v:?}");
+        // At the fraction the bound is slack: 1.4e-10 off passes with a bound of 5e-11.
+        let half = ORACLE_BOUND_FRACTION * tol.value;
+        assert_eq!(judge(1.0 + 1.4e-10, 1.0, half), Verdict::Pass);
+        assert_eq!(judge(1.0 + 1.6e-10, 1.0, half), Verdict::Fail);
+        // Beyond the bound's reach it fails even if the oracle is uncertain.
+        assert_eq!(judge(1.1, 1.0, 1e-6), Verdict::Fail);
+        // Oracle 0: the bound is absolute.
+        assert_eq!(judge(1e-11, 0.0, 1e-11), Verdict::Pass);
+        assert!(unresolved(&judge(0.0, 0.0, 1e-9)));
+        // Non-finite oracle value or bound: error; non-finite value under test: fail.
+        assert!(unresolved(&judge(1.0, f64::NAN, 0.0)));
+        assert!(unresolved(&judge(1.0, f64::INFINITY, 0.0)));
+        assert!(unresolved(&judge(1.0, 1.0, f64::INFINITY)));
+        assert!(unresolved(&judge(1.0, 1.0, f64::NAN)));
+        assert_eq!(judge(f64::NAN, 1.0, 0.0), Verdict::Fail);
+        // The exact comparison has no oracle bound and judges as before.
+        let mut r = CheckRecord::new("t.t", Value::Null, Value::Null, "");
+        compare_exact(&mut r, 1.0, 1.0, &tol);
+        assert_eq!(r.verdict, Verdict::Pass);
     }
 
     #[test]

@@ -366,10 +366,18 @@ fn bisect(outside: &Point, inside: &Point, route: &str) -> (Point, Point) {
     }
 }
 
-/// Pass without problems; otherwise fail, the problems in the case.
+/// Pass without problems (an error where the oracle could not resolve the answer inside);
+/// otherwise fail, the problems in the case.
 fn verdict(r: &mut CheckRecord, problems: Vec<String>) -> Verdict {
     if problems.is_empty() {
-        return Verdict::Pass;
+        // An oracle that could not resolve the answer inside (`compare`'s error) passes
+        // nothing.
+        return match &r.verdict {
+            Verdict::Error { message } if message.starts_with(crate::check::UNRESOLVED) => {
+                r.verdict.clone()
+            }
+            _ => Verdict::Pass,
+        };
     }
     note(r, "problems", json!(problems));
     Verdict::Fail

@@ -8,8 +8,9 @@
 //!
 //! One concept a file: the normal sampler's checks here (chi-square, pdf consistency, Λ by Monte
 //! Carlo), the KS marginals in `ks.rs`, visible normals in `visible.rs`, the pseudo-VNIS of seed
-//! 001 §7.2 in `pseudo_vnis.rs`.
+//! 001 §7.2 in `pseudo_vnis.rs`, the batch paths against the scalar ones in `batch_agrees.rs`.
 
+pub mod batch_agrees;
 mod ks;
 mod pseudo_vnis;
 mod visible;
@@ -132,6 +133,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
         );
     }
     out.push(super::jacobian::plan(subject, why));
+    out.extend(batch_agrees::plan_normal(subject, why));
     if subject.model.as_smith().is_some() {
         let m = subject.clone();
         let theta = 1.2;

@@ -387,7 +387,8 @@ pub fn plan_g1_g2<'a>(
                         "g2_uncorrelated" => (
                             smith.g2(wo, wi, n, Masking::Uncorrelated),
                             go * gi,
-                            (lo.error_bound + li.error_bound) * go * gi,
+                            // δ(go·gi)/(go·gi) = δΛo·go + δΛi·gi (each G1 = 1/(1 + Λ)).
+                            (lo.error_bound * go + li.error_bound * gi) * go * gi,
                         ),
                         _ => {
                             let g = 1.0 / (1.0 + lo.value + li.value);

@@ -33,7 +33,8 @@ fn visible_samplers_pass_their_checks() {
     ] {
         let (_, m) = model(json);
         let records = run(&plan_visible(&m, Profile::Quick, "test"));
-        assert_eq!(records.len(), 2 * VISIBLE_INCIDENCES.len());
+        // chi-square and normalization per incidence, and one `sampling.batch_agrees`.
+        assert_eq!(records.len(), 2 * VISIBLE_INCIDENCES.len() + 1);
         for r in &records {
             assert_eq!(r.verdict, Verdict::Pass, "{r:?}");
         }

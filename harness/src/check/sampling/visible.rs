@@ -39,7 +39,8 @@ pub fn terminator_azimuths(phi_i: f64) -> [f64; 2] {
 
 /// Plans the visible-normal sampling checks of one model (scene `sampling: visible_normals`):
 /// `sampling.chi2_visible` at each of [`VISIBLE_INCIDENCES`] and
-/// `sampling.pdf_visible_normalization` (∫ pdf_wm_visible dm = 1 by quadrature). A model without
+/// `sampling.pdf_visible_normalization` (∫ pdf_wm_visible dm = 1 by quadrature), and
+/// `sampling.batch_agrees` of its batch against its scalar visible sampler. A model without
 /// a visible-normal sampler gets one skipped `sampling.chi2_visible` record that says so: the
 /// scene is valid (the renderer may sample visible normals its own way), but there is no
 /// reference sampler to check it against.
@@ -124,5 +125,10 @@ pub fn plan_visible<'a>(
             }),
         );
     }
+    out.extend(super::batch_agrees::plan_visible(
+        subject,
+        &VISIBLE_INCIDENCES,
+        why,
+    ));
     out
 }
