@@ -86,7 +86,11 @@ pub fn run(args: SelftestArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
         },
         filter: args.only.clone(),
     };
-    if args.calibrate.is_none() && !args.power && selftest::selected(&options).is_empty() {
+    if args.calibrate.is_none()
+        && !args.power
+        && selftest::selected(&options).is_empty()
+        && !selftest::bsdf::any_selected(&options)
+    {
         let _ = writeln!(
             stderr,
             "mfh selftest: --only {:?} matches no mutant of the {:?} subset",
@@ -220,9 +224,6 @@ pub fn summary(report: &selftest::SelftestReport) -> String {
                 .collect();
             let _ = writeln!(s, "  {:<42} {}", m.id, cells.join(" | "));
         }
-        for line in report.survivors() {
-            let _ = writeln!(s, "not caught: {line}");
-        }
         for c in report.controls.iter().filter(|c| !c.passed) {
             let _ = writeln!(
                 s,
@@ -243,6 +244,48 @@ pub fn summary(report: &selftest::SelftestReport) -> String {
                 }
             }
         }
+    }
+    if !report.bsdf_mutants.is_empty() {
+        let caught = report.bsdf_mutants.iter().filter(|m| m.caught()).count();
+        let _ = writeln!(
+            s,
+            "mfh selftest: {caught}/{} BSDF mutants caught at every one of {} seeds (profile {}), \
+             {} BSDF controls",
+            report.bsdf_mutants.len(),
+            report.seeds.len(),
+            report.profile.name(),
+            report.bsdf_controls.len(),
+        );
+        for m in &report.bsdf_mutants {
+            let cells: Vec<String> = m
+                .runs
+                .iter()
+                .map(|r| {
+                    if !r.killed {
+                        "SURVIVED".to_string()
+                    } else {
+                        r.killers.join(",")
+                    }
+                })
+                .collect();
+            let _ = writeln!(s, "  {:<42} {}", m.id, cells.join(" | "));
+        }
+        for c in report
+            .bsdf_controls
+            .iter()
+            .filter(|c| !c.failures.is_empty())
+        {
+            let _ = writeln!(
+                s,
+                "BSDF control FAILED: {} seed {:#x}: {}",
+                c.base,
+                c.seed,
+                c.failures.join("; ")
+            );
+        }
+    }
+    for line in report.survivors() {
+        let _ = writeln!(s, "not caught: {line}");
     }
     if let Some(c) = &report.calibration {
         for t in &c.tests {

@@ -258,7 +258,74 @@ pub fn calibrate(
             }
         }
     }
+    tests.extend(calibrate_bsdf(runs, profile, progress)?);
     Ok(Calibration { profile, tests })
+}
+
+/// The BSDF calibrated: the reference GGX dielectric (η = 1.5, α = 0.3, visible normals).
+pub const BSDF_MODEL: &str =
+    r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}"#;
+
+/// Calibrates the whole-sphere chi-square of [`BSDF_MODEL`] as `bsdf.chi2` runs it, at the
+/// oblique incidence and beyond the critical angle from inside, over `runs` seeded runs (the
+/// expected masses integrated once per incidence: they do not depend on the seed).
+fn calibrate_bsdf(
+    runs: usize,
+    profile: Profile,
+    progress: Option<super::Progress<'_>>,
+) -> Result<Vec<TestCalibration>, String> {
+    use crate::check::bsdf::{incidences, pdf_at};
+    use crate::oracle::domain::HemisphereGrid;
+    use crate::oracle::sphere_chi2::{expected_sphere, mass_target, sphere_chi2_against};
+    let spec: mfh_reference::bsdf::BsdfSpec =
+        serde_json::from_str(BSDF_MODEL).map_err(|e| format!("calibration BSDF: {e}"))?;
+    let bsdf = spec.build().map_err(|e| format!("calibration BSDF: {e}"))?;
+    let value = serde_json::to_value(&spec).unwrap_or(Value::Null);
+    let samples = profile.chi2_samples();
+    let resolution = crate::check::bsdf::CHI2_RESOLUTION;
+    let grid = HemisphereGrid::new(resolution).expect("R ≥ 1");
+    let mut out = Vec::new();
+    for inc in incidences(bsdf.as_ref())
+        .into_iter()
+        .filter(|i| matches!(i.name, "oblique" | "total_internal_reflection"))
+    {
+        let t = Instant::now();
+        let expected = expected_sphere(&pdf_at(bsdf.as_ref(), inc.wi), grid, mass_target(samples));
+        let p: Vec<Option<f64>> = (0..runs)
+            .into_par_iter()
+            .map(|i| {
+                let config = Chi2Config {
+                    resolution,
+                    samples,
+                    seed: CALIBRATION_SEED.wrapping_add(i as u64),
+                    alpha: LEVELS[0],
+                };
+                let r = sphere_chi2_against(
+                    &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| {
+                        let mut s = vec![None; u.len()];
+                        bsdf.sample_batch(inc.wi, u, &mut s);
+                        for (o, s) in out.iter_mut().zip(s) {
+                            *o = s.filter(|s| s.pdf > 0.0).map(|s| s.wo);
+                        }
+                    },
+                    expected.clone(),
+                    &config,
+                );
+                (!r.sanity_failure).then_some(r.p_value)
+            })
+            .collect();
+        out.push(summarize(
+            &value,
+            &format!("bsdf_chi2_{}", inc.name),
+            samples,
+            p,
+            t.elapsed().as_secs_f64(),
+        ));
+        if let Some(f) = progress {
+            f(&format!("calibrated bsdf chi2 ({}): {runs} runs", inc.name));
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

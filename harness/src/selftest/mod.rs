@@ -12,6 +12,7 @@
 //! rejection fraction must lie in the 99 % binomial interval of α and the p-values must be
 //! uniform.
 
+pub mod bsdf;
 pub mod bsdf_mutant;
 pub mod calibrate;
 pub mod catalog;
@@ -147,6 +148,12 @@ pub struct SelftestReport {
     pub mutants: Vec<MutantResult>,
     /// The controls: each base unmutated, per seed.
     pub controls: Vec<ControlRun>,
+    /// The BSDF mutants' kill matrix ([`bsdf`]; with `--subset all` or `--only bsdf`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub bsdf_mutants: Vec<bsdf::BsdfMutantResult>,
+    /// The BSDF controls: each base BSDF unmutated, per seed.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub bsdf_controls: Vec<bsdf::BsdfControl>,
     /// The false-alarm calibration, when run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub calibration: Option<calibrate::Calibration>,
@@ -169,6 +176,8 @@ impl SelftestReport {
             catalog_size: CATALOG.len(),
             mutants: Vec::new(),
             controls: Vec::new(),
+            bsdf_mutants: Vec::new(),
+            bsdf_controls: Vec::new(),
             calibration: None,
             power: None,
             wall_seconds: 0.0,
@@ -180,20 +189,27 @@ impl SelftestReport {
     pub fn passed(&self) -> bool {
         self.mutants.iter().all(MutantResult::caught)
             && self.controls.iter().all(|c| c.passed)
+            && self.bsdf_mutants.iter().all(bsdf::BsdfMutantResult::caught)
+            && self.bsdf_controls.iter().all(|c| c.failures.is_empty())
             && self.calibration.as_ref().is_none_or(|c| c.passed())
     }
 
     /// The mutants not caught at some seed, with why.
     pub fn survivors(&self) -> Vec<String> {
         let mut out = Vec::new();
-        for m in &self.mutants {
-            for r in &m.runs {
+        let rows = self.mutants.iter().map(|m| (&m.id, &m.runs, &m.expected));
+        let bsdf_rows = self
+            .bsdf_mutants
+            .iter()
+            .map(|m| (&m.id, &m.runs, &m.expected));
+        for (id, runs, expected) in rows.chain(bsdf_rows) {
+            for r in runs {
                 if !r.killed {
-                    out.push(format!("{} survived seed {}", m.id, r.seed));
+                    out.push(format!("{id} survived seed {}", r.seed));
                 } else if !r.expected_hit {
                     out.push(format!(
-                        "{} at seed {} was killed by {:?}, none of the expected {:?}",
-                        m.id, r.seed, r.killers, m.expected
+                        "{id} at seed {} was killed by {:?}, none of the expected {expected:?}",
+                        r.seed, r.killers
                     ));
                 }
             }
@@ -315,7 +331,7 @@ fn describe(r: &CheckRecord) -> String {
 }
 
 /// The ids of the checks that failed, sorted, each once.
-fn killers(records: &[CheckRecord]) -> Vec<String> {
+pub(crate) fn killers(records: &[CheckRecord]) -> Vec<String> {
     let mut killers: Vec<String> = records
         .iter()
         .filter(|r| r.verdict.is_failure())
@@ -326,7 +342,12 @@ fn killers(records: &[CheckRecord]) -> Vec<String> {
     killers
 }
 
-fn kill_run(records: &[CheckRecord], expected: &[&str], seed: u64, seconds: f64) -> KillRun {
+pub(crate) fn kill_run(
+    records: &[CheckRecord],
+    expected: &[&str],
+    seed: u64,
+    seconds: f64,
+) -> KillRun {
     let killers = killers(records);
     KillRun {
         seed,
@@ -434,9 +455,12 @@ pub fn run(options: &SelftestOptions, progress: Option<Progress<'_>>) -> Selftes
             runs,
         });
     }
+    let (bsdf_mutants, bsdf_controls) = bsdf::run(options, progress);
     SelftestReport {
         mutants,
         controls,
+        bsdf_mutants,
+        bsdf_controls,
         wall_seconds: t.elapsed().as_secs_f64(),
         ..SelftestReport::empty(options)
     }

@@ -25,6 +25,7 @@ mod reciprocity;
 mod stability;
 
 pub use against::plan_against;
+pub use chi2::RESOLUTION as CHI2_RESOLUTION;
 
 use super::{PlannedCheck, Profile};
 use crate::oracle::chi2::Expected;
