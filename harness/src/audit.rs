@@ -13,6 +13,8 @@
 //!     .assert_pass();
 //! ```
 
+pub mod capabilities;
+
 use crate::check::{self, against, PlannedCheck, Profile};
 use crate::plan::{plan_model, Effects};
 use crate::record::{CheckRecord, Verdict};
@@ -44,6 +46,8 @@ pub struct Audit<'a> {
     against: Option<String>,
     /// `MFH_SEED` when it is set but not a seed: an error record, as the CLI's exit 2.
     seed_error: Option<String>,
+    /// The capability traits the model's type implements, when [`crate::audit!`] detected them.
+    implemented: Option<capabilities::Implemented>,
 }
 
 impl<'a> Audit<'a> {
@@ -69,6 +73,7 @@ impl<'a> Audit<'a> {
             theta_max: FRAC_PI_2,
             against: None,
             seed_error,
+            implemented: None,
         }
     }
 
@@ -100,6 +105,14 @@ impl<'a> Audit<'a> {
         audit.bsdf = Some(Arc::new(bsdf));
         audit.name = std::any::type_name::<B>().to_string();
         audit
+    }
+
+    /// The capability traits the model's type implements (set by [`crate::audit!`], which has
+    /// the compiler find them): one that its `as_*` method does not declare fails the
+    /// `audit.capabilities` record.
+    pub fn implemented(mut self, implemented: capabilities::Implemented) -> Self {
+        self.implemented = Some(implemented);
+        self
     }
 
     /// The name records give the model (default: its Rust type name).
@@ -204,6 +217,11 @@ impl<'a> Audit<'a> {
             ));
         }
         let effects = self.effects();
+        errors.push(capabilities_record(
+            &subject.label,
+            self.model.as_ref(),
+            self.implemented,
+        ));
         let mut plan = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             plan_model(&subject, &effects, self.options.profile, &why)
         }))
@@ -302,6 +320,56 @@ fn seed_from_env(value: Option<String>) -> (u64, Option<String>) {
             ),
         },
     }
+}
+
+/// The `audit.capabilities` record: the capabilities the model declares (and so is audited
+/// on) and those it does not offer; with [`crate::audit!`], those its type implements, and a
+/// failure for each implemented but undeclared one (its checks would silently not run).
+fn capabilities_record(
+    model: &serde_json::Value,
+    ndf: &dyn Ndf,
+    implemented: Option<capabilities::Implemented>,
+) -> CheckRecord {
+    let declared = capabilities::declared(ndf);
+    let audited: Vec<&str> = declared.iter().filter(|d| d.2).map(|d| d.1).collect();
+    let not_offered: Vec<&str> = declared.iter().filter(|d| !d.2).map(|d| d.1).collect();
+    let mut case = json!({"audited": audited, "not_offered": not_offered});
+    let mut r = CheckRecord::new(
+        "audit.capabilities",
+        model.clone(),
+        json!({}),
+        "the capability traits of mfh_reference::model",
+    );
+    r.verdict = Verdict::Pass;
+    match implemented {
+        None => {
+            case["implemented"] = json!("not detected (audit with mfh_harness::audit!(model))");
+        }
+        Some(i) => {
+            let undeclared: Vec<String> = declared
+                .iter()
+                .filter(|d| i.has(d.0) && !d.2)
+                .map(|d| {
+                    format!(
+                        "{} is implemented but as_{}() returns None: its checks would not run \
+                         (return Some(self))",
+                        d.1, d.0
+                    )
+                })
+                .collect();
+            case["implemented"] = json!(declared
+                .iter()
+                .filter(|d| i.has(d.0))
+                .map(|d| d.1)
+                .collect::<Vec<_>>());
+            if !undeclared.is_empty() {
+                case["undeclared"] = json!(undeclared);
+                r.verdict = Verdict::Fail;
+            }
+        }
+    }
+    r.case = case;
+    r
 }
 
 fn config_error(model: &serde_json::Value, message: String) -> CheckRecord {

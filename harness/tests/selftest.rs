@@ -175,4 +175,13 @@ fn false_alarm_calibration_extensive() {
         assert!(t.passed(), "{} {} miscalibrated: {t:?}", t.model, t.test);
     }
     assert_eq!(c.tests.len(), 6);
+    let b = calibrate::calibrate_bsdf(1000, mfh_harness::Profile::Quick, None).expect("BSDF");
+    for t in &b {
+        println!(
+            "{} {}: {:?}, uniformity p = {}",
+            t.model, t.test, t.levels, t.uniformity_p_value
+        );
+        assert!(t.passed(), "{} {} miscalibrated: {t:?}", t.model, t.test);
+    }
+    assert_eq!(b.len(), 2);
 }

@@ -115,7 +115,9 @@ pub fn run(args: SelftestArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
                 .copied()
                 .filter(|m| args.only.as_ref().is_none_or(|o| m.contains(o.as_str())))
                 .collect();
-            if models.is_empty() {
+            let only = |m: &str| args.only.as_ref().is_none_or(|o| m.contains(o.as_str()));
+            let bsdf = only(calibrate::BSDF_MODEL);
+            if models.is_empty() && !bsdf {
                 let _ = writeln!(
                     stderr,
                     "mfh selftest: --only {:?} matches none of the calibrated samplers {:?}",
@@ -124,7 +126,18 @@ pub fn run(args: SelftestArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
                 );
                 return EXIT_BAD_INPUT;
             }
-            match calibrate::calibrate(&models, n, options.profile, Some(&progress)) {
+            let calibration = calibrate::calibrate(&models, n, options.profile, Some(&progress))
+                .and_then(|mut c| {
+                    if bsdf {
+                        c.tests.extend(calibrate::calibrate_bsdf(
+                            n,
+                            options.profile,
+                            Some(&progress),
+                        )?);
+                    }
+                    Ok(c)
+                });
+            match calibration {
                 Ok(c) => {
                     report.calibration = Some(c);
                     report.wall_seconds = t.elapsed().as_secs_f64();

@@ -258,7 +258,6 @@ pub fn calibrate(
             }
         }
     }
-    tests.extend(calibrate_bsdf(runs, profile, progress)?);
     Ok(Calibration { profile, tests })
 }
 
@@ -269,7 +268,7 @@ pub const BSDF_MODEL: &str =
 /// Calibrates the whole-sphere chi-square of [`BSDF_MODEL`] as `bsdf.chi2` runs it, at the
 /// oblique incidence and beyond the critical angle from inside, over `runs` seeded runs (the
 /// expected masses integrated once per incidence: they do not depend on the seed).
-fn calibrate_bsdf(
+pub fn calibrate_bsdf(
     runs: usize,
     profile: Profile,
     progress: Option<super::Progress<'_>>,
