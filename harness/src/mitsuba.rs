@@ -12,6 +12,12 @@
 //! | `principled`, `principledthin` | GGX | `roughness` (0.5), `anisotropic` (0): α = max(10⁻³, r²/a), max(10⁻³, r²·a), a = √(1 − 0.9·anisotropic) (principledhelpers.h `calc_dist_params`) | visible normals (the `MicrofacetDistribution` default) |
 //! | `principled` clearcoat (when `clearcoat` ≠ 0) | GTR1 = GTR γ = 1 | α = lerp(0.1, 0.001, `clearcoat_gloss` (0)) | normals (`GTR1Isotropic::sample`) |
 //!
+//! `roughconductor` and `roughdielectric` also name a reference BSDF (issue 25), whose BSDF
+//! checks are planned besides the NDF's: a roughdielectric's η = `int_ior`/`ext_ior` (floats;
+//! absent: bk7 1.5046 / air 1.000277; named IORs are refused, mfh has no table), a
+//! roughconductor's n + ik = `eta` + i`k` (floats; absent or spectral: 0.2 + 3i, and a spectral
+//! index is listed as not audited); masking uncorrelated, exact Fresnel, radiance transport.
+//!
 //! Masking: Mitsuba 3's `MicrofacetDistribution::G` is "Smith's separable shadowing-masking
 //! approximation", G1(wi, m)·G1(wo, m) — the uncorrelated G2 (seed 001 eq 22), not the
 //! height-correlated form. Mitsuba clamps α ≥ 10⁻⁴ (`MicrofacetDistribution::configure`); so
@@ -24,13 +30,27 @@
 //! as in Mitsuba; `<include>` is refused (mfh reads one self-contained file). Every error names
 //! the file, line and column.
 
-use crate::scene::{Material, NotAudited, Sampling, Scene, SceneError};
+use crate::scene::{Material, MaterialBsdf, NotAudited, Sampling, Scene, SceneError};
+use mfh_reference::bsdf::{
+    BsdfSpec, ConductorSpec, DielectricSpec, FresnelModel, Sampling as BsdfSampling, Transport,
+};
 use mfh_reference::{Masking, ModelSpec};
 use roxmltree::{Document, Node};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Mitsuba's smallest roughness (`MicrofacetDistribution::configure`: α = max(α, 10⁻⁴)).
 pub const MITSUBA_ALPHA_MIN: f64 = 1e-4;
+
+/// Mitsuba's default `int_ior` of a roughdielectric, its named IOR `bk7` (ior.h).
+pub const MITSUBA_BK7_IOR: f64 = 1.5046;
+
+/// Mitsuba's default `ext_ior` of a roughdielectric, its named IOR `air` (ior.h).
+pub const MITSUBA_AIR_IOR: f64 = 1.000277;
+
+/// The complex index (n, k) a roughconductor is audited with when its `eta`/`k` are not given
+/// as floats (Mitsuba's default is the ideal mirror `material="none"`, which has no finite
+/// index): a bright metal, roughly silver at 550 nm.
+pub const DEFAULT_CONDUCTOR_NK: (f64, f64) = (0.2, 3.0);
 
 /// Plugin element names of Mitsuba 3 (everything else with a `name` is a property).
 const PLUGIN_TAGS: &[&str] = &[
@@ -478,13 +498,135 @@ impl<'input> Reader<'_, 'input> {
         } else {
             Sampling::Normals
         };
+        let bsdf = match kind {
+            "roughplastic" => None,
+            _ => Some(self.rough_bsdf(node, kind, name, &model, sample_visible)?),
+        };
         self.materials.push(Material {
             name: name.to_string(),
-            model,
+            model: Some(model),
+            bsdf,
             masking: Some(Masking::Uncorrelated),
             sampling: Some(sampling),
         });
         Ok(())
+    }
+
+    /// The reference BSDF of a roughconductor or roughdielectric with the NDF `ndf`:
+    /// Mitsuba's separable (uncorrelated) masking, its visible-normal or normal sampling, the
+    /// exact Fresnel, radiance transport. A roughdielectric's η = `int_ior`/`ext_ior` (floats;
+    /// Mitsuba's defaults bk7 and air as numbers); a roughconductor's complex index `eta` + i`k`
+    /// (floats; [`DEFAULT_CONDUCTOR_NK`] where absent or spectral, which is then listed as not
+    /// audited). An invalid value is an error naming the Mitsuba property and the limit.
+    fn rough_bsdf(
+        &mut self,
+        node: Node,
+        kind: &str,
+        name: &str,
+        ndf: &ModelSpec,
+        sample_visible: bool,
+    ) -> Result<MaterialBsdf, SceneError> {
+        let sampling = if sample_visible {
+            BsdfSampling::VisibleNormals
+        } else {
+            BsdfSampling::Normals
+        };
+        let spec = if kind == "roughdielectric" {
+            let int_ior = self.ior(node, kind, name, "int_ior", MITSUBA_BK7_IOR)?;
+            let ext_ior = self.ior(node, kind, name, "ext_ior", MITSUBA_AIR_IOR)?;
+            BsdfSpec::Dielectric(DielectricSpec {
+                eta: int_ior / ext_ior,
+                ndf: ndf.clone(),
+                masking: Masking::Uncorrelated,
+                sampling,
+                transport: Transport::Radiance,
+            })
+        } else {
+            let (n0, k0) = DEFAULT_CONDUCTOR_NK;
+            if let Some(Prop::Str(material)) = self.prop(node, "material")? {
+                if self.prop(node, "eta")?.is_none() {
+                    self.not_audited(
+                        &format!("{kind} material"),
+                        name,
+                        format!(
+                            "the named material `{material}` is not read (mfh has no table of \
+                             Mitsuba's spectral indices): the BSDF is audited with n = {n0}, \
+                             k = {k0}"
+                        ),
+                    );
+                }
+            }
+            let mut index = |property: &str, default: f64| -> Result<f64, SceneError> {
+                Ok(match self.prop(node, property)? {
+                    None => default,
+                    Some(Prop::Float(x)) => x,
+                    Some(_) => {
+                        self.not_audited(
+                            &format!("{kind} {property}"),
+                            name,
+                            format!(
+                                "`{property}` is not a <float> (spectral or named): the BSDF is \
+                                 audited with the default {property} = {default}"
+                            ),
+                        );
+                        default
+                    }
+                })
+            };
+            let n = index("eta", n0)?;
+            let k = index("k", k0)?;
+            BsdfSpec::Conductor(ConductorSpec {
+                n,
+                k,
+                fresnel: FresnelModel::Exact,
+                ndf: ndf.clone(),
+                masking: Masking::Uncorrelated,
+                sampling,
+            })
+        };
+        if let Err(e) = spec.validate() {
+            let property = match e.field() {
+                "eta" => "int_ior/ext_ior",
+                "n" => "eta",
+                "ndf" => "alpha",
+                other => other,
+            };
+            return Err(self.error(
+                node,
+                format!(
+                    "{kind} `{name}`: {property}: {}",
+                    crate::messages::compact_numbers(&e.to_string())
+                ),
+            ));
+        }
+        Ok(MaterialBsdf::of(spec))
+    }
+
+    /// The index of refraction `property` of a roughdielectric: a <float>, or `default` when
+    /// absent. Mitsuba's named IORs (`<string value="bk7">`) are refused: mfh has no table.
+    fn ior(
+        &self,
+        node: Node,
+        kind: &str,
+        name: &str,
+        property: &str,
+        default: f64,
+    ) -> Result<f64, SceneError> {
+        match self.prop(node, property)? {
+            None => Ok(default),
+            Some(Prop::Float(x)) => Ok(x),
+            Some(Prop::Str(s)) => Err(self.error(
+                node,
+                format!(
+                    "{kind} `{name}`: {property}: the named IOR \"{s}\" is not read (mfh has no \
+                     table of Mitsuba's named IORs): give the index as a <float>"
+                ),
+            )),
+            Some(_) => Err(self.error(
+                node,
+                format!("{kind} `{name}`: {property} must be a <float>"),
+            )),
+        }
     }
 
     /// principled and principledthin: the GGX main lobe, and principled's GTR1 clearcoat.
@@ -526,7 +668,8 @@ impl<'input> Reader<'_, 'input> {
         }
         self.materials.push(Material {
             name: name.to_string(),
-            model: microfacet_spec("ggx", ax, ay),
+            model: Some(microfacet_spec("ggx", ax, ay)),
+            bsdf: None,
             masking: Some(Masking::Uncorrelated),
             sampling: Some(Sampling::VisibleNormals),
         });
@@ -540,10 +683,11 @@ impl<'input> Reader<'_, 'input> {
                         let cc = format!("{name}/clearcoat");
                         self.materials.push(Material {
                             name: cc.clone(),
-                            model: ModelSpec::Gtr(mfh_reference::ndf::gtr::GtrSpec {
+                            model: Some(ModelSpec::Gtr(mfh_reference::ndf::gtr::GtrSpec {
                                 gamma: 1.0,
                                 alpha,
-                            }),
+                            })),
+                            bsdf: None,
                             masking: None,
                             sampling: Some(Sampling::Normals),
                         });
@@ -631,16 +775,101 @@ mod tests {
         assert_eq!(s.materials.len(), 1);
         let m = &s.materials[0];
         assert_eq!(m.name, "metal");
-        assert_eq!(
-            m.model,
-            ModelSpec::Beckmann(mfh_reference::ndf::beckmann::BeckmannSpec {
-                alpha: Some(0.1),
-                alpha_x: None,
-                alpha_y: None
-            })
-        );
+        let beckmann = ModelSpec::Beckmann(mfh_reference::ndf::beckmann::BeckmannSpec {
+            alpha: Some(0.1),
+            alpha_x: None,
+            alpha_y: None,
+        });
+        assert_eq!(m.model, Some(beckmann.clone()));
         assert_eq!(m.masking, Some(Masking::Uncorrelated));
         assert_eq!(m.sampling, Some(Sampling::VisibleNormals));
+        // The reference BSDF: the same NDF, the default index, Mitsuba's separable masking.
+        let (n, k) = DEFAULT_CONDUCTOR_NK;
+        assert_eq!(
+            m.bsdf.as_ref().map(MaterialBsdf::spec),
+            Some(BsdfSpec::Conductor(ConductorSpec {
+                n,
+                k,
+                fresnel: FresnelModel::Exact,
+                ndf: beckmann,
+                masking: Masking::Uncorrelated,
+                sampling: BsdfSampling::VisibleNormals,
+            }))
+        );
+    }
+
+    #[test]
+    fn rough_dielectric_and_conductor_name_their_reference_bsdf() {
+        let s = scene(
+            r#"<bsdf type="roughdielectric" id="glass"><string name="distribution" value="ggx"/>
+               <float name="alpha_u" value="0.1"/><float name="alpha_v" value="0.3"/>
+               <float name="int_ior" value="1.8"/><float name="ext_ior" value="1.2"/>
+               <boolean name="sample_visible" value="false"/></bsdf>
+               <bsdf type="roughdielectric" id="bk7"/>
+               <bsdf type="roughconductor" id="metal"><float name="eta" value="1.1"/>
+               <spectrum name="k" value="400:2, 700:3"/></bsdf>
+               <bsdf type="roughplastic" id="plastic"/>"#,
+        )
+        .unwrap();
+        match s.materials[0].bsdf.as_ref().map(MaterialBsdf::spec) {
+            Some(BsdfSpec::Dielectric(d)) => {
+                assert!((d.eta - 1.5).abs() < 1e-15, "{}", d.eta);
+                assert_eq!(d.sampling, BsdfSampling::Normals);
+                assert_eq!(d.masking, Masking::Uncorrelated);
+                assert_eq!(Some(&d.ndf), s.materials[0].model.as_ref());
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(
+            s.materials[1].bsdf.as_ref().and_then(|b| b.spec().eta()),
+            Some(MITSUBA_BK7_IOR / MITSUBA_AIR_IOR)
+        );
+        match s.materials[2].bsdf.as_ref().map(MaterialBsdf::spec) {
+            Some(BsdfSpec::Conductor(c)) => {
+                assert_eq!((c.n, c.k), (1.1, DEFAULT_CONDUCTOR_NK.1));
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(
+            s.not_audited[0].to_string().contains("`k`"),
+            "{:?}",
+            s.not_audited
+        );
+        assert_eq!(
+            s.materials[3].bsdf, None,
+            "roughplastic is no reference BSDF"
+        );
+    }
+
+    #[test]
+    fn bad_bsdf_values_name_the_mitsuba_property() {
+        for (xml, needles) in [
+            (
+                r#"<bsdf type="roughdielectric"><float name="int_ior" value="20"/></bsdf>"#,
+                &["t.xml:2:", "int_ior/ext_ior", "eta", "10"][..],
+            ),
+            (
+                r#"<bsdf type="roughdielectric"><float name="int_ior" value="1.0002"/><float name="ext_ior" value="1.0002"/></bsdf>"#,
+                &["int_ior/ext_ior"],
+            ),
+            (
+                r#"<bsdf type="roughdielectric"><string name="int_ior" value="bk7"/></bsdf>"#,
+                &["int_ior", "bk7", "<float>"],
+            ),
+            (
+                r#"<bsdf type="roughconductor"><float name="eta" value="-1"/></bsdf>"#,
+                &["roughconductor", "eta", "1e-3"],
+            ),
+            (
+                r#"<bsdf type="roughconductor"><float name="k" value="1000"/></bsdf>"#,
+                &["k", "100"],
+            ),
+        ] {
+            let e = scene(xml).unwrap_err().to_string();
+            for n in needles {
+                assert!(e.contains(n), "{xml}: {e} lacks {n}");
+            }
+        }
     }
 
     #[test]
@@ -653,21 +882,21 @@ mod tests {
         .unwrap();
         let aspect = (1.0f64 - 0.45).sqrt();
         match &s.materials[0].model {
-            ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
+            Some(ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
                 alpha_x: Some(x),
                 alpha_y: Some(y),
                 ..
-            }) => {
+            })) => {
                 assert!((x - 0.36 / aspect).abs() < 1e-15 && (y - 0.36 * aspect).abs() < 1e-15);
             }
             other => panic!("{other:?}"),
         }
         assert_eq!(
             s.materials[1].model,
-            ModelSpec::Gtr(mfh_reference::ndf::gtr::GtrSpec {
+            Some(ModelSpec::Gtr(mfh_reference::ndf::gtr::GtrSpec {
                 gamma: 1.0,
                 alpha: 0.1 - 0.099 * 0.5
-            })
+            }))
         );
         assert_eq!(s.not_audited.len(), 1);
     }
@@ -683,10 +912,10 @@ mod tests {
         assert_eq!(s.materials[0].name, "roughconductor@3:16");
         assert!(matches!(
             s.materials[0].model,
-            ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
+            Some(ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
                 alpha: Some(a),
                 ..
-            }) if a == 0.25
+            })) if a == 0.25
         ));
         let e = scene(r#"<bsdf type="roughconductor"><float name="alpha" value="$b"/></bsdf>"#)
             .unwrap_err()

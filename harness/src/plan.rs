@@ -6,6 +6,7 @@ use crate::check::{
     stability, Planned, PlannedCheck, Profile,
 };
 use crate::scene::{Sampling, Scene};
+use crate::subject::bsdf::BsdfSubject;
 use crate::subject::Subject;
 use mfh_reference::registry;
 use mfh_reference::{Masking, Model};
@@ -71,12 +72,28 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
     let mut std_alphas: Vec<f64> = Vec::new();
     let mut masked = Vec::new();
     for material in &scene.materials {
-        let Ok(model) = material.model.build() else {
+        // A material's BSDF plans the BSDF checks of that reference BSDF, and a BSDF-only
+        // material plans nothing else: the BSDF checks (chi-square over the whole sphere,
+        // sample consistency, albedo, reciprocity) exercise its NDF's D, G2 and sampler through
+        // the BSDF, while the NDF checks audit the NDF's closed forms against their documents,
+        // which a scene asks for by naming the NDF as `model` (with the masking and sampling
+        // the renderer evaluates), as the Mitsuba reader does for its rough BSDFs. Planning
+        // them implicitly would bill every BSDF material ≈ 60–190 NDF checks it did not ask for.
+        if let Some(bsdf) = &material.bsdf {
+            if let Ok(subject) = BsdfSubject::reference(&bsdf.spec()) {
+                let why = format!("material `{}` ({} BSDF)", material.name, subject.family());
+                out.extend(crate::check::bsdf::plan(&subject, profile, &why));
+            } // else: Scene::parse has rejected invalid BSDFs already.
+        }
+        let Some(spec) = &material.model else {
+            continue;
+        };
+        let Ok(model) = spec.build() else {
             continue; // Scene::parse has rejected invalid models already.
         };
         let model: Arc<dyn Model> = Arc::from(model);
         let subject = Subject::from_model(model.clone());
-        let info = registry::info(&material.model);
+        let info = registry::info(spec);
         let family = info.name;
         documents.extend(info.documents.iter().copied());
         let why = format!("material `{}` ({family})", material.name);
@@ -94,13 +111,13 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
             &format!("{why} evaluates D and Λ"),
         ));
         out.extend(stability::plan(
-            &material.model,
+            spec,
             &format!("{why}: its parameters pushed to the ends of their domains"),
         ));
         if material.sampling == Some(Sampling::PseudoVnis) {
             documents.insert("001");
             out.extend(sampling::plan_pseudo_vnis(
-                &material.model,
+                spec,
                 material.masking,
                 profile,
                 &format!("{why} samples (PseudoVnis)"),
@@ -122,7 +139,7 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
             ));
         }
         if info.beckmann_limit {
-            let spec = serde_json::to_value(&material.model).unwrap_or(Value::Null);
+            let spec = serde_json::to_value(spec).unwrap_or(Value::Null);
             if let Some(a) = spec.get("alpha").and_then(Value::as_f64) {
                 if !std_alphas.contains(&a) {
                     std_alphas.push(a);
@@ -158,7 +175,7 @@ pub fn plan(scene: &Scene, profile: Profile) -> Vec<Planned> {
 pub fn errata_scope(scene: &Scene) -> errata::Scope {
     let mut s = errata::Scope::default();
     for material in &scene.materials {
-        if let Ok(model) = material.model.build() {
+        if let Some(Ok(model)) = material.model.as_ref().map(|m| m.build()) {
             s.families.insert(model.family());
         }
         if material.masking.is_some() {
@@ -206,4 +223,59 @@ pub fn describe(plan: &[PlannedCheck<'_>]) -> Vec<Value> {
             })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::Profile;
+
+    /// A BSDF material plans the BSDF checks of its reference BSDF and no NDF check; a
+    /// material with a `model` beside its `bsdf` plans both.
+    #[test]
+    fn a_bsdf_material_plans_the_bsdf_checks() {
+        let glass = r#"{"type": "dielectric", "eta": 1.5, "ndf": {"family": "ggx", "alpha": 0.3}}"#;
+        let scene = Scene::parse(
+            &format!(r#"{{"name": "b", "materials": [{{"name": "glass", "bsdf": {glass}}}]}}"#),
+            "s",
+        )
+        .unwrap();
+        let planned = plan(&scene, Profile::Quick);
+        let ids: BTreeSet<&str> = planned.iter().map(|p| p.check.as_str()).collect();
+        for id in [
+            "bsdf.chi2",
+            "bsdf.sample_consistency",
+            "bsdf.albedo",
+            "bsdf.reciprocity",
+        ] {
+            assert!(ids.contains(id), "{id} not in {ids:?}");
+        }
+        let material: Vec<_> = planned
+            .iter()
+            .filter(|p| p.why.contains("material `glass`"))
+            .collect();
+        assert!(material.iter().all(|p| p.check.starts_with("bsdf.")));
+        assert!(
+            material[0].why.contains("dielectric BSDF"),
+            "{}",
+            material[0].why
+        );
+        // Both: the NDF checks of the model too.
+        let both = Scene::parse(
+            &format!(
+                r#"{{"name": "b", "materials": [{{"name": "glass", "bsdf": {glass},
+                   "model": {{"family": "ggx", "alpha": 0.3}}, "masking": "uncorrelated"}}]}}"#
+            ),
+            "s",
+        )
+        .unwrap();
+        let ids: BTreeSet<String> = plan(&both, Profile::Quick)
+            .into_iter()
+            .map(|p| p.check)
+            .collect();
+        assert!(
+            ids.contains("bsdf.chi2") && ids.contains("smith.g1_g2"),
+            "{ids:?}"
+        );
+    }
 }

@@ -3,6 +3,8 @@
 //! run, and the record it makes (a JSON object). No exit codes and no file writing here: the
 //! CLI (`cli/chi2.rs`) maps errors to exit codes and writes tables and heat maps.
 
+pub mod bsdf;
+
 use crate::oracle::chi2::{chi2_test_batch_in, Chi2Config, Chi2Result};
 use crate::tolerance::{CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE, MIN_EXPECTED};
 use mfh_reference::family::FamilySpec;
@@ -91,6 +93,9 @@ pub enum Chi2InputError {
     /// The `--model` text is not a valid model spec.
     #[error("--model: {0}")]
     Model(String),
+    /// The `--bsdf` text is not a valid reference BSDF spec (the message names the field).
+    #[error("--bsdf: {0}")]
+    Bsdf(String),
     /// The model has no sampler of the kind asked for.
     #[error("--sampling {sampling}: family `{family}` has no {what}; nothing to test")]
     NoSampler {
@@ -410,6 +415,7 @@ mod tests {
                 field
             }
             Chi2InputError::Model(_) => "--model",
+            Chi2InputError::Bsdf(_) => "--bsdf",
             Chi2InputError::NoSampler { .. } => "--sampling",
         }
     }

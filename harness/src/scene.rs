@@ -2,6 +2,10 @@
 //! incidence range), read from JSON with typed errors that carry the line and column, and the
 //! embedded default scene that covers every model of the source documents (ARCHITECTURE.md, "Scenes").
 
+mod bsdf;
+
+pub use bsdf::MaterialBsdf;
+
 use mfh_reference::{Masking, ModelSpec};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
@@ -35,14 +39,20 @@ pub enum Sampling {
     PseudoVnis,
 }
 
-/// One material.
+/// One material: an NDF (`model`, with what the renderer evaluates of it: `masking`,
+/// `sampling`), a reference BSDF (`bsdf`), or both (the Mitsuba reader's rough BSDFs). A
+/// material with both names the same NDF in each.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
     /// Its name in the scene.
     pub name: String,
-    /// The NDF.
-    pub model: ModelSpec,
+    /// The NDF, if the material plans NDF checks.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<ModelSpec>,
+    /// The reference BSDF, if the material plans BSDF checks.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bsdf: Option<MaterialBsdf>,
     /// The G2 form the renderer uses, if it masks.
     #[serde(default)]
     pub masking: Option<Masking>,
@@ -246,6 +256,18 @@ pub enum SceneError {
         /// Why the model cannot, naming the parameter and its limit.
         message: String,
     },
+    /// A material's BSDF is invalid, or contradicts the material's other fields.
+    #[error("{origin}: material `{name}`: {field}: {message}")]
+    InvalidBsdf {
+        /// The file.
+        origin: String,
+        /// The material.
+        name: String,
+        /// The field (`bsdf.eta`, `bsdf.ndf`, `model`, `masking`, …).
+        field: String,
+        /// What is wrong, naming the limit.
+        message: String,
+    },
     /// θ_max outside (0, π/2].
     #[error("{origin}: incidence.theta_max = {value} is not in (0, π/2]")]
     ThetaMax {
@@ -254,6 +276,56 @@ pub enum SceneError {
         /// The value.
         value: f64,
     },
+}
+
+impl Material {
+    /// The material's NDF: its `model`, else its BSDF's NDF (a valid material has one).
+    pub fn ndf(&self) -> Option<&ModelSpec> {
+        self.model
+            .as_ref()
+            .or_else(|| self.bsdf.as_ref().map(MaterialBsdf::ndf))
+    }
+
+    /// What is wrong with the material's BSDF, as `(field, message)`: neither `model` nor
+    /// `bsdf`; an invalid spec (the field and its limit); `masking` or `sampling` beside a
+    /// `bsdf` without a `model` (a BSDF carries its own); a `model` that is not the BSDF's NDF.
+    fn bsdf_error(&self) -> Option<(String, String)> {
+        let Some(bsdf) = &self.bsdf else {
+            return self.model.is_none().then(|| {
+                (
+                    "model".to_string(),
+                    "a material needs a `model` (an NDF) or a `bsdf` (a reference BSDF)".into(),
+                )
+            });
+        };
+        let spec = bsdf.spec();
+        if let Err(e) = spec.validate() {
+            return Some((format!("bsdf.{}", e.field()), e.to_string()));
+        }
+        if self.model.is_none() {
+            for (field, given) in [
+                ("masking", self.masking.is_some()),
+                ("sampling", self.sampling.is_some()),
+            ] {
+                if given {
+                    return Some((
+                        field.to_string(),
+                        format!(
+                            "a BSDF material gives its {field} inside `bsdf` (`bsdf.{field}`); \
+                             `{field}` beside it belongs to a `model`"
+                        ),
+                    ));
+                }
+            }
+        }
+        match &self.model {
+            Some(model) if model != spec.ndf() => Some((
+                "bsdf.ndf".to_string(),
+                "differs from the material's `model`: a material with both names one NDF".into(),
+            )),
+            _ => None,
+        }
+    }
 }
 
 impl Scene {
@@ -297,7 +369,19 @@ impl Scene {
                     name: m.name.clone(),
                 });
             }
-            if let Err(e) = m.model.build() {
+            if let Some(e) = m.bsdf_error() {
+                let (field, message) = e;
+                return Err(SceneError::InvalidBsdf {
+                    origin,
+                    name: m.name.clone(),
+                    field,
+                    message: crate::messages::compact_numbers(&message),
+                });
+            }
+            let Some(model) = &m.model else {
+                continue; // a BSDF material: its spec is checked above
+            };
+            if let Err(e) = model.build() {
                 return Err(SceneError::InvalidModel {
                     origin,
                     name: m.name.clone(),
@@ -311,7 +395,7 @@ impl Scene {
                 ("sampling", m.sampling == Some(Sampling::PseudoVnis)),
             ];
             for (field, needed) in needs_smith {
-                if let (true, Some(why)) = (needed, m.model.smith_limit()) {
+                if let (true, Some(why)) = (needed, model.smith_limit()) {
                     return Err(SceneError::Unsupported {
                         origin,
                         name: m.name.clone(),
@@ -354,7 +438,7 @@ impl Scene {
             if scene
                 .materials
                 .iter()
-                .any(|m| m.model.family() == family.name)
+                .any(|m| m.model.as_ref().is_some_and(|s| s.family() == family.name))
             {
                 continue;
             }
@@ -366,7 +450,8 @@ impl Scene {
                 name: format!("{} (registry example)", family.name),
                 masking: has_smith.then_some(Masking::HeightCorrelated),
                 sampling: built.as_sampler().map(|_| Sampling::Normals),
-                model,
+                model: Some(model),
+                bsdf: None,
             });
         }
         scene
@@ -381,8 +466,11 @@ mod tests {
     #[test]
     fn the_default_scene_parses_and_covers_every_family() {
         let s = Scene::default_scene();
-        let families: std::collections::BTreeSet<_> =
-            s.materials.iter().map(|m| m.model.family()).collect();
+        let families: std::collections::BTreeSet<_> = s
+            .materials
+            .iter()
+            .filter_map(|m| m.model.as_ref().map(|s| s.family()))
+            .collect();
         for f in mfh_reference::registry::FAMILIES.iter().map(|f| f.name) {
             assert!(families.contains(f), "{f} missing from the default scene");
         }
@@ -507,5 +595,72 @@ mod tests {
         assert_eq!(s.materials[0].masking, None);
         assert!(!s.lighting.spherical_gaussians && !s.filtering.gaussian_slopes);
         assert_eq!(s.incidence.theta_max, FRAC_PI_2);
+    }
+
+    const GLASS: &str =
+        r#"{"type": "dielectric", "eta": 1.5, "ndf": {"family": "ggx", "alpha": 0.3}}"#;
+
+    fn bsdf_scene(material: &str) -> String {
+        format!(r#"{{"name": "b", "materials": [{{"name": "glass", {material}}}]}}"#)
+    }
+
+    #[test]
+    fn a_material_may_name_a_reference_bsdf() {
+        let s = Scene::parse(&bsdf_scene(&format!(r#""bsdf": {GLASS}"#)), "s").unwrap();
+        let m = &s.materials[0];
+        assert_eq!(m.model, None);
+        assert_eq!(m.bsdf.as_ref().map(|b| b.spec().kind()), Some("dielectric"));
+        assert_eq!(m.ndf().map(ModelSpec::family), Some("ggx"));
+        // With its NDF as `model` too, masking and sampling describe the NDF.
+        let both = format!(
+            r#""model": {{"family": "ggx", "alpha": 0.3}}, "masking": "uncorrelated", "bsdf": {GLASS}"#
+        );
+        assert!(Scene::parse(&bsdf_scene(&both), "s").is_ok());
+    }
+
+    #[test]
+    fn bad_bsdf_materials_name_the_field() {
+        for (material, field, needles) in [
+            (
+                r#""bsdf": {"type": "dielectric", "eta": 20, "ndf": {"family": "ggx", "alpha": 0.3}}"#.to_string(),
+                "bsdf.eta",
+                &["[0.1, 10]", "`glass`"][..],
+            ),
+            (
+                r#""bsdf": {"type": "conductor", "n": 0.2, "k": 300, "ndf": {"family": "ggx", "alpha": 0.3}}"#.to_string(),
+                "bsdf.k",
+                &["100"],
+            ),
+            (
+                r#""bsdf": {"type": "conductor", "n": 0.2, "k": 3, "ndf": {"family": "std", "gamma": 1.2, "alpha": 0.3}}"#.to_string(),
+                "bsdf.ndf",
+                &["Smith"],
+            ),
+            (format!(r#""bsdf": {GLASS}, "masking": "uncorrelated""#), "masking", &["bsdf.masking"]),
+            (
+                format!(r#""bsdf": {GLASS}, "model": {{"family": "ggx", "alpha": 0.4}}"#),
+                "bsdf.ndf",
+                &["model"],
+            ),
+            (String::new(), "model", &["`bsdf`"]),
+        ] {
+            let text = bsdf_scene(&material).replace(", }", "}");
+            let e = Scene::parse(&text, "s.json").unwrap_err();
+            match &e {
+                SceneError::InvalidBsdf { field: f, .. } => assert_eq!(f, field, "{e}"),
+                other => panic!("{material}: {other:?}"),
+            }
+            let m = e.to_string();
+            assert!(m.contains(field), "{m}");
+            for n in needles {
+                assert!(m.contains(n), "{material}: {m} lacks {n}");
+            }
+        }
+        // An unknown BSDF type or key is a syntax error naming it, with its position.
+        let e = Scene::parse(&bsdf_scene(r#""bsdf": {"type": "plastic"}"#), "s.json").unwrap_err();
+        assert!(
+            matches!(e, SceneError::Syntax { .. }) && e.to_string().contains("plastic"),
+            "{e}"
+        );
     }
 }

@@ -349,3 +349,27 @@ fn a_long_chi2_on_a_terminal_shows_a_progress_bar() {
     assert_eq!(code, Some(0), "{terminal}");
     assert!(!terminal.contains("ETA"), "{terminal:?}");
 }
+
+#[test]
+fn eval_answers_bsdf_queries_and_exits_two_on_a_bad_spec() {
+    let glass = r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}"#;
+    let good = format!(
+        r#"{{"bsdf":{glass},"quantity":"bsdf_sample","wi":[0.6,0,0.8],"u":[0.7,0.3,0.6]}}"#
+    );
+    let out = mfh(&["eval"], &format!("{good}\n"));
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(text(&out.stdout).trim()).expect("JSON");
+    assert!(v["value"]["pdf"].as_f64().is_some_and(|p| p > 0.0), "{v}");
+    assert_eq!(v["value"]["wo"].as_array().map(Vec::len), Some(3), "{v}");
+    let bad = r#"{"bsdf":{"bsdf":"dielectric","eta":0.01,"ndf":{"family":"ggx","alpha":0.3}},"quantity":"bsdf_eval","wi":[0,0,1],"wo":[0,0,1]}"#;
+    let out = mfh(&["eval"], &format!("{good}\n{bad}\n"));
+    assert_eq!(out.status.code(), Some(2));
+    let stdout = text(&out.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 2, "{stdout}");
+    assert!(
+        lines[1].contains(r#""kind":"model""#) && lines[1].contains("eta"),
+        "{}",
+        lines[1]
+    );
+}

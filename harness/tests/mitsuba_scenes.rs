@@ -57,6 +57,16 @@ const EVERY_MATERIAL: &[&str] = &[
     "stability.extremes",
     "stability.incidence",
 ];
+/// The checks of a reference BSDF (roughconductor and roughdielectric name one, issue 25).
+const BSDF_CHECKS: &[&str] = &[
+    "bsdf.albedo",
+    "bsdf.chi2",
+    "bsdf.energy",
+    "bsdf.failure_rate",
+    "bsdf.reciprocity",
+    "bsdf.sample_consistency",
+    "bsdf.stability",
+];
 /// Certified double-double values of D and Λ: isotropic models only.
 const ISOTROPIC: &[&str] = &["precise.closed_form"];
 
@@ -75,11 +85,11 @@ fn conductor_plans_ggx_with_separable_masking_and_visible_normals() {
     assert_eq!(m.name, "gold");
     assert_eq!(
         m.model,
-        ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
+        Some(ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
             alpha: Some(0.2),
             alpha_x: None,
             alpha_y: None
-        })
+        }))
     );
     assert_eq!(m.masking, Some(Masking::Uncorrelated));
     assert_eq!(m.sampling, Some(Sampling::VisibleNormals));
@@ -90,7 +100,8 @@ fn conductor_plans_ggx_with_separable_masking_and_visible_normals() {
             ISOTROPIC,
             MASKING_CHECKS,
             NORMAL_SAMPLING,
-            VISIBLE_SAMPLING
+            VISIBLE_SAMPLING,
+            BSDF_CHECKS
         ])
     );
     // Errata and claims are planned only where they concern a family or effect the scene
@@ -109,6 +120,9 @@ fn conductor_plans_ggx_with_separable_masking_and_visible_normals() {
     assert_eq!(
         not_audited(&s),
         [
+            "not audited: roughconductor material (gold) the named material `Au` is not read \
+             (mfh has no table of Mitsuba's spectral indices): the BSDF is audited with n = 0.2, \
+             k = 3",
             "not audited: shape sphere (ball) is not a BSDF",
             "not audited: emitter constant (sky) is not a BSDF",
         ]
@@ -123,20 +137,22 @@ fn mixed_scene_walks_wrappers_params_and_refs_and_lists_the_rest() {
     // $dist = ggx, α_u = 0.05, α_v = $floor_alpha = 0.3; referenced twice, planned once.
     assert_eq!(
         s.materials[0].model,
-        ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
+        Some(ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
             alpha: None,
             alpha_x: Some(0.05),
             alpha_y: Some(0.3)
-        })
+        }))
     );
     // roughplastic's default distribution is Beckmann.
     assert_eq!(
         s.materials[1].model,
-        ModelSpec::Beckmann(mfh_reference::ndf::beckmann::BeckmannSpec {
-            alpha: Some(0.3),
-            alpha_x: None,
-            alpha_y: None
-        })
+        Some(ModelSpec::Beckmann(
+            mfh_reference::ndf::beckmann::BeckmannSpec {
+                alpha: Some(0.3),
+                alpha_x: None,
+                alpha_y: None
+            }
+        ))
     );
     assert_eq!(s.materials[2].sampling, Some(Sampling::Normals));
     assert!(s
@@ -145,7 +161,13 @@ fn mixed_scene_walks_wrappers_params_and_refs_and_lists_the_rest() {
         .all(|m| m.masking == Some(Masking::Uncorrelated)));
     assert_eq!(
         checks_of(&s, "leaf/leaf_glass"),
-        set(&[EVERY_MATERIAL, ISOTROPIC, MASKING_CHECKS, NORMAL_SAMPLING])
+        set(&[
+            EVERY_MATERIAL,
+            ISOTROPIC,
+            MASKING_CHECKS,
+            NORMAL_SAMPLING,
+            BSDF_CHECKS
+        ])
     );
     assert_eq!(
         checks_of(&s, "steel"),
@@ -153,7 +175,8 @@ fn mixed_scene_walks_wrappers_params_and_refs_and_lists_the_rest() {
             EVERY_MATERIAL,
             MASKING_CHECKS,
             NORMAL_SAMPLING,
-            VISIBLE_SAMPLING
+            VISIBLE_SAMPLING,
+            BSDF_CHECKS
         ])
     );
     let na = not_audited(&s);
@@ -186,11 +209,11 @@ fn anisotropic_principled_plans_its_ggx_lobe_and_gtr1_clear_coat() {
     let s = load("principled.xml");
     let aspect = (1.0f64 - 0.9 * 0.75).sqrt();
     match &s.materials[0].model {
-        ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
+        Some(ModelSpec::Ggx(mfh_reference::ndf::ggx::GgxSpec {
             alpha: None,
             alpha_x: Some(x),
             alpha_y: Some(y),
-        }) => {
+        })) => {
             assert!((x - 0.25 / aspect).abs() < 1e-15 && (y - 0.25 * aspect).abs() < 1e-15)
         }
         other => panic!("{other:?}"),
@@ -198,7 +221,7 @@ fn anisotropic_principled_plans_its_ggx_lobe_and_gtr1_clear_coat() {
     let cc = &s.materials[1];
     assert_eq!(cc.name, "car_paint/clearcoat");
     match cc.model {
-        ModelSpec::Gtr(mfh_reference::ndf::gtr::GtrSpec { gamma, alpha }) => {
+        Some(ModelSpec::Gtr(mfh_reference::ndf::gtr::GtrSpec { gamma, alpha })) => {
             assert_eq!(gamma, 1.0);
             assert!((alpha - 0.0604).abs() < 1e-15, "{alpha}");
         }
@@ -213,6 +236,7 @@ fn anisotropic_principled_plans_its_ggx_lobe_and_gtr1_clear_coat() {
             VISIBLE_SAMPLING
         ])
     );
+    // principled is no reference BSDF: no BSDF checks.
     // The clear coat samples normals and its masking (a GGX G1 at α = 0.25) is not audited.
     assert_eq!(
         checks_of(&s, "car_paint/clearcoat"),
@@ -275,10 +299,10 @@ fn plan_lists_not_audited_plugins_as_json_lines_and_in_the_table() {
         .iter()
         .filter(|l| l["not_audited"].is_object())
         .collect();
-    assert_eq!(na.len(), 2);
-    assert_eq!(na[0]["not_audited"]["id"], "ball");
+    assert_eq!(na.len(), 3);
+    assert_eq!(na[1]["not_audited"]["id"], "ball");
     assert_eq!(
-        na[0]["why"],
+        na[1]["why"],
         "not audited: shape sphere (ball) is not a BSDF"
     );
     let mut out = Vec::new();
@@ -291,19 +315,106 @@ fn plan_lists_not_audited_plugins_as_json_lines_and_in_the_table() {
     assert_eq!(code, 0);
     let table = String::from_utf8(out).unwrap();
     assert!(
-        table.contains("sampling.chi2_visible") && table.contains("2 not audited:"),
+        table.contains("sampling.chi2_visible")
+            && table.contains("bsdf.chi2")
+            && table.contains("3 not audited:"),
         "{table}"
     );
     assert_eq!(
         table
             .lines()
-            .filter(|l| l.contains("material `gold` (ggx)"))
+            .filter(|l| l.contains("material `gold` ("))
             .count(),
         lines.len()
-            - 2
+            - 3
             - plan(&load("conductor.xml"), Profile::Quick)
                 .iter()
                 .filter(|p| !p.why.contains("gold"))
                 .count()
     );
+}
+
+/// A scene file of `text` in the temp folder, with extension `ext`.
+fn temp_scene(name: &str, ext: &str, text: &str) -> PathBuf {
+    let path = std::env::temp_dir().join(format!(
+        "mfh-scene-bsdf-{name}-{}.{ext}",
+        std::process::id()
+    ));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// `mfh plan --scene path`: exit status, stdout, stderr.
+fn mfh_plan(path: &std::path::Path) -> (i32, String, String) {
+    let (mut out, mut err) = (Vec::new(), Vec::new());
+    let code = run(
+        ["mfh", "plan", "--scene", path.to_str().unwrap()],
+        &mut std::io::empty(),
+        &mut out,
+        &mut err,
+    );
+    (
+        code,
+        String::from_utf8(out).unwrap(),
+        String::from_utf8(err).unwrap(),
+    )
+}
+
+/// Issue 25: a JSON material's `bsdf` and a Mitsuba roughdielectric plan the BSDF checks
+/// (`bsdf.chi2` and the rest) through `mfh plan`; bad values exit 2 naming the field.
+#[test]
+fn json_and_mitsuba_bsdf_materials_plan_the_bsdf_checks() {
+    let json = temp_scene(
+        "glass",
+        "json",
+        r#"{"name": "glass", "materials": [{"name": "glass", "bsdf": {"type": "dielectric",
+            "eta": 1.5, "ndf": {"family": "ggx", "alpha": 0.3}}}]}"#,
+    );
+    let xml = temp_scene(
+        "glass",
+        "xml",
+        r#"<scene version="3.0.0"><bsdf type="roughdielectric" id="glass">
+           <string name="distribution" value="ggx"/><float name="alpha" value="0.3"/>
+           <float name="int_ior" value="1.5"/></bsdf></scene>"#,
+    );
+    for (path, ndf_checks) in [(&json, false), (&xml, true)] {
+        let (code, out, err) = mfh_plan(path);
+        assert_eq!(code, 0, "{path:?}: {err}");
+        let ids: BTreeSet<String> = out
+            .lines()
+            .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+            .filter_map(|v| v["check"].as_str().map(str::to_string))
+            .collect();
+        for id in BSDF_CHECKS {
+            assert!(ids.contains(*id), "{path:?}: {id} not planned: {ids:?}");
+        }
+        // The JSON material names only a BSDF; the Mitsuba one its NDF too.
+        assert_eq!(ids.contains("smith.g1_g2"), ndf_checks, "{path:?}: {ids:?}");
+    }
+    let bad_json = temp_scene(
+        "bad",
+        "json",
+        r#"{"name": "bad", "materials": [{"name": "glass", "bsdf": {"type": "dielectric",
+            "eta": 0.01, "ndf": {"family": "ggx", "alpha": 0.3}}}]}"#,
+    );
+    let bad_xml = temp_scene(
+        "bad",
+        "xml",
+        r#"<scene version="3.0.0"><bsdf type="roughdielectric" id="glass">
+           <string name="int_ior" value="water"/></bsdf></scene>"#,
+    );
+    for (path, needles) in [
+        (&bad_json, &["`glass`", "bsdf.eta", "[0.1, 10]"][..]),
+        (&bad_xml, &["int_ior", "water", "<float>"]),
+    ] {
+        let (code, out, err) = mfh_plan(path);
+        assert_eq!(code, 2, "{path:?}");
+        assert!(out.is_empty(), "{out}");
+        for n in needles {
+            assert!(err.contains(n), "{path:?}: {err} lacks {n}");
+        }
+    }
+    for p in [json, xml, bad_json, bad_xml] {
+        let _ = std::fs::remove_file(p);
+    }
 }

@@ -14,8 +14,20 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Args)]
 pub struct Chi2Args {
     /// The model spec as JSON text, e.g. '{"family":"ggx","alpha":0.3}'.
-    #[arg(long, required_unless_present = "cmd", conflicts_with = "cmd")]
+    #[arg(
+        long,
+        required_unless_present_any = ["cmd", "bsdf"],
+        conflicts_with_all = ["cmd", "bsdf"]
+    )]
     pub model: Option<String>,
+    /// Test a reference BSDF's sampling over the whole sphere instead: its spec as JSON text,
+    /// e.g. '{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}', at
+    /// --incidence (default 0.5) and --azimuth, from above (or --inside).
+    #[arg(long, conflicts_with = "cmd")]
+    pub bsdf: Option<String>,
+    /// With --bsdf: the incidence comes from inside (below the surface, z < 0).
+    #[arg(long)]
+    pub inside: bool,
     /// Test an implementation in any language instead: the command that starts it (run with
     /// `sh -c`, speaking the external protocol, see `mfh audit-external`), e.g.
     /// "python3 examples/external/ggx.py".
@@ -47,10 +59,11 @@ pub struct Chi2Args {
     /// the incidence).
     #[arg(long, value_enum, default_value = "normals")]
     pub sampling: SamplingArg,
-    /// The incidence θi in radians, in [0, π/2) (visible normals only; default 0.5).
+    /// The incidence θi in radians from the normal, in [0, π/2) (visible normals or --bsdf
+    /// only; default 0.5).
     #[arg(long, allow_negative_numbers = true)]
     pub incidence: Option<f64>,
-    /// The incidence azimuth φi in radians (visible normals only; default 0).
+    /// The incidence azimuth φi in radians (visible normals or --bsdf only; default 0).
     #[arg(long, allow_negative_numbers = true)]
     pub azimuth: Option<f64>,
     /// No progress bar (it is shown only when standard error is a terminal anyway).
@@ -59,7 +72,7 @@ pub struct Chi2Args {
 }
 
 /// Prints a bad-input message; the exit status 2.
-fn bad(stderr: &mut dyn Write, message: String) -> i32 {
+pub(super) fn bad(stderr: &mut dyn Write, message: String) -> i32 {
     let _ = writeln!(stderr, "mfh chi2: {message}");
     EXIT_BAD_INPUT
 }
@@ -85,6 +98,12 @@ pub fn run(args: Chi2Args, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
         Ok(seed) => seed,
         Err(e) => return bad(stderr, e),
     };
+    if let Some(bsdf) = args.bsdf.clone() {
+        return super::chi2_bsdf::run(&args, bsdf, seed, stdout, stderr);
+    }
+    if args.inside {
+        return bad(stderr, "--inside only applies with --bsdf".into());
+    }
     if let Some(cmd) = args.cmd.clone() {
         return run_external(&args, &cmd, seed, stdout, stderr);
     }
@@ -584,5 +603,108 @@ mod tests {
             "0",
         ]);
         assert_eq!(code, 2);
+    }
+
+    const GLASS: &str = r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.4}}"#;
+
+    /// Issue 25: `--bsdf` runs the whole-sphere chi-square of a reference BSDF, from inside
+    /// with `--inside`, and writes both hemispheres' tables and heat maps with `--out`.
+    #[test]
+    fn chi2_cli_bsdf_over_the_sphere_with_tables() {
+        let dir = std::env::temp_dir().join(format!("mfh-chi2-bsdf-{}", std::process::id()));
+        let (code, out, err) = run_args(&[
+            "chi2",
+            "--bsdf",
+            GLASS,
+            "--incidence",
+            "0.7",
+            "--inside",
+            "--samples",
+            "100000",
+            "--resolution",
+            "8",
+            "--seed",
+            "3",
+            "--json",
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{out}{err}");
+        let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+        assert_eq!(v["verdict"], "pass", "{v}");
+        assert_eq!(v["incidence"]["inside"], true);
+        assert!(v["incidence"]["wi"][2].as_f64().unwrap() < 0.0, "{v}");
+        assert!(v["dof"].as_u64().unwrap() > 1, "{v}");
+        for name in ["upper_chi2_observed.json", "lower_chi2_expected.json"] {
+            assert!(dir.join(name).exists(), "{name}");
+        }
+        let listed = v["artefacts"].as_array().unwrap();
+        assert!(listed.len() >= 4, "{listed:?}");
+        let _ = std::fs::remove_dir_all(&dir);
+        // The text summary, from outside.
+        let (code, out, err) = run_args(&[
+            "chi2",
+            "--bsdf",
+            r#"{"bsdf":"conductor","n":0.2,"k":3,"ndf":{"family":"beckmann","alpha":0.3}}"#,
+            "--samples",
+            "50000",
+            "--resolution",
+            "6",
+        ]);
+        assert_eq!(code, 0, "{out}{err}");
+        for text in ["verdict pass", "from outside", "reproduce: mfh chi2 --bsdf"] {
+            assert!(out.contains(text), "{out} lacks {text}");
+        }
+    }
+
+    /// `--bsdf`'s options are validated as the NDF path's: exit 2 naming the option.
+    #[test]
+    fn chi2_cli_bsdf_bad_input_names_the_option() {
+        let bad_eta = r#"{"bsdf":"dielectric","eta":20,"ndf":{"family":"ggx","alpha":0.4}}"#;
+        for (args, names) in [
+            (
+                vec!["--bsdf", GLASS, "--incidence", "2"],
+                vec!["--incidence", "--inside"],
+            ),
+            (
+                vec!["--bsdf", GLASS, "--incidence", "-0.1"],
+                vec!["--incidence"],
+            ),
+            (
+                vec!["--bsdf", GLASS, "--azimuth", "nan"],
+                vec!["--azimuth", "finite"],
+            ),
+            (
+                vec!["--bsdf", GLASS, "--samples", "1", "--resolution", "4"],
+                vec!["--samples", "at least 320"],
+            ),
+            (
+                vec!["--bsdf", GLASS, "--resolution", "1000"],
+                vec!["--resolution", "512"],
+            ),
+            (vec!["--bsdf", GLASS, "--alpha", "2"], vec!["--alpha"]),
+            (vec!["--bsdf", bad_eta], vec!["--bsdf", "eta", "[0.1, 10]"]),
+            (vec!["--bsdf", "not json"], vec!["--bsdf"]),
+            (
+                vec!["--bsdf", GLASS, "--sampling", "visible"],
+                vec!["--sampling"],
+            ),
+            (
+                vec!["--model", r#"{"family":"ggx","alpha":0.3}"#, "--inside"],
+                vec!["--inside", "--bsdf"],
+            ),
+        ] {
+            let mut all = vec!["chi2"];
+            all.extend(args.iter().copied());
+            let (code, out, err) = run_args(&all);
+            assert_eq!(code, 2, "{args:?}: {out}{err}");
+            assert!(out.is_empty(), "{args:?}: {out}");
+            for n in names {
+                assert!(err.contains(n), "{args:?}: {err:?} lacks {n:?}");
+            }
+        }
+        // --bsdf with --model: clap's conflict, exit 2.
+        let (code, _, err) = run_args(&["chi2", "--bsdf", GLASS, "--model", "{}"]);
+        assert_eq!(code, 2, "{err}");
     }
 }

@@ -7,6 +7,7 @@
 
 pub mod audit;
 pub mod chi2;
+pub mod chi2_bsdf;
 pub mod cost;
 pub mod eval;
 pub mod external;

@@ -63,14 +63,19 @@ impl Selection {
     };
 
     /// What a scene uses: the families of its materials (a Student-family material with
-    /// masking selects the STD Λ routes), its lighting effects; the oracles always.
+    /// masking, or a BSDF on one, which masks with G2, selects the STD Λ routes), its lighting
+    /// effects; the oracles always.
     pub fn of_scene(scene: &crate::scene::Scene) -> Selection {
-        let families: Vec<&str> = scene.materials.iter().map(|m| m.model.family()).collect();
+        let families: Vec<&str> = scene
+            .materials
+            .iter()
+            .filter_map(|m| m.ndf().map(|s| s.family()))
+            .collect();
         let masks = |f: &[&str]| {
-            scene
-                .materials
-                .iter()
-                .any(|m| f.contains(&m.model.family()) && m.masking.is_some())
+            scene.materials.iter().any(|m| {
+                m.ndf().is_some_and(|s| f.contains(&s.family()))
+                    && (m.masking.is_some() || m.bsdf.is_some())
+            })
         };
         Selection {
             student: masks(&[

@@ -5,6 +5,7 @@
 //! and `"nan"` (Λ at grazing incidence is +∞).
 
 mod args;
+pub mod bsdf;
 mod ndf;
 pub mod sg;
 
@@ -169,15 +170,21 @@ pub fn evaluate(line: &str) -> Result<Value, EvalError> {
     let obj = query
         .as_object()
         .ok_or_else(|| EvalError::Parse("a query must be a JSON object".into()))?;
-    // Spherical-Gaussian quantities (seed 003) take no "model": see [`sg`].
+    // Spherical-Gaussian quantities (seed 003) take no "model": see [`sg`]; nor do the BSDF
+    // quantities, which take a "bsdf" spec: see [`bsdf`].
     if let Some(quantity) = obj.get("quantity").and_then(Value::as_str) {
-        if let Some(known) = sg::arguments(quantity) {
+        if let Some(known) = bsdf::arguments(quantity) {
+            check_keys(obj, quantity, &["bsdf", "quantity", "route"], known)?;
+        } else if let Some(known) = sg::arguments(quantity) {
             check_keys(obj, quantity, &["quantity", "route"], known)?;
         } else if let Some(known) = arguments(quantity) {
             check_keys(obj, quantity, &["model", "quantity", "route"], known)?;
         }
         let route = obj.get("route").and_then(Value::as_str);
         if let Some(answer) = sg::evaluate(quantity, obj, route) {
+            return answer;
+        }
+        if let Some(answer) = bsdf::evaluate(quantity, obj, route) {
             return answer;
         }
     }

@@ -197,9 +197,11 @@ pub(crate) fn evaluate_quantity(
             }))
         }
         other => Err(EvalError::Argument(format!(
-            "unknown quantity {other:?} (known: {}, and the SG/ASG quantities {})",
+            "unknown quantity {other:?} (known: {}, the SG/ASG quantities {} and the BSDF \
+             quantities {})",
             QUANTITIES.join(", "),
-            super::sg::QUANTITIES.join(", ")
+            super::sg::QUANTITIES.join(", "),
+            super::bsdf::QUANTITIES.join(", ")
         ))),
     }
 }

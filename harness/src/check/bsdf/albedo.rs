@@ -119,8 +119,8 @@ pub fn plan<'a>(
             .why(format!("{why}: the BSDF conserves energy"))
             .covers(vec![covers(family, "bsdf_eval", "energy")])
             .run(move |r, _| {
+                // ∫ eval's evaluations are billed to bsdf.albedo ([`super::Integrals`]).
                 let quad = integrals.albedo(s.bsdf.as_ref());
-                r.cost.evaluations += quad.evaluations;
                 r.value = Some(quad.value);
                 r.oracle = Some(OracleValue {
                     value: 1.0,

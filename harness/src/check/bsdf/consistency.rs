@@ -116,7 +116,7 @@ pub fn plan<'a>(
             let failed: u64 = parts.iter().map(|w| w.failed).sum();
             let mass = shared.pdf_mass(bsdf);
             r.cost.samples = n;
-            r.cost.evaluations += mass.evaluations;
+            // The masses' evaluations are billed to bsdf.chi2 ([`Integrals`]).
             judge_rate(r, failed, n, mass);
             Ok(())
         });

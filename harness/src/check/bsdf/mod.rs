@@ -162,6 +162,11 @@ pub fn fold_samples<A: Send>(
 /// whichever check needs it first (the others wait for it): the pdf's cell masses (the
 /// chi-square's expected counts and the failure rate's 1 − ∫ pdf) and ∫ eval (the albedo and
 /// the energy). Each is an adaptive cubature of a BSDF with kinks, seconds of work.
+///
+/// Their evaluations are reported whoever computed them, and each is billed to one designated
+/// record: the pdf masses to `bsdf.chi2`, ∫ eval to `bsdf.albedo` (`bsdf.failure_rate` and
+/// `bsdf.energy` add none). Billing the first caller made a record's cost depend on the order
+/// the checks ran in, so a sharded audit's records differed from the unsharded ones.
 pub struct Integrals {
     wi: Vec3,
     samples: u64,
@@ -181,16 +186,15 @@ impl Integrals {
     }
 
     /// The pdf's masses over the cells of both hemispheres (upper, lower) on the chi-square's
-    /// grid, to the [`mass_target`] of its samples, and the evaluations they cost (counted once).
+    /// grid, to the [`mass_target`] of its samples, and the evaluations they cost.
     pub fn pdf_masses(&self, bsdf: &dyn Bsdf) -> (&(Expected, Expected), u64) {
-        let mut spent = 0;
         let masses = self.pdf.get_or_init(|| {
             let grid = HemisphereGrid::new(chi2::RESOLUTION).expect("R ≥ 1");
             let e = expected_sphere(&pdf_at(bsdf, self.wi), grid, mass_target(self.samples));
-            spent = e.0.evaluations + e.1.evaluations;
+            let spent = e.0.evaluations + e.1.evaluations;
             (e, spent)
         });
-        (&masses.0, spent)
+        (&masses.0, masses.1)
     }
 
     /// ∫ pdf dωo with its error bound.
@@ -203,12 +207,10 @@ impl Integrals {
         }
     }
 
-    /// ∫ eval dωo (the albedo) with its error bound, on the same grid and tolerance (evaluations
-    /// counted by the first caller only).
+    /// ∫ eval dωo (the albedo) with its error bound and the evaluations it cost, on the same
+    /// grid and tolerance.
     pub fn albedo(&self, bsdf: &dyn Bsdf) -> Estimate {
-        let mut first = false;
-        let mut e = *self.eval.get_or_init(|| {
-            first = true;
+        *self.eval.get_or_init(|| {
             let grid = HemisphereGrid::new(chi2::RESOLUTION).expect("R ≥ 1");
             let (u, l) = expected_sphere(&eval_at(bsdf, self.wi), grid, mass_target(self.samples));
             Estimate {
@@ -216,11 +218,7 @@ impl Integrals {
                 error_bound: u.error_bound + l.error_bound,
                 evaluations: u.evaluations + l.evaluations,
             }
-        });
-        if !first {
-            e.evaluations = 0;
-        }
-        e
+        })
     }
 }
 
