@@ -170,48 +170,71 @@ pub fn observe_sphere(
     seed: u64,
 ) -> SphereObserved {
     let finder = CellFinder::new(grid);
-    let chunks = samples.div_ceil(CHUNK);
-    (0..chunks)
+    // Each chunk's counts with its buffer of sampled directions (reused block to block).
+    draw_chunks(
+        samples,
+        seed,
+        || (SphereObserved::zero(grid.cells()), Vec::new()),
+        |(obs, out), index, u| {
+            out.clear();
+            out.resize(u.len(), None);
+            sample(u, out);
+            for (k, wo) in out.iter().enumerate() {
+                let Some(w) = *wo else {
+                    obs.failed += 1;
+                    continue;
+                };
+                let (cells, mirrored) = if w[2] >= 0.0 {
+                    (&mut obs.upper, w)
+                } else {
+                    (&mut obs.lower, [w[0], w[1], -w[2]])
+                };
+                match finder.cell_of(mirrored) {
+                    Ok(c) => cells[c] += 1,
+                    Err(_) => {
+                        obs.invalid += 1;
+                        if obs.first_invalid.is_none() {
+                            obs.first_invalid = Some((index + k as u64, w));
+                        }
+                    }
+                }
+            }
+        },
+    )
+    .into_iter()
+    .fold(SphereObserved::zero(grid.cells()), |a, (b, _)| a.merge(b))
+}
+
+/// The u ∈ [0, 1)³ of `samples` samples from the streams of `seed` (three uniforms a sample,
+/// one stream per chunk of [`CHUNK`] samples), handed to `block(acc, first index, u)` a block
+/// of at most 1024 at a time, the chunks in parallel, each folded into its own accumulator;
+/// the accumulators in chunk order (so a result folded from them does not depend on the
+/// thread count). The one sampling loop of the BSDF's chi-square and of the BSDF checks.
+pub fn draw_chunks<A: Send>(
+    samples: u64,
+    seed: u64,
+    init: impl Fn() -> A + Sync,
+    block: impl Fn(&mut A, u64, &[[f64; 3]]) + Sync,
+) -> Vec<A> {
+    (0..samples.div_ceil(CHUNK))
         .into_par_iter()
         .map(|chunk| {
             let mut rng = stream(seed, chunk);
-            let mut obs = SphereObserved::zero(grid.cells());
+            let mut acc = init();
             let (start, end) = (chunk * CHUNK, ((chunk + 1) * CHUNK).min(samples));
             let mut u = vec![[0.0; 3]; BLOCK];
-            let mut out = vec![None; BLOCK];
             let mut index = start;
             while index < end {
                 let n = BLOCK.min((end - index) as usize);
                 for v in &mut u[..n] {
                     *v = [rng.uniform(), rng.uniform(), rng.uniform()];
                 }
-                out[..n].iter_mut().for_each(|o| *o = None);
-                sample(&u[..n], &mut out[..n]);
-                for (k, wo) in out[..n].iter().enumerate() {
-                    let Some(w) = *wo else {
-                        obs.failed += 1;
-                        continue;
-                    };
-                    let (cells, mirrored) = if w[2] >= 0.0 {
-                        (&mut obs.upper, w)
-                    } else {
-                        (&mut obs.lower, [w[0], w[1], -w[2]])
-                    };
-                    match finder.cell_of(mirrored) {
-                        Ok(c) => cells[c] += 1,
-                        Err(_) => {
-                            obs.invalid += 1;
-                            if obs.first_invalid.is_none() {
-                                obs.first_invalid = Some((index + k as u64, w));
-                            }
-                        }
-                    }
-                }
+                block(&mut acc, index, &u[..n]);
                 index += n as u64;
             }
-            obs
+            acc
         })
-        .reduce(|| SphereObserved::zero(grid.cells()), SphereObserved::merge)
+        .collect()
 }
 
 /// The summed error bound the expected masses of one hemisphere aim at for `samples` samples:

@@ -30,21 +30,16 @@ pub use chi2::RESOLUTION as CHI2_RESOLUTION;
 use super::{PlannedCheck, Profile};
 use crate::oracle::chi2::Expected;
 use crate::oracle::domain::HemisphereGrid;
-use crate::oracle::sphere_chi2::{expected_sphere, mass_target};
+use crate::oracle::sphere_chi2::{draw_chunks, expected_sphere, mass_target};
 use crate::oracle::Estimate;
-use crate::random::stream;
 use crate::subject::bsdf::BsdfSubject;
 use mfh_reference::bsdf::{Bsdf, BsdfSample};
 use mfh_reference::geometry::Vec3;
-use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::sync::{Arc, OnceLock};
 
 /// The source every BSDF check cites.
 pub const SOURCE: &str = "Walter et al. 2007 (seed 001 [13]) eq 13–23; Walter §5.3 (sampling)";
-
-/// Samples per random stream of the BSDF checks.
-const CHUNK: u64 = 1 << 16;
 
 /// An incidence at which the direction-dependent checks run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -131,31 +126,13 @@ pub fn fold_samples<A: Send>(
     init: impl Fn() -> A + Sync,
     push: impl Fn(&mut A, u64, [f64; 3], Option<BsdfSample>) + Sync,
 ) -> Vec<A> {
-    const BLOCK: usize = 1024;
-    (0..samples.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|chunk| {
-            let mut rng = stream(seed, chunk);
-            let mut acc = init();
-            let (start, end) = (chunk * CHUNK, ((chunk + 1) * CHUNK).min(samples));
-            let mut u = vec![[0.0; 3]; BLOCK];
-            let mut out = vec![None; BLOCK];
-            let mut index = start;
-            while index < end {
-                let n = BLOCK.min((end - index) as usize);
-                for v in &mut u[..n] {
-                    *v = [rng.uniform(), rng.uniform(), rng.uniform()];
-                }
-                out[..n].iter_mut().for_each(|o| *o = None);
-                bsdf.sample_batch(wi, &u[..n], &mut out[..n]);
-                for k in 0..n {
-                    push(&mut acc, index + k as u64, u[k], out[k]);
-                }
-                index += n as u64;
-            }
-            acc
-        })
-        .collect()
+    draw_chunks(samples, seed, init, |acc, index, u| {
+        let mut out = vec![None; u.len()];
+        bsdf.sample_batch(wi, u, &mut out);
+        for (k, (&u, s)) in u.iter().zip(out).enumerate() {
+            push(acc, index + k as u64, u, s);
+        }
+    })
 }
 
 /// The integrals over the sphere that the checks of one incidence share, each computed once by
