@@ -34,8 +34,14 @@ INPUTS = {
     "pdf_wm": (("m", 3),),
     "sample_wm_visible": (("wi", 3), ("u", 2)),
     "pdf_wm_visible": (("wi", 3), ("m", 3)),
+    "bsdf_eval": (("wi", 3), ("wo", 3)),
+    "bsdf_pdf": (("wi", 3), ("wo", 3)),
+    "bsdf_sample": (("wi", 3), ("u", 3)),
 }
 SAMPLING = ("sample_wm", "sample_wm_visible")
+# A BSDF sample answers three arrays: the direction, its density and its weight eval/pdf (a
+# failed sample: pdf 0, weight 0, any finite wo). The model's function returns the triple.
+BSDF_SAMPLE = (("wo", 3), ("pdf", 1), ("weight", 1))
 BIG_ENDIAN = sys.byteorder == "big"
 
 
@@ -51,8 +57,26 @@ def options(argv=None):
     return ax, ay, protocol
 
 
+def _apply(job):
+    """A worker's share of a batch (module level, so that a pool can call it)."""
+    function, rows, extra = job
+    return [function(*row, *extra) for row in rows]
+
+
 class PurePython:
-    """Arrays as lists of tuples; the model's functions take one item at a time."""
+    """Arrays as lists of tuples; the model's functions take one item at a time. With
+    workers > 1, batches of at least MIN_SPLIT items are split among that many forked
+    processes (pure Python is one core per process)."""
+
+    MIN_SPLIT = 2048
+
+    def __init__(self, workers=1):
+        self.pool = None
+        if workers > 1:
+            import multiprocessing
+
+            self.pool = multiprocessing.get_context("fork").Pool(workers)
+            self.workers = workers
 
     @staticmethod
     def decode(field, width):
@@ -63,9 +87,18 @@ class PurePython:
             a.byteswap()
         return list(zip(*(a[k::width] for k in range(width))))
 
+    def call(self, function, arrays, extra):
+        rows = list(zip(*arrays))
+        if self.pool is None or len(rows) < self.MIN_SPLIT:
+            return [function(*row, *extra) for row in rows]
+        step = -(-len(rows) // self.workers)
+        jobs = [(function, rows[k:k + step], extra) for k in range(0, len(rows), step)]
+        return list(chain.from_iterable(self.pool.map(_apply, jobs)))
+
     @staticmethod
-    def call(function, arrays, extra):
-        return [function(*row, *extra) for row in zip(*arrays)]
+    def columns(result, k):
+        """The k columns of a list of k-tuples."""
+        return [list(c) for c in zip(*result)] if result else [[] for _ in range(k)]
 
     @staticmethod
     def encode(result, width, version):
@@ -94,6 +127,11 @@ class Numpy:
     def call(function, arrays, extra):
         return function(*arrays, *extra)
 
+    @staticmethod
+    def columns(result, k):
+        """A numpy function answers a tuple of k arrays already."""
+        return result
+
     def encode(self, result, width, version):
         if version == 1:
             return result.tolist()
@@ -113,6 +151,10 @@ def answer(request, describe, functions, codec, version):
     result = codec.call(functions[op], arrays, extra)
     if op in SAMPLING:
         return {"m": codec.encode(result, 3, version)}
+    if op == "bsdf_sample":
+        columns = codec.columns(result, len(BSDF_SAMPLE))
+        return {name: codec.encode(column, width, version)
+                for (name, width), column in zip(BSDF_SAMPLE, columns)}
     return {"values": codec.encode(result, 1, version)}
 
 
@@ -128,14 +170,17 @@ def encode_line(reply):
     return b"".join(parts)
 
 
-def serve(name, parameters, functions, protocol=VERSIONS[-1], numpy=False):
+def serve(name, parameters, functions, protocol=VERSIONS[-1], numpy=False, extra=None,
+          workers=1):
     """Answers mfh's requests on stdin until `shutdown` or end of input.
 
     functions: op name -> function (its capabilities, in the order given). Pure Python: called
     per item with tuples; numpy=True: called per batch with (n, 3) or (n, 2) arrays, returning
-    an (n,) or (n, 3) array. protocol: the newest version to speak."""
-    codec = Numpy() if numpy else PurePython()
-    describe = {"name": name, "parameters": parameters}
+    an (n,) or (n, 3) array (bsdf_sample: a (wo, pdf, weight) triple per item, or of arrays).
+    protocol: the newest version to speak. extra: more fields of the describe answer (a BSDF's
+    "eta" and "transport"). workers: processes sharing large pure-Python batches."""
+    codec = Numpy() if numpy else PurePython(workers)
+    describe = dict(extra or {}, name=name, parameters=parameters)
     version = 1
     out = sys.stdout.buffer
     for line in sys.stdin.buffer:

@@ -131,7 +131,10 @@ pub fn fold_samples<A: Send>(
     init: impl Fn() -> A + Sync,
     push: impl Fn(&mut A, u64, [f64; 3], Option<BsdfSample>) + Sync,
 ) -> Vec<A> {
-    const BLOCK: usize = 1024;
+    // Samples handed to the BSDF at once: large enough that an external BSDF answers few
+    // requests (one round trip per 16 384, which a child may share among its processes);
+    // the results do not depend on it.
+    const BLOCK: usize = 1 << 14;
     (0..samples.div_ceil(CHUNK))
         .into_par_iter()
         .map(|chunk| {
