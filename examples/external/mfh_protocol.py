@@ -57,10 +57,39 @@ def options(argv=None):
     return ax, ay, protocol
 
 
-def _apply(job):
-    """A worker's share of a batch (module level, so that a pool can call it)."""
-    function, rows, extra = job
-    return [function(*row, *extra) for row in rows]
+def outputs(op):
+    """The answer arrays of op: (name, numbers per item)."""
+    if op in SAMPLING:
+        return (("m", 3),)
+    if op == "bsdf_sample":
+        return BSDF_SAMPLE
+    return (("values", 1),)
+
+
+def _part(job):
+    """A worker's share of a version-2 batch (module level, so that a pool can call it): the
+    raw little-endian f64 bytes of each request array in, those of each answer array out (bytes
+    travel between processes far cheaper than lists of tuples)."""
+    function, op, raws, extra = job
+    columns = []
+    for raw, width in raws:
+        a = array("d", raw)
+        if BIG_ENDIAN:
+            a.byteswap()
+        columns.append(list(zip(*(a[k::width] for k in range(width)))) if width > 1 else a)
+    result = [function(*row, *extra) for row in zip(*columns)]
+    names = outputs(op)
+    if len(names) > 1:
+        result = PurePython.columns(result, len(names))
+    else:
+        result = [result]
+    out = []
+    for column, (_, width) in zip(result, names):
+        a = array("d", chain.from_iterable(column) if width > 1 else column)
+        if BIG_ENDIAN:
+            a.byteswap()
+        out.append(a.tobytes())
+    return out
 
 
 class PurePython:
@@ -87,13 +116,26 @@ class PurePython:
             a.byteswap()
         return list(zip(*(a[k::width] for k in range(width))))
 
-    def call(self, function, arrays, extra):
-        rows = list(zip(*arrays))
-        if self.pool is None or len(rows) < self.MIN_SPLIT:
-            return [function(*row, *extra) for row in rows]
-        step = -(-len(rows) // self.workers)
-        jobs = [(function, rows[k:k + step], extra) for k in range(0, len(rows), step)]
-        return list(chain.from_iterable(self.pool.map(_apply, jobs)))
+    @staticmethod
+    def call(function, arrays, extra):
+        return [function(*row, *extra) for row in zip(*arrays)]
+
+    def split(self, op, function, request, extra):
+        """The answer of a large version-2 request computed by the workers, or None (no pool,
+        a small batch, or JSON arrays)."""
+        fields = [(request[name], width) for name, width in INPUTS[op]]
+        if self.pool is None or not all(isinstance(f, str) for f, _ in fields):
+            return None
+        raws = [(base64.b64decode(f), width) for f, width in fields]
+        n = len(raws[0][0]) // (8 * raws[0][1])
+        if n < self.MIN_SPLIT or any(len(r) != 8 * w * n for r, w in raws):
+            return None
+        step = -(-n // self.workers)
+        jobs = [(function, op, [(r[8 * w * k:8 * w * (k + step)], w) for r, w in raws], extra)
+                for k in range(0, n, step)]
+        parts = self.pool.map(_part, jobs)
+        return {name: base64.b64encode(b"".join(p[j] for p in parts))
+                for j, (name, _) in enumerate(outputs(op))}
 
     @staticmethod
     def columns(result, k):
@@ -146,8 +188,12 @@ def answer(request, describe, functions, codec, version):
         return dict(describe, protocol=version, capabilities=list(functions))
     if op not in functions:
         return {"error": "unknown op " + repr(op)}
-    arrays = [codec.decode(request[name], width) for name, width in INPUTS[op]]
     extra = [request["masking"]] if op == "g2" else []
+    if version == 2 and isinstance(codec, PurePython):
+        shared = codec.split(op, functions[op], request, extra)
+        if shared is not None:
+            return shared
+    arrays = [codec.decode(request[name], width) for name, width in INPUTS[op]]
     result = codec.call(functions[op], arrays, extra)
     if op in SAMPLING:
         return {"m": codec.encode(result, 3, version)}
