@@ -34,8 +34,14 @@ INPUTS = {
     "pdf_wm": (("m", 3),),
     "sample_wm_visible": (("wi", 3), ("u", 2)),
     "pdf_wm_visible": (("wi", 3), ("m", 3)),
+    "bsdf_eval": (("wi", 3), ("wo", 3)),
+    "bsdf_pdf": (("wi", 3), ("wo", 3)),
+    "bsdf_sample": (("wi", 3), ("u", 3)),
 }
 SAMPLING = ("sample_wm", "sample_wm_visible")
+# A BSDF sample answers three arrays: the direction, its density and its weight eval/pdf (a
+# failed sample: pdf 0, weight 0, any finite wo). The model's function returns the triple.
+BSDF_SAMPLE = (("wo", 3), ("pdf", 1), ("weight", 1))
 BIG_ENDIAN = sys.byteorder == "big"
 
 
@@ -51,8 +57,55 @@ def options(argv=None):
     return ax, ay, protocol
 
 
+def outputs(op):
+    """The answer arrays of op: (name, numbers per item)."""
+    if op in SAMPLING:
+        return (("m", 3),)
+    if op == "bsdf_sample":
+        return BSDF_SAMPLE
+    return (("values", 1),)
+
+
+def _part(job):
+    """A worker's share of a version-2 batch (module level, so that a pool can call it): the
+    raw little-endian f64 bytes of each request array in, those of each answer array out (bytes
+    travel between processes far cheaper than lists of tuples)."""
+    function, op, raws, extra = job
+    columns = []
+    for raw, width in raws:
+        a = array("d", raw)
+        if BIG_ENDIAN:
+            a.byteswap()
+        columns.append(list(zip(*(a[k::width] for k in range(width)))) if width > 1 else a)
+    result = [function(*row, *extra) for row in zip(*columns)]
+    names = outputs(op)
+    if len(names) > 1:
+        result = PurePython.columns(result, len(names))
+    else:
+        result = [result]
+    out = []
+    for column, (_, width) in zip(result, names):
+        a = array("d", chain.from_iterable(column) if width > 1 else column)
+        if BIG_ENDIAN:
+            a.byteswap()
+        out.append(a.tobytes())
+    return out
+
+
 class PurePython:
-    """Arrays as lists of tuples; the model's functions take one item at a time."""
+    """Arrays as lists of tuples; the model's functions take one item at a time. With
+    workers > 1, batches of at least MIN_SPLIT items are split among that many forked
+    processes (pure Python is one core per process)."""
+
+    MIN_SPLIT = 2048
+
+    def __init__(self, workers=1):
+        self.pool = None
+        if workers > 1:
+            import multiprocessing
+
+            self.pool = multiprocessing.get_context("fork").Pool(workers)
+            self.workers = workers
 
     @staticmethod
     def decode(field, width):
@@ -66,6 +119,28 @@ class PurePython:
     @staticmethod
     def call(function, arrays, extra):
         return [function(*row, *extra) for row in zip(*arrays)]
+
+    def split(self, op, function, request, extra):
+        """The answer of a large version-2 request computed by the workers, or None (no pool,
+        a small batch, or JSON arrays)."""
+        fields = [(request[name], width) for name, width in INPUTS[op]]
+        if self.pool is None or not all(isinstance(f, str) for f, _ in fields):
+            return None
+        raws = [(base64.b64decode(f), width) for f, width in fields]
+        n = len(raws[0][0]) // (8 * raws[0][1])
+        if n < self.MIN_SPLIT or any(len(r) != 8 * w * n for r, w in raws):
+            return None
+        step = -(-n // self.workers)
+        jobs = [(function, op, [(r[8 * w * k:8 * w * (k + step)], w) for r, w in raws], extra)
+                for k in range(0, n, step)]
+        parts = self.pool.map(_part, jobs)
+        return {name: base64.b64encode(b"".join(p[j] for p in parts))
+                for j, (name, _) in enumerate(outputs(op))}
+
+    @staticmethod
+    def columns(result, k):
+        """The k columns of a list of k-tuples."""
+        return [list(c) for c in zip(*result)] if result else [[] for _ in range(k)]
 
     @staticmethod
     def encode(result, width, version):
@@ -94,6 +169,11 @@ class Numpy:
     def call(function, arrays, extra):
         return function(*arrays, *extra)
 
+    @staticmethod
+    def columns(result, k):
+        """A numpy function answers a tuple of k arrays already."""
+        return result
+
     def encode(self, result, width, version):
         if version == 1:
             return result.tolist()
@@ -108,11 +188,19 @@ def answer(request, describe, functions, codec, version):
         return dict(describe, protocol=version, capabilities=list(functions))
     if op not in functions:
         return {"error": "unknown op " + repr(op)}
-    arrays = [codec.decode(request[name], width) for name, width in INPUTS[op]]
     extra = [request["masking"]] if op == "g2" else []
+    if version == 2 and isinstance(codec, PurePython):
+        shared = codec.split(op, functions[op], request, extra)
+        if shared is not None:
+            return shared
+    arrays = [codec.decode(request[name], width) for name, width in INPUTS[op]]
     result = codec.call(functions[op], arrays, extra)
     if op in SAMPLING:
         return {"m": codec.encode(result, 3, version)}
+    if op == "bsdf_sample":
+        columns = codec.columns(result, len(BSDF_SAMPLE))
+        return {name: codec.encode(column, width, version)
+                for (name, width), column in zip(BSDF_SAMPLE, columns)}
     return {"values": codec.encode(result, 1, version)}
 
 
@@ -128,14 +216,17 @@ def encode_line(reply):
     return b"".join(parts)
 
 
-def serve(name, parameters, functions, protocol=VERSIONS[-1], numpy=False):
+def serve(name, parameters, functions, protocol=VERSIONS[-1], numpy=False, extra=None,
+          workers=1):
     """Answers mfh's requests on stdin until `shutdown` or end of input.
 
     functions: op name -> function (its capabilities, in the order given). Pure Python: called
     per item with tuples; numpy=True: called per batch with (n, 3) or (n, 2) arrays, returning
-    an (n,) or (n, 3) array. protocol: the newest version to speak."""
-    codec = Numpy() if numpy else PurePython()
-    describe = {"name": name, "parameters": parameters}
+    an (n,) or (n, 3) array (bsdf_sample: a (wo, pdf, weight) triple per item, or of arrays).
+    protocol: the newest version to speak. extra: more fields of the describe answer (a BSDF's
+    "eta" and "transport"). workers: processes sharing large pure-Python batches."""
+    codec = Numpy() if numpy else PurePython(workers)
+    describe = dict(extra or {}, name=name, parameters=parameters)
     version = 1
     out = sys.stdout.buffer
     for line in sys.stdin.buffer:

@@ -3,6 +3,7 @@
 //! the other side (crash, hang, garbage on stdout, NaN, wrong length, early exit, bad
 //! description, wrong id; in version 2 bad base64, a short or ragged array, NaN in the binary
 //! data, an oversized answer) becomes a clear error in bounded time, with no child left running.
+//! The BSDF example (`dielectric.py`) is an `mfh_reference::bsdf::Bsdf` through the protocol.
 
 #[path = "external/common.rs"]
 mod common;
@@ -96,6 +97,100 @@ fn pure_python_examples_agree_with_the_reference() {
 /// Samples per second through the protocol, `sample_wm_batch` in batches of 65 536, for
 /// versions 1 and 2 (printed; run with --nocapture). The samples equal the reference sampler's
 /// for the same u (the same map) to 1e-12 in mean cos θ.
+/// The pure-Python dielectric through `ExternalModel` as a `Bsdf` agrees with the reference
+/// dielectric (eval and pdf on pairs over the whole sphere, sampled wo, pdf and weight for the
+/// same u; batches large enough to be shared among the child's workers), in versions 1 and 2;
+/// its `eta` and `transport` come from `describe`.
+#[test]
+fn the_python_dielectric_is_a_bsdf_that_agrees_with_the_reference() {
+    use mfh_reference::bsdf::{Bsdf, BsdfSpec, Transport};
+    let spec: BsdfSpec = serde_json::from_str(
+        r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}"#,
+    )
+    .unwrap();
+    let reference = spec.build().unwrap();
+    let sphere: Vec<Vec3> = (0..96)
+        .map(|i| {
+            let z = 1.0 - (2 * i + 1) as f64 / 96.0;
+            let s = (1.0 - z * z).sqrt();
+            let phi = 2.399_963 * i as f64;
+            [s * phi.cos(), s * phi.sin(), z]
+        })
+        .collect();
+    let (wi, wo): (Vec<Vec3>, Vec<Vec3>) = sphere
+        .iter()
+        .flat_map(|&a| sphere.iter().map(move |&b| (a, b)))
+        .unzip();
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1e-300);
+    for version in ["1", "2"] {
+        let model = start(
+            &example("dielectric.py", &format!("--protocol {version}")),
+            30.0,
+        )
+        .unwrap();
+        assert!(model.description().has_bsdf() && !model.description().has_ndf());
+        assert_eq!(
+            (Bsdf::eta(&model), Bsdf::transport(&model)),
+            (Some(1.5), Transport::Radiance)
+        );
+        let (mut got, mut want) = (vec![0.0; wo.len()], vec![0.0; wo.len()]);
+        model.eval_batch(&wi, &wo, &mut got);
+        reference.eval_batch(&wi, &wo, &mut want);
+        for k in 0..wo.len() {
+            assert!(
+                close(got[k], want[k]),
+                "v{version} eval {k}: {} vs {}",
+                got[k],
+                want[k]
+            );
+        }
+        model.pdf_batch(&wi, &wo, &mut got);
+        reference.pdf_batch(&wi, &wo, &mut want);
+        for k in 0..wo.len() {
+            assert!(
+                close(got[k], want[k]),
+                "v{version} pdf {k}: {} vs {}",
+                got[k],
+                want[k]
+            );
+        }
+        let u: Vec<[f64; 3]> = (0..3000)
+            .map(|i| {
+                let f = |a: f64| (i as f64 * a).fract();
+                [f(0.618_034), f(0.754_878), f(0.569_840)]
+            })
+            .collect();
+        for &w in &[sphere[3], sphere[50], sphere[90]] {
+            let (mut got, mut want) = (vec![None; u.len()], vec![None; u.len()]);
+            model.sample_batch(w, &u, &mut got);
+            reference.sample_batch(w, &u, &mut want);
+            for k in 0..u.len() {
+                match (got[k], want[k]) {
+                    (None, None) => {}
+                    (Some(g), Some(r)) => {
+                        let d: f64 = (0..3).map(|j| (g.wo[j] - r.wo[j]).abs()).sum();
+                        assert!(d < 1e-9, "v{version} wo {k}: {:?} vs {:?}", g.wo, r.wo);
+                        assert!(close(g.pdf, r.pdf) && close(g.weight, r.weight), "{k}");
+                    }
+                    (g, r) => panic!("v{version} sample {k}: {g:?} vs {r:?}"),
+                }
+            }
+        }
+        // A scalar call is a batch of one: the same sample (to rounding).
+        let (one, want) = (
+            model.sample(sphere[3], u[7]),
+            reference.sample(sphere[3], u[7]),
+        );
+        let (one, want) = (one.unwrap(), want.unwrap());
+        assert!(
+            (0..3).all(|j| (one.wo[j] - want.wo[j]).abs() < 1e-12),
+            "{one:?} vs {want:?}"
+        );
+        assert!(model.first_error().is_none());
+        model.shutdown();
+    }
+}
+
 #[test]
 fn batch_throughput_of_the_pure_python_example() {
     let reference = Ggx::new(0.3, 0.3).unwrap();

@@ -1,7 +1,9 @@
 //! `mfh audit-external` and `mfh chi2 --cmd` end to end on the examples under
 //! examples/external/: the pure-Python GGX and Beckmann and the numpy GGX pass the ci profile,
 //! the deliberately wrong sampler fails `sampling.chi2` (and nothing that does not depend on its
-//! samples), and `mfh chi2 --cmd` tests an external sampler as `--model` tests a reference one.
+//! samples), and `mfh chi2 --cmd` tests an external sampler as `--model` tests a reference one;
+//! the pure-Python rough dielectric BSDF passes its BSDF audit and its broken variant (the
+//! refraction pdf without its Jacobian) fails `bsdf.chi2`.
 
 #[path = "external/common.rs"]
 mod common;
@@ -18,8 +20,13 @@ fn temp(name: &str) -> PathBuf {
 /// Runs `mfh audit-external` at the ci profile; returns the exit status and the ids of the
 /// checks whose records failed (or erred), printing the time it took.
 fn audit(file: &str, against: Option<&str>) -> (i32, Vec<String>, Value) {
-    let out = temp(&format!("audit-{file}"));
-    let cmd = example(file, "");
+    audit_with(file, "", against)
+}
+
+/// [`audit`] of `examples/external/<file> <args>`.
+fn audit_with(file: &str, args: &str, against: Option<&str>) -> (i32, Vec<String>, Value) {
+    let out = temp(&format!("audit-{file}{}", args.replace([' ', '-'], "")));
+    let cmd = example(file, args);
     let mut args = vec![
         "audit-external",
         "--cmd",
@@ -276,4 +283,79 @@ fn a_bad_against_spec_is_refused_before_the_child_starts() {
         assert!(!marker.exists(), "{against}: the child was started");
     }
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// The reference BSDF the dielectric example implements.
+const DIELECTRIC: &str = r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}"#;
+
+/// The pure-Python rough dielectric (a BSDF only: no `d`) passes the BSDF checks and the
+/// comparison with the reference dielectric. Extensive tier: a pure-Python child answers ~11
+/// million samples at the ci profile (minutes on 2 cores; the time is printed).
+#[test]
+#[cfg_attr(
+    not(mfh_extensive),
+    ignore = "extensive tier: set MFH_EXTENSIVE=1 (the pure-Python BSDF audit takes minutes)"
+)]
+fn the_pure_python_dielectric_passes_the_ci_bsdf_audit() {
+    let (code, failing, report) = audit("dielectric.py", Some(DIELECTRIC));
+    assert_eq!(code, 0, "failing: {failing:?}");
+    let checks: Vec<&str> = report["records"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["check"].as_str().unwrap())
+        .collect();
+    for want in [
+        "bsdf.chi2",
+        "bsdf.sample_consistency",
+        "bsdf.failure_rate",
+        "bsdf.albedo",
+        "bsdf.reciprocity",
+        "bsdf.stability",
+        "bsdf.against",
+    ] {
+        assert!(checks.contains(&want), "{want} not run: {checks:?}");
+    }
+    // A BSDF-only child: no NDF checks.
+    assert!(!checks.iter().any(|c| c.starts_with("normalization.")));
+    // Five incidences (three from outside, from inside, beyond the critical angle).
+    assert_eq!(checks.iter().filter(|c| **c == "bsdf.chi2").count(), 5);
+}
+
+/// The classic refraction bug (the refracted directions' pdf without the Jacobian dωh/dωo)
+/// fails `bsdf.chi2`. Extensive tier, like the passing audit.
+#[test]
+#[cfg_attr(
+    not(mfh_extensive),
+    ignore = "extensive tier: set MFH_EXTENSIVE=1 (the pure-Python BSDF audit takes minutes)"
+)]
+fn the_dielectric_without_the_refraction_jacobian_fails_the_chi_square() {
+    let (code, failing, _) = audit_with(
+        "dielectric.py",
+        "--defect refraction_jacobian",
+        Some(DIELECTRIC),
+    );
+    assert_eq!(code, 1);
+    assert!(
+        failing.iter().any(|c| c == "bsdf.chi2"),
+        "failing: {failing:?}"
+    );
+}
+
+/// `--against` takes a BSDF spec, validated before the child starts: an invalid one is exit 2
+/// naming `--against` (the command would not even start).
+#[test]
+fn an_invalid_bsdf_against_is_bad_input_before_the_child_starts() {
+    let (code, _, stderr) = run(&[
+        "audit-external",
+        "--cmd",
+        "exit 3",
+        "--against",
+        r#"{"bsdf":"dielectric","eta":1.00001,"ndf":{"family":"ggx","alpha":0.3}}"#,
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("--against") && stderr.contains("eta"),
+        "{stderr}"
+    );
 }

@@ -16,8 +16,9 @@ pub struct ExternalArgs {
     /// How hard to look.
     #[arg(long, value_enum, default_value = "ci")]
     pub profile: ProfileArg,
-    /// Also compare value by value with this reference spec (JSON), e.g.
-    /// '{"family":"ggx","alpha":0.3}'.
+    /// Also compare value by value with this reference spec (JSON): an NDF's, e.g.
+    /// '{"family":"ggx","alpha":0.3}', or for a child that offers a BSDF a BSDF's, e.g.
+    /// '{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}'.
     #[arg(long)]
     pub against: Option<String>,
     /// Seconds to wait for each answer before the child is killed.
@@ -55,7 +56,7 @@ pub fn run(args: ExternalArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
         return EXIT_BAD_INPUT;
     }
     if let Some(text) = &args.against {
-        if let Err(e) = reference_spec(text) {
+        if let Err(e) = crate::external::Against::parse(text) {
             let _ = writeln!(stderr, "mfh audit-external: --against: {e}");
             return EXIT_BAD_INPUT;
         }
@@ -113,15 +114,4 @@ pub fn run(args: ExternalArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
     } else {
         EXIT_FAIL
     }
-}
-
-/// The `--against` text as a reference model: JSON of a `ModelSpec` whose parameters build a
-/// model (as `Audit::against` requires), or why not. Checked before the child starts, so that
-/// a typo costs no audit.
-fn reference_spec(text: &str) -> Result<mfh_reference::ModelSpec, String> {
-    let spec: mfh_reference::ModelSpec = serde_json::from_str(text)
-        .map_err(|e| format!("{text:?} is not a reference model spec (JSON): {e}"))?;
-    spec.build()
-        .map_err(|e| format!("the reference spec {text} is invalid: {e}"))?;
-    Ok(spec)
 }

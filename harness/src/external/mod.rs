@@ -1,23 +1,27 @@
 //! Audit an implementation in any language: a child process speaking the external protocol
 //! (JSON lines over stdin / stdout, [`protocol`]) is one more implementation of the capability
-//! traits ([`model::ExternalModel`]), audited by [`crate::audit::Audit`] like a Rust model.
+//! traits and of [`mfh_reference::bsdf::Bsdf`] ([`model::ExternalModel`], [`bsdf`]), audited
+//! by [`crate::audit::Audit`] like a Rust model or BSDF.
 
+pub mod against;
+pub mod bsdf;
 pub mod group;
 pub mod model;
 pub mod process;
 pub mod protocol;
 pub mod stderr_tail;
 
+pub use against::Against;
 pub use model::ExternalModel;
 pub use process::{ExternalError, DEFAULT_TIMEOUT_SECONDS};
 
 use crate::audit::Audit;
-use crate::check::Profile;
+use crate::check::{PlannedCheck, Profile};
 use crate::record::{CheckRecord, Verdict};
-use crate::run::{AuditOptions, AuditReport};
+use crate::run::{run_plan, AuditOptions, AuditReport};
 use serde_json::json;
 use std::path::PathBuf;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// What `mfh audit-external` is asked to do.
 #[derive(Debug, Clone)]
@@ -28,7 +32,8 @@ pub struct ExternalAudit {
     pub profile: Profile,
     /// The audit seed.
     pub seed: u64,
-    /// A reference spec (JSON) to compare with value by value.
+    /// A reference spec (JSON) to compare with value by value: an NDF's or a BSDF's
+    /// ([`Against`]).
     pub against: Option<String>,
     /// The per-request timeout.
     pub timeout: Duration,
@@ -36,49 +41,40 @@ pub struct ExternalAudit {
     pub out: Option<PathBuf>,
 }
 
-/// Starts the child, audits it, shuts it down. A child that cannot be started or describe
-/// itself is an error (bad input); a protocol error during the audit is an `external.protocol`
-/// error record in the report (the audit fails).
+/// Starts the child, audits it, shuts it down: the NDF checks if it offers an NDF (`d`), the
+/// BSDF checks ([`crate::check::bsdf::plan`], as [`Audit::of_bsdf`]) if it offers a BSDF, both
+/// in one plan; `against` goes to the side its spec is of ([`Against`]). A child that cannot be
+/// started or describe itself is an error (bad input); a protocol error during the audit is an
+/// `external.protocol` error record in the report (the audit fails).
 pub fn audit(request: &ExternalAudit) -> Result<AuditReport, ExternalError> {
+    let t = Instant::now();
     let model = ExternalModel::start(&request.command, request.timeout)?;
     let description = model.description().clone();
     let name = description
         .name
         .clone()
         .unwrap_or_else(|| request.command.clone());
-    let mut audit = Audit::of(&model)
-        .name(&name)
-        .profile(request.profile)
-        .seed(request.seed);
-    if let Some(spec) = &request.against {
-        audit = audit.against(spec);
-    }
-    if let Some(out) = &request.out {
-        audit = audit.out(out.clone());
-    }
-    let mut report = audit.run();
-    let protocol_error = model.first_error();
-    model.shutdown();
     let label = json!({
         "name": name,
         "command": request.command,
         "parameters": description.parameters,
         "capabilities": description.capabilities,
     });
-    let mut records = std::mem::take(&mut report.records);
-    if let Some(e) = protocol_error {
-        let mut r = CheckRecord::new("external.protocol", label, json!({}), "");
-        r.verdict = Verdict::Error {
-            message: e.to_string(),
-        };
-        records.push(r);
-    }
     let options = AuditOptions {
         profile: request.profile,
         seed: request.seed,
         out: request.out.clone(),
         ..Default::default()
     };
+    let (plan, mut errors) = plan(&model, request, &name, &label);
+    let (mut records, k, alpha) = run_plan(&plan, &options);
+    drop(plan);
+    records.append(&mut errors);
+    let protocol_error = model.first_error();
+    model.shutdown();
+    if let Some(e) = protocol_error {
+        records.push(error_record("external.protocol", &label, e.to_string()));
+    }
     let mut command = format!(
         "MFH_SEED={} mfh audit-external --cmd {:?} --profile {}",
         request.seed,
@@ -93,7 +89,68 @@ pub fn audit(request: &ExternalAudit) -> Result<AuditReport, ExternalError> {
         &options,
         command,
         records,
-        report.summary.statistical,
-        report.summary.wall_seconds,
+        (k, alpha),
+        t.elapsed().as_secs_f64(),
     ))
+}
+
+/// The checks of the child's NDF and of its BSDF, each planned as [`Audit::of`] and
+/// [`Audit::of_bsdf`] plan them, and the configuration errors (an `--against` spec that is
+/// invalid, or of a kind the child does not offer) as records that fail.
+fn plan<'a>(
+    model: &'a ExternalModel,
+    request: &ExternalAudit,
+    name: &str,
+    label: &serde_json::Value,
+) -> (Vec<PlannedCheck<'a>>, Vec<CheckRecord>) {
+    let description = model.description();
+    let against = request.against.as_deref().map(Against::parse);
+    let configure = |audit: Audit<'a>, wanted: fn(&Against) -> bool| {
+        let audit = audit.name(name).profile(request.profile).seed(request.seed);
+        match (&against, &request.against) {
+            (Some(Ok(spec)), Some(text)) if wanted(spec) => audit.against(text),
+            _ => audit,
+        }
+    };
+    let (mut plan, mut errors) = (Vec::new(), Vec::new());
+    if description.has_ndf() {
+        let (p, e) = configure(Audit::of(model), |a| matches!(a, Against::Ndf(_))).plan();
+        plan.extend(p);
+        errors.extend(e);
+    }
+    if description.has_bsdf() {
+        let (p, e) = configure(Audit::of_bsdf(model), |a| matches!(a, Against::Bsdf(_))).plan();
+        plan.extend(p);
+        errors.extend(e);
+    }
+    let offered = |a: &Against| match a {
+        Against::Ndf(_) => description.has_ndf(),
+        Against::Bsdf(_) => description.has_bsdf(),
+    };
+    match &against {
+        Some(Err(e)) => errors.push(error_record(
+            "audit.configuration",
+            label,
+            format!("against: {e}"),
+        )),
+        Some(Ok(spec)) if !offered(spec) => errors.push(error_record(
+            "audit.configuration",
+            label,
+            format!(
+                "against: the spec is of {}, which the child does not offer (its \
+                 capabilities: {})",
+                spec.kind(),
+                description.capabilities.join(", ")
+            ),
+        )),
+        _ => {}
+    }
+    (plan, errors)
+}
+
+/// A record of `check` that errs with `message`.
+fn error_record(check: &str, label: &serde_json::Value, message: String) -> CheckRecord {
+    let mut r = CheckRecord::new(check, label.clone(), json!({}), "");
+    r.verdict = Verdict::Error { message };
+    r
 }

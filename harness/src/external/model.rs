@@ -2,6 +2,9 @@
 //! method is a request to the child. Batches go through the inherent `*_batch` methods (split
 //! into requests of at most [`MAX_BATCH`] items); a scalar trait call is one round trip.
 //!
+//! The BSDF capability (`bsdf_eval`, `bsdf_pdf`, `bsdf_sample`) is in `bsdf.rs` beside this
+//! file.
+//!
 //! Trait methods cannot return errors, so the first protocol error is recorded (see
 //! [`ExternalModel::first_error`]), the child is killed, and every later call answers NaN
 //! (values) or a NaN direction (samples) at once: the audit's checks fail quickly, and the
@@ -66,7 +69,7 @@ impl ExternalModel {
         }
     }
 
-    fn call(&self, request: &Request<'_>) -> Result<Answer, ExternalError> {
+    pub(super) fn call(&self, request: &Request<'_>) -> Result<Answer, ExternalError> {
         let mut session = self
             .session
             .lock()
@@ -82,7 +85,7 @@ impl ExternalModel {
 
     /// Sends one request for scalar values and checks the answer: one finite-or-infinite
     /// number per item, no NaN.
-    fn values(
+    pub(super) fn values(
         &self,
         request: &Request<'_>,
         inputs: &dyn Fn(usize) -> String,
@@ -107,7 +110,7 @@ impl ExternalModel {
 
     /// Checks an answer's array `field` against `request`: present, decodable in the session's
     /// protocol version, one item per item asked, no NaN. Its numbers, row-major.
-    fn items<T: Item>(
+    pub(super) fn items<T: Item>(
         &self,
         request: &Request<'_>,
         inputs: &dyn Fn(usize) -> String,
@@ -144,7 +147,7 @@ impl ExternalModel {
     }
 
     /// Records an error found in an answer (the session itself is still alive: stop it).
-    fn record(&self, e: ExternalError) -> ExternalError {
+    pub(super) fn record(&self, e: ExternalError) -> ExternalError {
         if let Ok(mut first) = self.first_error.lock() {
             first.get_or_insert_with(|| e.clone());
         }
@@ -208,7 +211,7 @@ impl ExternalModel {
 }
 
 /// Runs `f` on consecutive ranges of at most [`MAX_BATCH`] items and concatenates.
-fn chunked(
+pub(super) fn chunked(
     n: usize,
     f: impl Fn(std::ops::Range<usize>) -> Result<Vec<f64>, ExternalError>,
 ) -> Result<Vec<f64>, ExternalError> {
@@ -221,16 +224,16 @@ fn chunked(
 
 /// The batch methods' contract: as many outputs as inputs (a caller's bug otherwise: panics).
 #[track_caller]
-fn same_length(method: &str, input: &str, n_in: usize, n_out: usize) {
+pub(super) fn same_length(method: &str, input: &str, n_in: usize, n_out: usize) {
     assert_eq!(n_in, n_out, "{method}: {input} and out differ in length");
 }
 
-fn show(v: Vec3) -> String {
+pub(super) fn show(v: Vec3) -> String {
     format!("[{}, {}, {}]", v[0], v[1], v[2])
 }
 
 /// Copies a batch result into `out`, or NaN everywhere after a protocol error (recorded).
-fn fill(out: &mut [f64], got: Result<Vec<f64>, ExternalError>) {
+pub(super) fn fill(out: &mut [f64], got: Result<Vec<f64>, ExternalError>) {
     match got {
         Ok(v) => out.copy_from_slice(&v),
         Err(_) => out.fill(f64::NAN),

@@ -24,6 +24,7 @@
 //! that version (a version-1 child needs no change).
 
 use base64::Engine;
+use mfh_reference::bsdf::Transport;
 use mfh_reference::{Masking, Vec3};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -40,7 +41,22 @@ pub const PROTOCOL_VERSION: u32 = 2;
 const BASE64: base64::engine::GeneralPurpose = base64::engine::general_purpose::STANDARD;
 
 /// The capabilities a child may declare in its `describe` answer.
-pub const CAPABILITIES: [&str; 8] = [
+pub const CAPABILITIES: [&str; 11] = [
+    "d",
+    "lambda",
+    "g1",
+    "g2",
+    "sample_wm",
+    "pdf_wm",
+    "sample_wm_visible",
+    "pdf_wm_visible",
+    "bsdf_eval",
+    "bsdf_pdf",
+    "bsdf_sample",
+];
+
+/// The capabilities of an NDF (the first of them, `d`, required by the others).
+pub const NDF_CAPABILITIES: [&str; 8] = [
     "d",
     "lambda",
     "g1",
@@ -50,6 +66,9 @@ pub const CAPABILITIES: [&str; 8] = [
     "sample_wm_visible",
     "pdf_wm_visible",
 ];
+
+/// The capabilities of a BSDF: all three are needed for a BSDF audit.
+pub const BSDF_CAPABILITIES: [&str; 3] = ["bsdf_eval", "bsdf_pdf", "bsdf_sample"];
 
 /// A request to the child (serialized with `"op"` as the tag).
 #[derive(Debug, Clone, Serialize)]
@@ -109,6 +128,27 @@ pub enum Request<'a> {
         /// Microfacet normals.
         m: &'a [Vec3],
     },
+    /// eval(wi, wo) = f(wi, wo)·|cos θo| of a BSDF for each pair.
+    BsdfEval {
+        /// The directions queried from (either hemisphere).
+        wi: &'a [Vec3],
+        /// The other directions.
+        wo: &'a [Vec3],
+    },
+    /// The solid-angle density of `bsdf_sample`'s wo for each pair.
+    BsdfPdf {
+        /// The directions queried from.
+        wi: &'a [Vec3],
+        /// The other directions.
+        wo: &'a [Vec3],
+    },
+    /// A sampled (wo, pdf, weight) for each (wi, u).
+    BsdfSample {
+        /// The directions queried from.
+        wi: &'a [Vec3],
+        /// Uniform triples in [0, 1)³ (u0 chooses the lobe, u1 and u2 the normal).
+        u: &'a [[f64; 3]],
+    },
     /// The child should exit (no answer expected).
     Shutdown,
 }
@@ -126,6 +166,9 @@ impl Request<'_> {
             Request::PdfWm { .. } => "pdf_wm",
             Request::SampleWmVisible { .. } => "sample_wm_visible",
             Request::PdfWmVisible { .. } => "pdf_wm_visible",
+            Request::BsdfEval { .. } => "bsdf_eval",
+            Request::BsdfPdf { .. } => "bsdf_pdf",
+            Request::BsdfSample { .. } => "bsdf_sample",
             Request::Shutdown => "shutdown",
         }
     }
@@ -138,6 +181,8 @@ impl Request<'_> {
             Request::Lambda { w } | Request::G1 { w, .. } => w.len(),
             Request::G2 { m, .. } | Request::PdfWmVisible { m, .. } => m.len(),
             Request::SampleWm { u } | Request::SampleWmVisible { u, .. } => u.len(),
+            Request::BsdfEval { wo, .. } | Request::BsdfPdf { wo, .. } => wo.len(),
+            Request::BsdfSample { u, .. } => u.len(),
         }
     }
 
@@ -164,6 +209,12 @@ impl Request<'_> {
             }
             Request::PdfWmVisible { wi, m } => {
                 vec![("wi", wi.as_flattened()), ("m", m.as_flattened())]
+            }
+            Request::BsdfEval { wi, wo } | Request::BsdfPdf { wi, wo } => {
+                vec![("wi", wi.as_flattened()), ("wo", wo.as_flattened())]
+            }
+            Request::BsdfSample { wi, u } => {
+                vec![("wi", wi.as_flattened()), ("u", u.as_flattened())]
             }
         }
     }
@@ -225,11 +276,20 @@ pub struct Description {
     /// The implementation's name, for the report.
     #[serde(default)]
     pub name: Option<String>,
-    /// Its capabilities, among [`CAPABILITIES`]; `d` is required.
+    /// Its capabilities, among [`CAPABILITIES`]: an NDF's (`d` and what it allows), a
+    /// BSDF's (`bsdf_eval`, `bsdf_pdf`, `bsdf_sample`), or both.
     pub capabilities: Vec<String>,
     /// Its parameters (any JSON object), for the report.
     #[serde(default)]
     pub parameters: Value,
+    /// A BSDF's relative index η_inside/η_outside (absent: reflection only); checked by
+    /// [`Description::validate`], read by [`Description::eta`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eta: Option<Value>,
+    /// A BSDF's transport convention, `"importance"` or `"radiance"` (absent: radiance);
+    /// checked by [`Description::validate`], read by [`Description::transport`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transport: Option<Value>,
 }
 
 impl Description {
@@ -238,8 +298,38 @@ impl Description {
         self.capabilities.iter().any(|c| c == name)
     }
 
-    /// Checks the version and the capability list: `d` is required, every name must be known,
-    /// `g1`/`g2` need `lambda`, `pdf_wm` needs `sample_wm`, visible sampling needs `lambda`.
+    /// Whether the child offers a BSDF (it declared all of [`BSDF_CAPABILITIES`]; validation
+    /// refuses a part of them).
+    pub fn has_bsdf(&self) -> bool {
+        BSDF_CAPABILITIES.iter().all(|c| self.has(c))
+    }
+
+    /// Whether the child offers an NDF (it declared `d`).
+    pub fn has_ndf(&self) -> bool {
+        self.has("d")
+    }
+
+    /// The BSDF's relative index (None: reflection only, or not a valid number: see
+    /// [`Description::validate`]).
+    pub fn eta(&self) -> Option<f64> {
+        self.eta.as_ref().and_then(Value::as_f64)
+    }
+
+    /// The BSDF's transport convention (radiance when absent or invalid: see
+    /// [`Description::validate`]).
+    pub fn transport(&self) -> Transport {
+        match self.transport.as_ref().and_then(Value::as_str) {
+            Some("importance") => Transport::Importance,
+            _ => Transport::Radiance,
+        }
+    }
+
+    /// Checks the version, the capability list and the BSDF fields: every name must be known;
+    /// the child offers an NDF (`d`), a BSDF (`bsdf_eval`, `bsdf_pdf`, `bsdf_sample`, all
+    /// three), or both; the other NDF capabilities need `d`, `g1`/`g2` need `lambda`, `pdf_wm`
+    /// needs `sample_wm`, visible sampling needs `lambda`; `bsdf_pdf` and `bsdf_sample` need
+    /// `bsdf_eval`; `eta`, when given, is a finite number in [0.1, 10] at least 5e-5 away from
+    /// 1; `transport`, when given, is `"importance"` or `"radiance"`.
     pub fn validate(&self) -> Result<(), String> {
         if !VERSIONS.contains(&self.protocol) {
             return Err(format!(
@@ -258,25 +348,75 @@ impl Description {
             ));
         }
         let needs = [
-            ("d", None),
-            ("g1", Some("lambda")),
-            ("g2", Some("lambda")),
-            ("pdf_wm", Some("sample_wm")),
-            ("sample_wm_visible", Some("lambda")),
-            ("pdf_wm_visible", Some("sample_wm_visible")),
+            ("g1", "lambda"),
+            ("g2", "lambda"),
+            ("pdf_wm", "sample_wm"),
+            ("sample_wm_visible", "lambda"),
+            ("pdf_wm_visible", "sample_wm_visible"),
+            ("bsdf_pdf", "bsdf_eval"),
+            ("bsdf_sample", "bsdf_eval"),
         ];
+        let bsdf_declared = BSDF_CAPABILITIES.iter().any(|c| self.has(c));
+        if !self.has("d") && !bsdf_declared {
+            return Err(
+                "capability \"d\" (an NDF) or \"bsdf_eval\", \"bsdf_pdf\" and \"bsdf_sample\" \
+                 (a BSDF) is required"
+                    .into(),
+            );
+        }
         if !self.has("d") {
-            return Err("capability \"d\" is required".into());
+            if let Some(c) = NDF_CAPABILITIES[1..].iter().find(|c| self.has(c)) {
+                return Err(format!("capability {c:?} requires \"d\""));
+            }
         }
         for (cap, need) in needs {
-            if let Some(need) = need {
-                if self.has(cap) && !self.has(need) {
-                    return Err(format!("capability {cap:?} requires {need:?}"));
-                }
+            if self.has(cap) && !self.has(need) {
+                return Err(format!("capability {cap:?} requires {need:?}"));
+            }
+        }
+        if bsdf_declared && !self.has_bsdf() {
+            let missing: Vec<&str> = BSDF_CAPABILITIES
+                .into_iter()
+                .filter(|c| !self.has(c))
+                .collect();
+            return Err(format!(
+                "a BSDF audit needs all of bsdf_eval, bsdf_pdf and bsdf_sample; missing: {}",
+                missing.join(", ")
+            ));
+        }
+        if let Some(eta) = &self.eta {
+            let value = eta.as_f64().ok_or_else(|| {
+                format!("\"eta\" is {eta}, not a number (η inside / η outside, in [0.1, 10])")
+            })?;
+            check_eta(value).map_err(|e| format!("\"eta\": {e}"))?;
+        }
+        if let Some(t) = &self.transport {
+            if !matches!(t.as_str(), Some("importance" | "radiance")) {
+                return Err(format!(
+                    "\"transport\" is {t}; it must be \"importance\" or \"radiance\""
+                ));
             }
         }
         Ok(())
     }
+}
+
+/// A relative index checked against the reference dielectric's limits
+/// ([`mfh_reference::bsdf::dielectric::ETA_MIN`] and its siblings).
+fn check_eta(eta: f64) -> Result<f64, String> {
+    use mfh_reference::bsdf::dielectric::{ETA_MAX, ETA_MIN, ETA_MIN_GAP};
+    if !(ETA_MIN..=ETA_MAX).contains(&eta) {
+        return Err(format!(
+            "{eta} is outside [{ETA_MIN}, {ETA_MAX}] (η inside / η outside)"
+        ));
+    }
+    if !((eta - 1.0).abs() >= ETA_MIN_GAP) {
+        return Err(format!(
+            "{eta} is less than {ETA_MIN_GAP:e} away from 1 (at η = 1 refraction is a delta, \
+             wo = −wi, which no density-based check resolves)"
+        ));
+    }
+    Ok(eta)
 }
 
 /// Rewrites the bare tokens `NaN`, `Infinity` and `-Infinity` (outside strings) as the strings
@@ -397,6 +537,15 @@ pub struct Answer {
     /// Sampled directions.
     #[serde(default)]
     pub m: Option<Wire<[Number; 3]>>,
+    /// Sampled BSDF directions (`bsdf_sample`).
+    #[serde(default)]
+    pub wo: Option<Wire<[Number; 3]>>,
+    /// The densities of sampled BSDF directions (`bsdf_sample`; 0 for a failed sample).
+    #[serde(default)]
+    pub pdf: Option<Wire<Number>>,
+    /// The weights eval/pdf of sampled BSDF directions (`bsdf_sample`; 0 for a failed sample).
+    #[serde(default)]
+    pub weight: Option<Wire<Number>>,
     /// The child's own error message.
     #[serde(default)]
     pub error: Option<String>,
@@ -620,6 +769,8 @@ mod tests {
             name: None,
             capabilities: caps.iter().map(|s| s.to_string()).collect(),
             parameters: Value::Null,
+            eta: None,
+            transport: None,
         };
         assert!(d(&["d", "lambda", "g2"], 1).validate().is_ok());
         assert!(d(&["lambda"], 1).validate().unwrap_err().contains("\"d\""));
@@ -633,5 +784,91 @@ mod tests {
             .validate()
             .unwrap_err()
             .contains("unknown"));
+    }
+
+    /// A child may offer a BSDF only (no `d`), an NDF only, or both; a BSDF needs all three
+    /// capabilities; `eta` and `transport` are checked, and the error names the field.
+    #[test]
+    fn bsdf_descriptions_are_validated() {
+        let d = |caps: &[&str], eta: Option<Value>, transport: Option<Value>| Description {
+            protocol: 2,
+            name: None,
+            capabilities: caps.iter().map(|s| s.to_string()).collect(),
+            parameters: Value::Null,
+            eta,
+            transport,
+        };
+        let bsdf = ["bsdf_eval", "bsdf_pdf", "bsdf_sample"];
+        let ok = d(&bsdf, Some(1.5.into()), Some("importance".into()));
+        assert!(ok.validate().is_ok());
+        assert!(ok.has_bsdf() && !ok.has_ndf());
+        assert_eq!(ok.eta(), Some(1.5));
+        assert_eq!(ok.transport(), Transport::Importance);
+        let both = d(&["d", "bsdf_eval", "bsdf_pdf", "bsdf_sample"], None, None);
+        assert!(both.validate().is_ok() && both.has_bsdf() && both.has_ndf());
+        assert_eq!((both.eta(), both.transport()), (None, Transport::Radiance));
+        let e = d(&["bsdf_pdf"], None, None).validate().unwrap_err();
+        assert!(e.contains("bsdf_eval"), "{e}");
+        let e = d(&["bsdf_eval", "bsdf_pdf"], None, None)
+            .validate()
+            .unwrap_err();
+        assert!(e.contains("missing: bsdf_sample"), "{e}");
+        let e = d(
+            &["lambda", "bsdf_eval", "bsdf_pdf", "bsdf_sample"],
+            None,
+            None,
+        )
+        .validate()
+        .unwrap_err();
+        assert!(e.contains("\"lambda\" requires \"d\""), "{e}");
+        assert!(d(&[], None, None)
+            .validate()
+            .unwrap_err()
+            .contains("bsdf_eval"));
+        for (eta, want) in [
+            (Value::from(1.00001), "5e-5"),
+            (Value::from(11.0), "[0.1, 10]"),
+            (Value::from(0.05), "[0.1, 10]"),
+            (Value::from("1.5"), "not a number"),
+        ] {
+            let e = d(&bsdf, Some(eta.clone()), None).validate().unwrap_err();
+            assert!(e.contains("\"eta\"") && e.contains(want), "{eta}: {e}");
+        }
+        let e = d(&bsdf, None, Some("photons".into()))
+            .validate()
+            .unwrap_err();
+        assert!(e.contains("\"transport\""), "{e}");
+    }
+
+    /// The BSDF requests carry their arrays in both versions (u triples as 3 numbers an item).
+    #[test]
+    fn bsdf_requests_carry_their_arrays() {
+        let w = [[0.6, 0.0, 0.8]];
+        let u = [[0.25, 0.5, 0.75]];
+        let v: Value =
+            serde_json::from_str(&Request::BsdfSample { wi: &w, u: &u }.to_line(1, 1)).unwrap();
+        assert_eq!(v["op"], "bsdf_sample");
+        assert_eq!(v["u"], serde_json::json!([[0.25, 0.5, 0.75]]));
+        let v: Value =
+            serde_json::from_str(&Request::BsdfSample { wi: &w, u: &u }.to_line(2, 2)).unwrap();
+        assert_eq!(v["n"], 1);
+        assert_eq!(v["u"].as_str().unwrap(), encode(&[0.25, 0.5, 0.75]));
+        assert_eq!(v["wi"].as_str().unwrap(), encode(&[0.6, 0.0, 0.8]));
+        for (request, op) in [
+            (Request::BsdfEval { wi: &w, wo: &w }, "bsdf_eval"),
+            (Request::BsdfPdf { wi: &w, wo: &w }, "bsdf_pdf"),
+        ] {
+            let v: Value = serde_json::from_str(&request.to_line(3, 2)).unwrap();
+            assert_eq!((v["op"].as_str(), v["n"].as_u64()), (Some(op), Some(1)));
+            assert_eq!(v["wo"].as_str().unwrap(), encode(&[0.6, 0.0, 0.8]));
+        }
+        let line = format!(
+            r#"{{"id":1,"wo":"{}","pdf":[0.5],"weight":[0.25]}}"#,
+            encode(&[0.0, 0.0, -1.0])
+        );
+        let a: Answer = serde_json::from_str(&line).unwrap();
+        assert_eq!(a.wo.unwrap().numbers(2).unwrap(), [0.0, 0.0, -1.0]);
+        assert_eq!(a.pdf.unwrap().numbers(2).unwrap(), [0.5]);
+        assert_eq!(a.weight.unwrap().numbers(2).unwrap(), [0.25]);
     }
 }

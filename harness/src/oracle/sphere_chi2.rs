@@ -42,8 +42,9 @@ use std::time::Instant;
 
 /// Samples per random stream (the unit of work and of seeding).
 pub const CHUNK: u64 = 1 << 16;
-/// Samples handed to the sampler at once, within a chunk (the counts do not depend on it).
-const BLOCK: usize = 1024;
+/// Samples handed to the sampler at once, within a chunk (the counts do not depend on it):
+/// large enough that an external BSDF answers one request per 16 384 samples.
+const BLOCK: usize = 1 << 14;
 
 /// A batch BSDF sampler at one incidence: writes the direction of `u[k]` (or `None`, a failed
 /// sample) into `out[k]`.
