@@ -26,32 +26,28 @@ fn failures(records: &[CheckRecord]) -> Vec<String> {
         .collect()
 }
 
-/// Every BSDF mutant is killed by a check its entry names, through the public gate at the ci
+/// A BSDF mutant is killed by a check its entry names, through the public gate at the ci
 /// profile (the Šidák level of the whole audit): at seed 7, and at two more seeds in the
-/// extensive tier (`MFH_EXTENSIVE=1`).
-#[test]
-fn every_bsdf_mutant_is_killed_by_its_named_check() {
-    use crate::selftest::bsdf_mutant::{BsdfDefect, MutatedBsdf};
+/// extensive tier (`MFH_EXTENSIVE=1`). One test a mutant (below), so that nextest spreads the
+/// thirteen ci audits over the cores and each stays far inside its time limit.
+fn is_killed_by_its_named_check(defect: crate::selftest::bsdf_mutant::BsdfDefect) {
+    use crate::selftest::bsdf_mutant::MutatedBsdf;
     use crate::{Audit, Profile};
-    let mut missed = Vec::new();
     let seeds: &[u64] = if cfg!(mfh_extensive) {
         &[7, 8, 9]
     } else {
         &[7]
     };
-    for (defect, &seed) in BsdfDefect::ALL
-        .iter()
-        .flat_map(|d| seeds.iter().map(move |s| (*d, s)))
-    {
+    let mut missed = Vec::new();
+    for &seed in seeds {
         let m = MutatedBsdf::new(defect);
         let report = Audit::of_bsdf(&m).profile(Profile::Ci).seed(seed).run();
-        let killers: Vec<&str> = report
+        let mut killers: Vec<&str> = report
             .records
             .iter()
             .filter(|r| r.verdict.is_failure())
             .map(|r| r.check.as_str())
             .collect();
-        let mut killers = killers;
         killers.sort_unstable();
         killers.dedup();
         println!("{:40} seed {seed}: killed by {killers:?}", defect.id());
@@ -63,6 +59,47 @@ fn every_bsdf_mutant_is_killed_by_its_named_check() {
         }
     }
     assert!(missed.is_empty(), "{missed:#?}");
+}
+
+macro_rules! mutant_tests {
+    ($($name:ident: $defect:ident,)*) => {
+        /// The tests below cover every mutant of the catalog, once each.
+        #[test]
+        fn every_bsdf_mutant_has_its_kill_test() {
+            use crate::selftest::bsdf_mutant::BsdfDefect;
+            let tested = [$(BsdfDefect::$defect),*];
+            assert_eq!(tested.len(), BsdfDefect::ALL.len());
+            for d in BsdfDefect::ALL {
+                assert!(tested.contains(&d), "{} has no kill test", d.id());
+            }
+        }
+        mod mutant_is_killed {
+            $(
+                #[test]
+                fn $name() {
+                    super::is_killed_by_its_named_check(
+                        crate::selftest::bsdf_mutant::BsdfDefect::$defect,
+                    );
+                }
+            )*
+        }
+    };
+}
+
+mutant_tests! {
+    weight_off: WeightOff,
+    reflection_jacobian_missing: ReflectionJacobianMissing,
+    refraction_jacobian_missing: RefractionJacobianMissing,
+    eta_squared_inverted: EtaSquaredInverted,
+    eta_squared_missing: EtaSquaredMissing,
+    fresnel_wrong_cosine_in_pdf: FresnelWrongCosineInPdf,
+    total_internal_reflection_lost: TotalInternalReflectionLost,
+    side_condition_lost_in_eval: SideConditionLostInEval,
+    samples_lost: SamplesLost,
+    g1_missing_in_visible_pdf: G1MissingInVisiblePdf,
+    arguments_swapped: ArgumentsSwapped,
+    nan_at_degenerate_half_vector: NanAtDegenerateHalfVector,
+    reflection_value_off: ReflectionValueOff,
 }
 
 #[test]
