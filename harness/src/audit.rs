@@ -179,6 +179,15 @@ impl<'a> Audit<'a> {
         self
     }
 
+    /// Streaming, resuming and a time limit ([`crate::run::RunControl`]): a callback told when
+    /// each check starts and finishes (with its record, e.g. to stream records to a log as the
+    /// CLI does into `report.jsonl`), records of an earlier run to take instead of running their
+    /// checks, and a wall-time limit after which no check starts.
+    pub fn control(mut self, control: crate::run::RunControl) -> Self {
+        self.options.control = control;
+        self
+    }
+
     /// The effects the plan follows: the declared ones, else what the capabilities allow.
     pub fn effects(&self) -> Effects {
         let m = &self.model;

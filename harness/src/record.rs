@@ -214,6 +214,7 @@ pub enum RecordData {
         /// Observed counts per cell.
         observed: Vec<u64>,
         /// Expected counts per cell (pdf mass × samples).
+        #[serde(deserialize_with = "crate::record_serde::nullable_f64_vec")]
         expected: Vec<f64>,
     },
     /// The observed and expected counts of a BSDF's chi-square test over the whole sphere: each
@@ -232,10 +233,12 @@ pub enum RecordData {
         /// Observed counts per cell above the surface (reflection from outside).
         upper_observed: Vec<u64>,
         /// Expected counts per cell above the surface.
+        #[serde(deserialize_with = "crate::record_serde::nullable_f64_vec")]
         upper_expected: Vec<f64>,
         /// Observed counts per cell below the surface, mirrored.
         lower_observed: Vec<u64>,
         /// Expected counts per cell below the surface, mirrored.
+        #[serde(deserialize_with = "crate::record_serde::nullable_f64_vec")]
         lower_expected: Vec<f64>,
     },
     /// A Kolmogorov–Smirnov marginal: the model's CDF and an empirical CDF at `x`.
@@ -243,10 +246,13 @@ pub enum RecordData {
         /// The marginal (`cos_theta` or `phi`).
         marginal: String,
         /// Points of the marginal's range.
+        #[serde(deserialize_with = "crate::record_serde::nullable_f64_vec")]
         x: Vec<f64>,
         /// The model's CDF at `x` (the oracle's table).
+        #[serde(deserialize_with = "crate::record_serde::nullable_f64_vec")]
         model_cdf: Vec<f64>,
         /// The empirical CDF at `x`.
+        #[serde(deserialize_with = "crate::record_serde::nullable_f64_vec")]
         empirical_cdf: Vec<f64>,
         /// Samples behind the empirical CDF.
         samples: u64,
@@ -258,8 +264,10 @@ pub enum RecordData {
         /// What the curve shows.
         label: String,
         /// The abscissae.
+        #[serde(deserialize_with = "crate::record_serde::nullable_f64_vec")]
         x: Vec<f64>,
         /// The ordinates.
+        #[serde(deserialize_with = "crate::record_serde::nullable_f64_vec")]
         y: Vec<f64>,
     },
 }

@@ -26,6 +26,15 @@ pub fn nullable_f64<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
+/// Deserializes a list of `f64` written by serde_json, each `null` read back as NaN (as
+/// [`nullable_f64`]): the tables and curves of a record's data, read back from `report.jsonl`.
+pub fn nullable_f64_vec<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+    Ok(Vec::<Option<f64>>::deserialize(d)?
+        .into_iter()
+        .map(|x| x.unwrap_or(f64::NAN))
+        .collect())
+}
+
 /// Deserializes a string into a `&'static str` through [`intern`].
 pub fn interned<'de, D: Deserializer<'de>>(d: D) -> Result<&'static str, D::Error> {
     Ok(intern(&String::deserialize(d)?))

@@ -13,7 +13,8 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
-use std::time::Instant;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 /// The default audit seed (overridable everywhere a seed is taken: `--seed`, `MFH_SEED`, the
 /// options): every check's random stream derives from it and the check's id, model and case.
@@ -39,6 +40,8 @@ pub struct AuditOptions {
     pub out: Option<PathBuf>,
     /// Called after each check (from worker threads); None: no progress is reported.
     pub progress: Option<ProgressFn>,
+    /// Streaming, resuming and the time limit ([`RunControl`]).
+    pub control: RunControl,
 }
 
 impl Default for AuditOptions {
@@ -48,8 +51,95 @@ impl Default for AuditOptions {
             seed: DEFAULT_SEED,
             out: None,
             progress: None,
+            control: RunControl::default(),
         }
     }
+}
+
+/// What an audit does beyond running its plan: tell a sink about each check as it starts and
+/// finishes (the CLI appends each record to `report.jsonl` and prints progress lines from
+/// these events; the library itself writes nothing), take the records of an interrupted run
+/// instead of running their checks again, and stop starting checks after a time limit.
+#[derive(Debug, Clone, Default)]
+pub struct RunControl {
+    /// Told when a check starts and when it finishes, from the worker threads.
+    pub on_check: Option<CheckEventFn>,
+    /// Records of an earlier run of the same plan (read back from `report.jsonl`), by the
+    /// [`plan_key`] of the planned check that made each: a planned check with a record here is
+    /// not run again, its record is taken. Records do not depend on the order or the thread a
+    /// check runs on ([`check_seed`]), so a resumed audit has the records of an uninterrupted
+    /// one. (The key is the planned check's, not the record's identity: some checks refine
+    /// the case they record.)
+    pub resume: Option<Arc<std::collections::HashMap<String, CheckRecord>>>,
+    /// The wall-time limit from the start of [`run_plan`]: a check not started when it has
+    /// passed is not run and gets an `error` record naming the limit ([`not_run_message`]);
+    /// checks already running finish (a check cannot be cancelled midway).
+    pub max_time: Option<Duration>,
+}
+
+/// What happened to one planned check ([`RunControl::on_check`]).
+#[derive(Debug)]
+pub enum CheckEvent<'e> {
+    /// The run begins: `checks` planned, of which `resumed` were taken from
+    /// [`RunControl::resume`] and will not run. Sent once, before any other event.
+    Plan {
+        /// Checks planned.
+        checks: usize,
+        /// Checks whose records were taken from the earlier run.
+        resumed: usize,
+    },
+    /// Check `index` of the plan has started.
+    Started {
+        /// Its index in the plan.
+        index: usize,
+        /// The planned check.
+        planned: &'e PlannedCheck<'e>,
+    },
+    /// Check `index` of the plan has finished with `record` (before the Šidák correction
+    /// re-judges the statistical records over the whole audit). Not sent for records taken
+    /// from [`RunControl::resume`] nor for checks not run because of the time limit.
+    Finished {
+        /// Its index in the plan.
+        index: usize,
+        /// The planned check (its [`plan_key`] identifies the record for
+        /// [`RunControl::resume`]).
+        planned: &'e PlannedCheck<'e>,
+        /// Its record (with its `data`, if any).
+        record: &'e CheckRecord,
+    },
+}
+
+/// A check-event callback; it never changes a result.
+#[derive(Clone)]
+pub struct CheckEventFn(pub Arc<dyn Fn(CheckEvent<'_>) + Send + Sync>);
+
+impl std::fmt::Debug for CheckEventFn {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("CheckEventFn")
+    }
+}
+
+/// The key of a planned check for [`RunControl::resume`]: the hex FNV-1a of its
+/// `check|model|case` (the model and case as compact JSON, as [`check_seed`] and the shard
+/// fingerprint spell them).
+pub fn plan_key(planned: &PlannedCheck<'_>) -> String {
+    format!(
+        "{:016x}",
+        fnv1a(&format!(
+            "{}|{}|{}",
+            planned.check, planned.model, planned.case
+        ))
+    )
+}
+
+/// The message of the `error` record of a check that was not run because the time limit
+/// `limit` had passed.
+pub fn not_run_message(limit: Duration) -> String {
+    format!(
+        "not run: the audit's time limit of {} s (max_time, `--max-time`) had passed before \
+         this check could start",
+        limit.as_secs_f64()
+    )
 }
 
 /// How far an audit has got: checks done of those planned, and failures so far (before the
@@ -290,21 +380,48 @@ pub fn check_seed(seed: u64, planned: &PlannedCheck<'_>) -> u64 {
 /// not start last and run alone while the other threads are idle (rayon's split of the plan
 /// into contiguous halves did that). Records do not depend on the order: each check has its
 /// own seed ([`check_seed`]).
+///
+/// `options.control` ([`RunControl`]): each check's start and finish are told to `on_check`;
+/// the checks with a record in `resume` are not run (their records are taken); once `max_time`
+/// has passed no check is started, and each one not run gets an `error` record naming the limit.
 pub fn run_plan(
     plan: &[PlannedCheck<'_>],
     options: &AuditOptions,
 ) -> (Vec<CheckRecord>, usize, f64) {
+    let start = Instant::now();
+    let control = &options.control;
+    let deadline = control.max_time.map(|limit| start + limit);
     let trace = std::env::var_os("MFH_TRACE").is_some();
-    let (done, failures) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    let costs: Vec<f64> = plan.iter().map(crate::estimate::estimated_cost).collect();
-    let mut order: Vec<usize> = (0..plan.len()).collect();
-    order.sort_by(|&a, &b| costs[b].total_cmp(&costs[a]));
-    let next = AtomicUsize::new(0);
     let slots: Vec<std::sync::OnceLock<CheckRecord>> =
         plan.iter().map(|_| std::sync::OnceLock::new()).collect();
-    let run_one = |p: &PlannedCheck<'_>| {
+    let mut resumed = 0;
+    if let Some(previous) = &control.resume {
+        for (slot, p) in slots.iter().zip(plan) {
+            if let Some(r) = previous.get(&plan_key(p)) {
+                let _ = slot.set(r.clone());
+                resumed += 1;
+            }
+        }
+    }
+    if let Some(f) = &control.on_check {
+        (f.0)(CheckEvent::Plan {
+            checks: plan.len(),
+            resumed,
+        });
+    }
+    let (done, failures) = (AtomicUsize::new(resumed), AtomicUsize::new(0));
+    let costs: Vec<f64> = plan.iter().map(crate::estimate::estimated_cost).collect();
+    let mut order: Vec<usize> = (0..plan.len())
+        .filter(|&i| slots[i].get().is_none())
+        .collect();
+    order.sort_by(|&a, &b| costs[b].total_cmp(&costs[a]));
+    let next = AtomicUsize::new(0);
+    let run_one = |index: usize, p: &PlannedCheck<'_>| {
         if trace {
             eprintln!("start {} {} {}", p.check, p.model, p.case);
+        }
+        if let Some(f) = &control.on_check {
+            (f.0)(CheckEvent::Started { index, planned: p });
         }
         let ctx = RunContext {
             seed: check_seed(options.seed, p),
@@ -335,6 +452,13 @@ pub fn run_plan(
                 p.case
             );
         }
+        if let Some(f) = &control.on_check {
+            (f.0)(CheckEvent::Finished {
+                index,
+                planned: p,
+                record: &r,
+            });
+        }
         if let Some(f) = &options.progress {
             let failed = failures.fetch_add(usize::from(r.verdict.is_failure()), Relaxed);
             (f.0)(Progress {
@@ -348,19 +472,26 @@ pub fn run_plan(
     (0..rayon::current_num_threads().max(1))
         .into_par_iter()
         .for_each(|_| loop {
+            if deadline.is_some_and(|d| Instant::now() >= d) {
+                break;
+            }
             let at = next.fetch_add(1, Relaxed);
             let Some(&i) = order.get(at) else { break };
-            let _ = slots[i].set(run_one(&plan[i]));
+            let _ = slots[i].set(run_one(i, &plan[i]));
         });
     let mut records: Vec<CheckRecord> = slots
         .into_iter()
         .zip(plan)
         .map(|(s, p)| {
-            // Every index is taken from the queue once; an empty slot is not reached.
+            // Without a time limit every index is taken from the queue once, and an empty slot
+            // is not reached; with one, the checks not started in time are empty.
             s.into_inner().unwrap_or_else(|| {
                 let mut r = CheckRecord::new(&p.check, p.model.clone(), p.case.clone(), "");
                 r.verdict = Verdict::Error {
-                    message: "the check was not run".into(),
+                    message: match control.max_time {
+                        Some(limit) => not_run_message(limit),
+                        None => "the check was not run".into(),
+                    },
                 };
                 r
             })

@@ -19,19 +19,23 @@ pub struct AuditArgs {
     /// The audit seed (default: MFH_SEED, else a fixed seed).
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Output folder.
-    #[arg(long, default_value = "reports/latest")]
-    pub out: PathBuf,
+    /// Output folder (default: the --resume folder, else reports/latest).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
     /// Print report.json to standard output instead of the summary.
     #[arg(long)]
     pub json: bool,
-    /// No progress bar (it is shown only when standard error is a terminal anyway).
+    /// No progress: neither the bar of a terminal nor the lines (every 10 s) of a
+    /// non-terminal standard error.
     #[arg(long, short)]
     pub quiet: bool,
     /// Run only shard i of n (1 ≤ i ≤ n) of the plan, balanced by estimated cost; writes
     /// shard.json beside report.json for `mfh merge`.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "resume")]
     pub shard: Option<crate::shard::ShardSpec>,
+    /// Resuming and the time limit.
+    #[command(flatten)]
+    pub stream: super::stream::StreamArgs,
     /// Comparison with a saved run.
     #[command(flatten)]
     pub baseline: BaselineArgs,
@@ -115,7 +119,11 @@ pub fn run(args: AuditArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i
             return EXIT_BAD_INPUT;
         }
     };
-    let out = args.out;
+    if let Err(e) = args.stream.max_time() {
+        let _ = writeln!(stderr, "mfh audit: {e}");
+        return EXIT_BAD_INPUT;
+    }
+    let out = args.stream.out(args.out.clone(), "reports/latest");
     if let Err(e) = std::fs::create_dir_all(&out) {
         let _ = writeln!(stderr, "mfh audit: cannot create {}: {e}", out.display());
         return EXIT_BAD_INPUT;
@@ -124,14 +132,30 @@ pub fn run(args: AuditArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i
         profile: args.profile.profile(),
         seed,
         out: Some(out.clone()),
-        progress: None,
+        ..Default::default()
     };
-    let planned = crate::plan::plan(&scene, options.profile).len();
+    let (planned, fingerprint) = {
+        let plan = crate::plan::plan(&scene, options.profile);
+        (plan.len(), crate::shard::fingerprint(&plan))
+    };
     let origin = super::scene_origin(args.scene.as_deref());
     if let Err(e) = crate::scene::Scene::check_plan_size(planned, &origin, options.profile.name()) {
         let _ = writeln!(stderr, "mfh audit: {e}");
         return EXIT_BAD_INPUT;
     }
+    let header =
+        super::stream::audit_header(origin, options.profile.name(), seed, (fingerprint, planned));
+    let streaming =
+        match super::stream::prepare("audit", &args.stream, header, &out, args.quiet, stderr) {
+            Ok((control, streaming)) => {
+                options.control = control;
+                streaming
+            }
+            Err(e) => {
+                let _ = writeln!(stderr, "mfh audit: {e}");
+                return EXIT_BAD_INPUT;
+            }
+        };
     let scene_name = args.scene.as_ref().map(|p| p.display().to_string());
     let bar = std::sync::Arc::new(Bar::new(planned as u64, "checks", args.quiet));
     if bar.enabled() {
@@ -155,7 +179,8 @@ pub fn run(args: AuditArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i
         }
     };
     bar.finish();
-    finish_report(
+    let streamed = streaming.finish(&report, stderr);
+    let code = finish_report(
         &report,
         &out,
         args.json,
@@ -163,7 +188,15 @@ pub fn run(args: AuditArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i
         "audit",
         stdout,
         stderr,
-    )
+    );
+    match streamed {
+        // The whole report is written; a report.jsonl that misses records is still an error.
+        Err(e) => {
+            let _ = writeln!(stderr, "mfh audit: {e}");
+            EXIT_BAD_INPUT
+        }
+        Ok(()) => code,
+    }
 }
 
 /// Writes the report's sinks into `out`, prints the summary (or the JSON), the not-audited

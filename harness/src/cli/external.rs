@@ -27,12 +27,19 @@ pub struct ExternalArgs {
     /// The audit seed (default: MFH_SEED, else a fixed seed).
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Output folder (report.json, junit.xml, report.html).
-    #[arg(long, default_value = "reports/external")]
-    pub out: PathBuf,
+    /// Output folder (report.jsonl, report.json, junit.xml, report.html; default: the
+    /// --resume folder, else reports/external).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
     /// Print report.json to standard output instead of the summary.
     #[arg(long)]
     pub json: bool,
+    /// No progress lines (printed every 10 s when standard error is not a terminal).
+    #[arg(long, short)]
+    pub quiet: bool,
+    /// Resuming and the time limit.
+    #[command(flatten)]
+    pub stream: super::stream::StreamArgs,
 }
 
 /// Runs `mfh audit-external`: 0 pass, 1 a check failed (a protocol error during the audit is
@@ -61,7 +68,11 @@ pub fn run(args: ExternalArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
             return EXIT_BAD_INPUT;
         }
     }
-    let out = args.out;
+    if let Err(e) = args.stream.max_time() {
+        let _ = writeln!(stderr, "mfh audit-external: {e}");
+        return EXIT_BAD_INPUT;
+    }
+    let out = args.stream.out(args.out.clone(), "reports/external");
     if let Err(e) = std::fs::create_dir_all(&out) {
         let _ = writeln!(
             stderr,
@@ -70,6 +81,26 @@ pub fn run(args: ExternalArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
         );
         return EXIT_BAD_INPUT;
     }
+    let header = super::stream::external_header(
+        args.cmd.clone(),
+        args.against.clone(),
+        args.profile.profile().name(),
+        seed,
+    );
+    let (control, streaming) = match super::stream::prepare(
+        "audit-external",
+        &args.stream,
+        header,
+        &out,
+        args.quiet,
+        stderr,
+    ) {
+        Ok(prepared) => prepared,
+        Err(e) => {
+            let _ = writeln!(stderr, "mfh audit-external: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
     let request = crate::external::ExternalAudit {
         command: args.cmd,
         profile: args.profile.profile(),
@@ -77,6 +108,7 @@ pub fn run(args: ExternalArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
         against: args.against,
         timeout: std::time::Duration::from_secs_f64(args.timeout),
         out: Some(out.clone()),
+        control,
     };
     let report = match crate::external::audit(&request) {
         Ok(r) => r,
@@ -85,6 +117,10 @@ pub fn run(args: ExternalArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
             return EXIT_BAD_INPUT;
         }
     };
+    if let Err(e) = streaming.finish(&report, stderr) {
+        let _ = writeln!(stderr, "mfh audit-external: {e}");
+        return EXIT_BAD_INPUT;
+    }
     let written = match crate::report::write_all(&report, &out) {
         Ok(w) => w,
         Err(e) => {

@@ -15,6 +15,7 @@ pub mod plan;
 pub mod progress;
 pub mod selftest;
 pub mod signals;
+pub mod stream;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::ffi::OsString;

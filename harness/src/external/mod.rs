@@ -39,6 +39,8 @@ pub struct ExternalAudit {
     pub timeout: Duration,
     /// Where artefacts go.
     pub out: Option<PathBuf>,
+    /// Check events, resumed records and the time limit ([`crate::run::RunControl`]).
+    pub control: crate::run::RunControl,
 }
 
 /// Starts the child, audits it, shuts it down: the NDF checks if it offers an NDF (`d`), the
@@ -64,6 +66,7 @@ pub fn audit(request: &ExternalAudit) -> Result<AuditReport, ExternalError> {
         profile: request.profile,
         seed: request.seed,
         out: request.out.clone(),
+        control: request.control.clone(),
         ..Default::default()
     };
     let (plan, mut errors) = plan(&model, request, &name, &label);

@@ -9,6 +9,7 @@ pub mod cost_html;
 #[cfg(feature = "html")]
 pub mod html;
 pub mod json;
+pub mod jsonl;
 pub mod junit;
 #[cfg(feature = "html")]
 pub mod page;

@@ -311,7 +311,7 @@ fn audit(
                 profile,
                 seed,
                 out: None,
-                progress: None,
+                ..Default::default()
             };
             run_plan(&plan, &options).0
         }

@@ -96,7 +96,7 @@ pub fn measure(
                     profile,
                     seed,
                     out: None,
-                    progress: None,
+                    ..Default::default()
                 };
                 let (mut records, _, _) = run_plan(&plan, &options);
                 judge_at(&mut records, alpha);
