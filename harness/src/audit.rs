@@ -14,9 +14,11 @@
 //! ```
 
 pub mod capabilities;
+pub mod precision_probe;
 
 use crate::check::{self, against, PlannedCheck, Profile};
 use crate::plan::{plan_model, Effects};
+use crate::precision::Precision;
 use crate::record::{CheckRecord, Verdict};
 use crate::run::DEFAULT_SEED;
 use crate::run::{run_plan, AuditOptions, AuditReport};
@@ -48,6 +50,8 @@ pub struct Audit<'a> {
     seed_error: Option<String>,
     /// The capability traits the model's type implements, when [`crate::audit!`] detected them.
     implemented: Option<capabilities::Implemented>,
+    /// The precision the model computes in.
+    precision: Precision,
 }
 
 impl<'a> Audit<'a> {
@@ -74,6 +78,7 @@ impl<'a> Audit<'a> {
             against: None,
             seed_error,
             implemented: None,
+            precision: Precision::F64,
         }
     }
 
@@ -112,6 +117,15 @@ impl<'a> Audit<'a> {
     /// `audit.capabilities` record.
     pub fn implemented(mut self, implemented: capabilities::Implemented) -> Self {
         self.implemented = Some(implemented);
+        self
+    }
+
+    /// The precision the model computes in (default f64): a float32 implementation is judged
+    /// with value tolerances budgeted in float32 ε (`tolerance::Tolerance::at`) and oracles
+    /// that stop at its rounding floor; statistical checks are unchanged. Not yet for
+    /// [`Audit::of_bsdf`] (an `audit.configuration` error).
+    pub fn precision(mut self, precision: Precision) -> Self {
+        self.precision = precision;
         self
     }
 
@@ -204,7 +218,21 @@ impl<'a> Audit<'a> {
         if let Some(bsdf) = &self.bsdf {
             return self.plan_bsdf(bsdf.clone());
         }
-        let subject = Subject::user(self.model.clone(), &self.name, self.hints.clone());
+        // What the model's answers say of its precision (`audit.precision`); a float32 model
+        // declared f64 is judged at f32, and the record says so.
+        let seen = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            precision_probe::probe(self.model.as_ref())
+        }))
+        .ok();
+        let precision = seen.map_or(self.precision, |seen| {
+            precision_probe::effective(self.precision, seen)
+        });
+        let subject = Subject::user_at(
+            self.model.clone(),
+            &self.name,
+            self.hints.clone(),
+            precision,
+        );
         let why = format!("model `{}`", self.name);
         let mut errors = Vec::new();
         if let Some(message) = &self.seed_error {
@@ -215,6 +243,11 @@ impl<'a> Audit<'a> {
                 &subject.label,
                 format!("theta_max = {} is outside (0, π/2]", self.theta_max),
             ));
+        }
+        if let Some(seen) = seen {
+            let mut r = precision_probe::record(&subject.label, self.precision, seen);
+            r.precision = precision;
+            errors.push(r);
         }
         let effects = self.effects();
         errors.push(capabilities_record(
@@ -255,6 +288,16 @@ impl<'a> Audit<'a> {
         if let Some(message) = &self.seed_error {
             errors.push(config_error(&subject.label, message.clone()));
         }
+        if self.precision != Precision::F64 {
+            errors.push(config_error(
+                &subject.label,
+                format!(
+                    "precision: {} is not supported for a BSDF audit yet (its tolerances are \
+                     budgeted for f64)",
+                    self.precision
+                ),
+            ));
+        }
         let mut plan = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             check::bsdf::plan(&subject, self.options.profile, &why)
         }))
@@ -289,6 +332,17 @@ impl<'a> Audit<'a> {
         let (plan, mut errors) = self.plan();
         let (mut records, k, alpha) = run_plan(&plan, &self.options);
         records.append(&mut errors);
+        if self.bsdf.is_none() {
+            // The precision the plan's checks were judged at (the declared one, or f32 when
+            // `audit.precision` found a float32 model declared f64).
+            let judged = records
+                .iter()
+                .find(|r| r.check == "audit.precision")
+                .map_or(self.precision, |r| r.precision);
+            for r in &mut records {
+                r.precision = judged;
+            }
+        }
         let command = format!(
             "MFH_SEED={} cargo test (Audit::of({}).profile(Profile::{:?}))",
             self.options.seed, self.name, self.options.profile

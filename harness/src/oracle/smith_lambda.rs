@@ -30,6 +30,10 @@ pub trait LambdaSubject {
     fn lobe_width(&self) -> f64;
     /// Polar angles where D has kinks for every azimuth: cuts of the lune quadrature.
     fn theta_kinks(&self) -> Vec<f64>;
+    /// The precision D is computed in: the quadratures' rounding floor (default f64).
+    fn precision(&self) -> crate::precision::Precision {
+        crate::precision::Precision::F64
+    }
 }
 
 /// Below this exponent C of a Student-t slope marginal, the tail of (q − μ)P2 is out of reach
@@ -56,7 +60,7 @@ pub fn lambda_oracle_to(subject: &dyn LambdaSubject, w: Vec3, relative: f64) -> 
     if cos_t >= 1.0 || sin_t == 0.0 {
         return Estimate::default();
     }
-    let accuracy = Accuracy::relative(relative);
+    let accuracy = Accuracy::relative(relative).at(subject.precision());
     if let Some(slopes) = subject.ndf().as_slopes() {
         let mu = cos_t / sin_t;
         let phi = w[1].atan2(w[0]);
@@ -191,7 +195,7 @@ fn lambda_oracle_lune(subject: &dyn LambdaSubject, w: Vec3) -> Estimate {
             points.extend(kinks.iter().copied().filter(|k| *k > 0.0 && *k < eps_t));
             points.push(eps_t);
             points.sort_by(f64::total_cmp);
-            problems.push((points, Accuracy::relative(2e-13)));
+            problems.push((points, Accuracy::relative(2e-13).at(subject.precision())));
             geometry.push((r, eps_t, sin_cos(psi)));
             index.push(i);
         }
@@ -241,7 +245,11 @@ fn lambda_oracle_lune(subject: &dyn LambdaSubject, w: Vec3) -> Estimate {
     }
     points.retain(|p| *p >= lo && *p <= hi);
     points.sort_by(f64::total_cmp);
-    let outer = integrate_pieces_batch(&inner, &points, Accuracy::relative(1e-12));
+    let outer = integrate_pieces_batch(
+        &inner,
+        &points,
+        Accuracy::relative(1e-12).at(subject.precision()),
+    );
     Estimate {
         value: outer.value / ct,
         error_bound: (outer.error_bound + inner_error.get() * (hi - lo)) / ct,
