@@ -277,6 +277,20 @@ impl<'a> Audit<'a> {
                 )),
             }
         }
+        // Every record carries the precision it was judged at (the declared one, or f32 when
+        // `audit.precision` found a float32 model declared f64): stamped by the runner, so
+        // that `Audit::run` and the external audit's own runner both see it.
+        for p in &mut plan {
+            let run = std::mem::replace(&mut p.run, Box::new(|_| unreachable_record()));
+            p.run = Box::new(move |ctx| {
+                let mut r = run(ctx);
+                r.precision = precision;
+                r
+            });
+        }
+        for e in &mut errors {
+            e.precision = precision;
+        }
         (plan, errors)
     }
 
@@ -332,17 +346,7 @@ impl<'a> Audit<'a> {
         let (plan, mut errors) = self.plan();
         let (mut records, k, alpha) = run_plan(&plan, &self.options);
         records.append(&mut errors);
-        if self.bsdf.is_none() {
-            // The precision the plan's checks were judged at (the declared one, or f32 when
-            // `audit.precision` found a float32 model declared f64).
-            let judged = records
-                .iter()
-                .find(|r| r.check == "audit.precision")
-                .map_or(self.precision, |r| r.precision);
-            for r in &mut records {
-                r.precision = judged;
-            }
-        }
+
         let command = format!(
             "MFH_SEED={} cargo test (Audit::of({}).profile(Profile::{:?}))",
             self.options.seed, self.name, self.options.profile
@@ -424,6 +428,11 @@ fn capabilities_record(
     }
     r.case = case;
     r
+}
+
+/// The placeholder runner while a planned check's runner is wrapped (never run).
+fn unreachable_record() -> CheckRecord {
+    config_error(&json!(null), "a placeholder runner ran".into())
 }
 
 fn config_error(model: &serde_json::Value, message: String) -> CheckRecord {

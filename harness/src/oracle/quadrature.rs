@@ -38,6 +38,24 @@ fn node_noise(lo: f64, hi: f64) -> f64 {
     }
 }
 
+/// The most integrand evaluations one nested (2-D) quadrature spends ([`integrate_cap`] and
+/// the hemisphere integrals on it, the Λ lune oracle): 2·10⁷, ~100× what a smooth model's
+/// most expensive record spends at the `thorough` profile, and ~1 s of a closed-form D.
+/// Past it the inner integrals are no longer computed and the estimate is NaN with an infinite
+/// bound and `evaluations` ≥ the budget, which `check::compare` reports as an `error` naming
+/// the budget: a piecewise-constant D's `smith.lambda_route` took 125 s per record without it
+/// (issue 27).
+pub const EVALUATION_BUDGET: u64 = 20_000_000;
+
+/// The estimate of a nested quadrature that ran out of [`EVALUATION_BUDGET`].
+pub fn exhausted(evaluations: u64) -> Estimate {
+    Estimate {
+        value: f64::NAN,
+        error_bound: f64::INFINITY,
+        evaluations: evaluations.max(EVALUATION_BUDGET),
+    }
+}
+
 /// The accuracy asked of an integral: stop when the error bound is ≤ max(relative·|I|, absolute).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Accuracy {
@@ -566,8 +584,14 @@ fn cap_polar(
         points
     };
     let calls = Cell::new(0u64);
+    let over_budget = Cell::new(false);
     let inner =
         |phis: &[f64], out: &mut [f64]| {
+            if evaluations.get() >= EVALUATION_BUDGET {
+                over_budget.set(true);
+                out.fill(0.0);
+                return;
+            }
             calls.set(calls.get() + phis.len() as u64);
             let problems: Vec<(Vec<f64>, Accuracy)> = phis
                 .iter()
@@ -621,6 +645,9 @@ fn cap_polar(
     // The outer estimate's error bound covers its own rule; each inner error enters the outer
     // sum with a weight of at most the largest outer weight, bounded here by the mean inner
     // error times the azimuthal range.
+    if over_budget.get() {
+        return exhausted(evaluations.get());
+    }
     let mean_inner = inner_error.get() / (calls.get().max(1) as f64);
     Estimate {
         value: outer.value,

@@ -6,7 +6,8 @@
 //! errata and the claims hold every Λ route against it.
 
 use crate::oracle::quadrature::{
-    integrate_pieces, integrate_pieces_batch, integrate_pieces_many, integrate_upper, Accuracy,
+    exhausted, integrate_pieces, integrate_pieces_batch, integrate_pieces_many, integrate_upper,
+    Accuracy, EVALUATION_BUDGET,
 };
 use crate::oracle::{student_t, Estimate};
 use mfh_reference::model::SlopeDistribution;
@@ -181,7 +182,13 @@ fn lambda_oracle_lune(subject: &dyn LambdaSubject, w: Vec3) -> Estimate {
     let inner_error = Cell::new(0.0f64);
     // The inner integrals of one outer step run in lockstep, D in batches (one round trip per
     // step for an external model); the arithmetic is that of one integral at a time.
+    let over_budget = Cell::new(false);
     let inner = |psis: &[f64], out: &mut [f64]| {
+        if evaluations.get() >= EVALUATION_BUDGET {
+            over_budget.set(true);
+            out.fill(0.0);
+            return;
+        }
         let (mut problems, mut geometry, mut index) = (Vec::new(), Vec::new(), Vec::new());
         for (i, &psi) in psis.iter().enumerate() {
             out[i] = 0.0;
@@ -250,6 +257,9 @@ fn lambda_oracle_lune(subject: &dyn LambdaSubject, w: Vec3) -> Estimate {
         &points,
         Accuracy::relative(1e-12).at(subject.precision()),
     );
+    if over_budget.get() {
+        return exhausted(evaluations.get());
+    }
     Estimate {
         value: outer.value / ct,
         error_bound: (outer.error_bound + inner_error.get() * (hi - lo)) / ct,

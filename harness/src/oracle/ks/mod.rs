@@ -97,6 +97,13 @@ pub const INNER_ACCURACY: Accuracy = Accuracy {
 /// initial interval to [`MAX_SPANS`] (issue 27). The table's error bound still sums the
 /// accepted |S₂ − S₁|, so the bound stays honest and `TABLE_FRACTION` still judges it.
 pub(crate) const SIMPSON_NOISE_FLOOR: f64 = 16.0;
+/// The most density evaluations one KS table spends (the inner integrals included): 5·10⁷,
+/// ~50× a smooth model's table at the `thorough` profile. Past it the spans still open are
+/// accepted with an infinite error, so the test refuses to judge
+/// ([`Failure::TableInaccurate`], an `error` record) instead of refining for ever: the table
+/// of a D that oscillates faster than any span (GGX × (1 + ½ sin(10⁴ x))) ran for minutes
+/// (issue 27).
+pub const KS_EVALUATION_BUDGET: u64 = 50_000_000;
 /// Initial intervals per piece between cuts, before adaptive bisection.
 pub(crate) const INITIAL_PER_PIECE: usize = 8;
 /// Bisections below an initial interval before it is accepted whatever its error.
@@ -244,7 +251,15 @@ pub enum Failure {
     },
     /// The CDF table is not accurate enough for the number of samples: no verdict.
     #[error(
-        "CDF table error bound {error_bound:.2e} above {limit:.2e} ({TABLE_FRACTION} of 1/√N)"
+        "CDF table error bound {error_bound:.2e} above {limit:.2e} ({TABLE_FRACTION} of 1/√N){}",
+        if error_bound.is_infinite() {
+            format!(
+                ": the table's evaluation budget ({KS_EVALUATION_BUDGET} evaluations, \
+                 KS_EVALUATION_BUDGET) ran out"
+            )
+        } else {
+            String::new()
+        }
     )]
     TableInaccurate {
         /// The table's error bound.

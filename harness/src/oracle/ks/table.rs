@@ -2,7 +2,9 @@
 //! procedure in the module documentation of [`crate::oracle::ks`]).
 
 use super::{LobeHints, Marginal, INITIAL_PER_PIECE, INNER_ACCURACY, INTERPOLATION_TOLERANCE};
-use super::{MAX_DEPTH, MAX_SPANS, QUADRATURE_TOLERANCE, SIMPSON_NOISE_FLOOR};
+use super::{
+    KS_EVALUATION_BUDGET, MAX_DEPTH, MAX_SPANS, QUADRATURE_TOLERANCE, SIMPSON_NOISE_FLOOR,
+};
 use crate::oracle::lobe::{self, Lobe};
 use crate::oracle::quadrature::integrate_pieces_many;
 use crate::oracle::Estimate;
@@ -124,6 +126,26 @@ impl CdfTable {
             queued[s.interval] += 1;
         }
         while !active.is_empty() {
+            if evaluations >= KS_EVALUATION_BUDGET {
+                // Out of budget: the spans still open are accepted unrefined with an infinite
+                // quadrature error, so that the table's bound says it was not resolved.
+                for s in active.drain(..) {
+                    let h = s.b.x - s.a.x;
+                    let whole = h / 6.0 * (s.a.f + 4.0 * s.m.f + s.b.f);
+                    accepted[s.interval].push(Piece {
+                        a: s.a,
+                        m: s.m,
+                        b: s.b,
+                        left: 0.5 * whole,
+                        right: 0.5 * whole,
+                        quadrature_error: f64::INFINITY,
+                        interpolation_error: 0.0,
+                        inner_error: h * s.a.error.max(s.m.error).max(s.b.error),
+                        invalid: None,
+                    });
+                }
+                break;
+            }
             let xs: Vec<f64> = active
                 .iter()
                 .flat_map(|s| [0.5 * (s.a.x + s.m.x), 0.5 * (s.m.x + s.b.x)])
