@@ -12,7 +12,7 @@ use serde_json::json;
 /// Directions probed: 512, spread over the upper hemisphere (z = (i + ½)/512, golden azimuths).
 pub const PROBE_DIRECTIONS: usize = 512;
 
-/// The fewest non-trivial answers (finite, non-zero, not an integer) on which the probe
+/// The fewest distinct non-trivial answers (finite, non-zero, not an integer) on which the probe
 /// concludes: 64, so that an f64 model whose answers are f32 values by chance (probability
 /// ~2⁻²⁹ each) is never taken for one.
 pub const MIN_NONTRIVIAL: usize = 64;
@@ -33,7 +33,7 @@ fn directions() -> Vec<Vec3> {
 /// What the probe saw: the non-trivial answers and how many of them are float32 values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Seen {
-    /// Non-trivial answers (finite, non-zero, not an integer) of D, Λ and pdf_wm.
+    /// Distinct non-trivial answers (finite, non-zero, not an integer) of D, Λ and pdf_wm.
     pub nontrivial: usize,
     /// Of them, exactly representable in float32.
     pub float32: usize,
@@ -62,10 +62,13 @@ pub fn probe(model: &dyn Ndf) -> Seen {
         s.pdf_wm_batch(&dirs, &mut answers);
         all.extend_from_slice(&answers);
     }
-    let nontrivial: Vec<f64> = all
+    // Distinct values only: a constant (or dyadic) answer repeated says nothing.
+    let mut nontrivial: Vec<f64> = all
         .into_iter()
         .filter(|x| x.is_finite() && *x != 0.0 && x.fract() != 0.0)
         .collect();
+    nontrivial.sort_by(f64::total_cmp);
+    nontrivial.dedup();
     Seen {
         nontrivial: nontrivial.len(),
         float32: nontrivial
@@ -149,6 +152,14 @@ mod tests {
             record(&json!({}), Precision::F32, seen).verdict,
             Verdict::Pass
         );
+        // A constant dyadic D is a float32 value, but one value says nothing.
+        struct Half;
+        impl Ndf for Half {
+            fn d(&self, _: Vec3) -> f64 {
+                0.5
+            }
+        }
+        assert!(!probe(&Half).is_float32());
         let seen = probe(&Exact(3.0));
         assert!(!seen.is_float32(), "{seen:?}");
         assert_eq!(effective(Precision::F64, seen), Precision::F64);

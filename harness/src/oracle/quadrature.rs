@@ -39,13 +39,14 @@ fn node_noise(lo: f64, hi: f64) -> f64 {
 }
 
 /// The most integrand evaluations one nested (2-D) quadrature spends ([`integrate_cap`] and
-/// the hemisphere integrals on it, the Λ lune oracle): 2·10⁷, ~100× what a smooth model's
-/// most expensive record spends at the `thorough` profile, and ~1 s of a closed-form D.
+/// the hemisphere integrals on it, the Λ lune oracle): 10⁸, 5× the most a correct model is
+/// known to need (the normalization of an anisotropic GGX α = 10⁻⁴ × 10⁻², 2.0·10⁷, in
+/// `oracle::sweep_tests`), ~5 s of a closed-form D.
 /// Past it the inner integrals are no longer computed and the estimate is NaN with an infinite
 /// bound and `evaluations` ≥ the budget, which `check::compare` reports as an `error` naming
 /// the budget: a piecewise-constant D's `smith.lambda_route` took 125 s per record without it
 /// (issue 27).
-pub const EVALUATION_BUDGET: u64 = 20_000_000;
+pub const EVALUATION_BUDGET: u64 = 100_000_000;
 
 /// The estimate of a nested quadrature that ran out of [`EVALUATION_BUDGET`].
 pub fn exhausted(evaluations: u64) -> Estimate {
