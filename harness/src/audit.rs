@@ -14,9 +14,11 @@
 //! ```
 
 pub mod capabilities;
+pub mod precision_probe;
 
 use crate::check::{self, against, PlannedCheck, Profile};
 use crate::plan::{plan_model, Effects};
+use crate::precision::Precision;
 use crate::record::{CheckRecord, Verdict};
 use crate::run::DEFAULT_SEED;
 use crate::run::{run_plan, AuditOptions, AuditReport};
@@ -48,6 +50,8 @@ pub struct Audit<'a> {
     seed_error: Option<String>,
     /// The capability traits the model's type implements, when [`crate::audit!`] detected them.
     implemented: Option<capabilities::Implemented>,
+    /// The precision the model computes in.
+    precision: Precision,
 }
 
 impl<'a> Audit<'a> {
@@ -74,6 +78,7 @@ impl<'a> Audit<'a> {
             against: None,
             seed_error,
             implemented: None,
+            precision: Precision::F64,
         }
     }
 
@@ -112,6 +117,15 @@ impl<'a> Audit<'a> {
     /// `audit.capabilities` record.
     pub fn implemented(mut self, implemented: capabilities::Implemented) -> Self {
         self.implemented = Some(implemented);
+        self
+    }
+
+    /// The precision the model computes in (default f64): a float32 implementation is judged
+    /// with value tolerances budgeted in float32 ε (`tolerance::Tolerance::at`) and oracles
+    /// that stop at its rounding floor; statistical checks are unchanged. Not yet for
+    /// [`Audit::of_bsdf`] (an `audit.configuration` error).
+    pub fn precision(mut self, precision: Precision) -> Self {
+        self.precision = precision;
         self
     }
 
@@ -213,7 +227,21 @@ impl<'a> Audit<'a> {
         if let Some(bsdf) = &self.bsdf {
             return self.plan_bsdf(bsdf.clone());
         }
-        let subject = Subject::user(self.model.clone(), &self.name, self.hints.clone());
+        // What the model's answers say of its precision (`audit.precision`); a float32 model
+        // declared f64 is judged at f32, and the record says so.
+        let seen = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            precision_probe::probe(self.model.as_ref())
+        }))
+        .ok();
+        let precision = seen.map_or(self.precision, |seen| {
+            precision_probe::effective(self.precision, seen)
+        });
+        let subject = Subject::user_at(
+            self.model.clone(),
+            &self.name,
+            self.hints.clone(),
+            precision,
+        );
         let why = format!("model `{}`", self.name);
         let mut errors = Vec::new();
         if let Some(message) = &self.seed_error {
@@ -224,6 +252,11 @@ impl<'a> Audit<'a> {
                 &subject.label,
                 format!("theta_max = {} is outside (0, π/2]", self.theta_max),
             ));
+        }
+        if let Some(seen) = seen {
+            let mut r = precision_probe::record(&subject.label, self.precision, seen);
+            r.precision = precision;
+            errors.push(r);
         }
         let effects = self.effects();
         errors.push(capabilities_record(
@@ -253,6 +286,20 @@ impl<'a> Audit<'a> {
                 )),
             }
         }
+        // Every record carries the precision it was judged at (the declared one, or f32 when
+        // `audit.precision` found a float32 model declared f64): stamped by the runner, so
+        // that `Audit::run` and the external audit's own runner both see it.
+        for p in &mut plan {
+            let run = std::mem::replace(&mut p.run, Box::new(|_| unreachable_record()));
+            p.run = Box::new(move |ctx| {
+                let mut r = run(ctx);
+                r.precision = precision;
+                r
+            });
+        }
+        for e in &mut errors {
+            e.precision = precision;
+        }
         (plan, errors)
     }
 
@@ -263,6 +310,16 @@ impl<'a> Audit<'a> {
         let mut errors = Vec::new();
         if let Some(message) = &self.seed_error {
             errors.push(config_error(&subject.label, message.clone()));
+        }
+        if self.precision != Precision::F64 {
+            errors.push(config_error(
+                &subject.label,
+                format!(
+                    "precision: {} is not supported for a BSDF audit yet (its tolerances are \
+                     budgeted for f64)",
+                    self.precision
+                ),
+            ));
         }
         let mut plan = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             check::bsdf::plan(&subject, self.options.profile, &why)
@@ -298,6 +355,7 @@ impl<'a> Audit<'a> {
         let (plan, mut errors) = self.plan();
         let (mut records, k, alpha) = run_plan(&plan, &self.options);
         records.append(&mut errors);
+
         let command = format!(
             "MFH_SEED={} cargo test (Audit::of({}).profile(Profile::{:?}))",
             self.options.seed, self.name, self.options.profile
@@ -379,6 +437,11 @@ fn capabilities_record(
     }
     r.case = case;
     r
+}
+
+/// The placeholder runner while a planned check's runner is wrapped (never run).
+fn unreachable_record() -> CheckRecord {
+    config_error(&json!(null), "a placeholder runner ran".into())
 }
 
 fn config_error(model: &serde_json::Value, message: String) -> CheckRecord {

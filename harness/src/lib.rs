@@ -19,6 +19,7 @@ pub mod messages;
 pub mod mitsuba;
 pub mod oracle;
 pub mod plan;
+pub mod precision;
 pub mod random;
 pub mod readback;
 pub mod record;
@@ -36,6 +37,7 @@ pub mod tolerance;
 pub use audit::Audit;
 pub use check::Profile;
 pub use mfh_reference::model;
+pub use precision::Precision;
 pub use scene::Sampling;
 pub use subject::Hints;
 

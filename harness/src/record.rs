@@ -181,6 +181,10 @@ pub struct CheckRecord {
     pub cost: Cost,
     /// The seed of the check's random stream (statistical checks).
     pub seed: Option<u64>,
+    /// The precision the implementation was judged at (its value tolerances and the oracles'
+    /// rounding floors; `f64` in reports written before issue 27).
+    #[serde(default)]
+    pub precision: crate::precision::Precision,
     /// The source: document and equation.
     pub source: String,
     /// The closed forms this record exercises (`family/quantity/route`), for the coverage registry.
@@ -289,6 +293,7 @@ impl CheckRecord {
             },
             cost: Cost::default(),
             seed: None,
+            precision: crate::precision::Precision::F64,
             source: source.to_string(),
             covers: Vec::new(),
             artefacts: Vec::new(),

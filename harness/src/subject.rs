@@ -7,6 +7,7 @@ pub mod bsdf;
 
 use crate::oracle::lobe::{self, Lobe, Options};
 use crate::oracle::smith_lambda::LambdaSubject;
+use crate::precision::Precision;
 use mfh_reference::family::{FamilyInfo, FamilySpec};
 use mfh_reference::registry;
 use mfh_reference::{Model, ModelSpec, Ndf, ParamError, Vec3};
@@ -35,6 +36,9 @@ pub struct Subject<'a> {
     pub reference: Option<(ModelSpec, &'static FamilyInfo)>,
     /// What the user stated.
     pub hints: Hints,
+    /// The precision the implementation computes in (declared; F64 for reference models):
+    /// value tolerances and the oracles' rounding floors follow it.
+    pub precision: Precision,
     measured: OnceLock<Lobe>,
 }
 
@@ -74,6 +78,7 @@ impl<'a> Subject<'a> {
             label: serde_json::to_value(&spec).unwrap_or(Value::Null),
             reference: Some((spec, info)),
             hints,
+            precision: Precision::F64,
             measured: OnceLock::new(),
         }
     }
@@ -87,11 +92,22 @@ impl<'a> Subject<'a> {
 
     /// A user's model, named `name` in the records.
     pub fn user(model: Arc<dyn Ndf + 'a>, name: &str, hints: Hints) -> Arc<Self> {
+        Self::user_at(model, name, hints, Precision::F64)
+    }
+
+    /// A user's model that computes in `precision`.
+    pub fn user_at(
+        model: Arc<dyn Ndf + 'a>,
+        name: &str,
+        hints: Hints,
+        precision: Precision,
+    ) -> Arc<Self> {
         Arc::new(Self {
             model,
             label: json!({ "name": name }),
             reference: None,
             hints,
+            precision,
             measured: OnceLock::new(),
         })
     }
@@ -181,6 +197,9 @@ impl LambdaSubject for Subject<'_> {
     }
     fn theta_kinks(&self) -> Vec<f64> {
         Subject::theta_kinks(self)
+    }
+    fn precision(&self) -> Precision {
+        self.precision
     }
 }
 

@@ -9,6 +9,7 @@
 mod bsdf;
 mod chi2;
 mod expected;
+mod precision;
 
 pub use bsdf::{
     BSDF_AGAINST_REFERENCE, BSDF_ENERGY, BSDF_RECIPROCITY, BSDF_SAMPLE_CONSISTENCY,
@@ -19,6 +20,7 @@ pub use chi2::{
     MASS_TOLERANCE, MIN_EXPECTED, REMOTE_CELL_ABSOLUTE_TOLERANCE,
 };
 pub use expected::{expected_failures, Bound, Domain, ExpectedFailure, EXPECTED_FAILURES};
+pub use precision::{cell_relative_tolerance, EPS32, F32_TABLE};
 
 /// A named tolerance.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,6 +31,22 @@ pub struct Tolerance {
     pub value: f64,
     /// Why this value.
     pub reason: &'static str,
+}
+
+impl Tolerance {
+    /// This tolerance for an implementation computing in `precision`: itself for f64; for f32
+    /// its row of `tolerance/precision.rs` (an error budget in float32 ε with its reason), or
+    /// itself where the tolerance does not depend on the implementation's precision (α, the
+    /// documents' claims, bit-for-bit promises of mfh's own models).
+    pub fn at(&self, precision: crate::precision::Precision) -> Tolerance {
+        match precision {
+            crate::precision::Precision::F64 => *self,
+            crate::precision::Precision::F32 => F32_TABLE
+                .iter()
+                .find(|(name, _)| *name == self.name)
+                .map_or(*self, |(_, t)| *t),
+        }
+    }
 }
 
 /// The largest relative error bound of an oracle, as a fraction of the tolerance it judges
@@ -364,6 +382,17 @@ mod tests {
             assert!(t.value >= 0.0 && t.reason.len() > 40, "{t:?}");
             assert!(TABLE[..i].iter().all(|u| u.name != t.name), "{}", t.name);
         }
+        // Every float32 row names an f64 tolerance, is looser than it, and has its reason.
+        for (name, t) in F32_TABLE {
+            let f64_row = TABLE.iter().find(|u| u.name == *name).expect(name);
+            assert!(t.value > f64_row.value && t.reason.len() > 40, "{t:?}");
+            assert_eq!(f64_row.at(crate::precision::Precision::F32), *t);
+            assert_eq!(f64_row.at(crate::precision::Precision::F64), *f64_row);
+        }
+        assert_eq!(
+            STATISTICAL_ALPHA.at(crate::precision::Precision::F32),
+            STATISTICAL_ALPHA
+        );
         assert!(
             expected_failures("smith.lambda_route", "std", "2f1_algorithm2")
                 .next()

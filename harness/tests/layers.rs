@@ -13,7 +13,14 @@ use std::path::{Path, PathBuf};
 const LAYERS: &[(u32, &[&str])] = &[
     (
         0,
-        &["record", "record_serde", "tolerance", "random", "messages"],
+        &[
+            "record",
+            "record_serde",
+            "tolerance",
+            "random",
+            "messages",
+            "precision",
+        ],
     ),
     (1, &["oracle"]),
     (2, &["check", "subject"]),

@@ -5,6 +5,7 @@
 
 use super::{applied, covers, PlannedCheck};
 use crate::check::{need, Check};
+use crate::precision::Precision;
 use crate::record::{Measured, OracleValue, Verdict};
 use crate::subject::Subject;
 use crate::tolerance::PDF_JACOBIAN;
@@ -15,8 +16,24 @@ use std::sync::Arc;
 
 /// Points at which the Jacobian is measured.
 const POINTS: u32 = 1024;
-/// The finite-difference step in u (and half of it, for Richardson extrapolation).
+/// The finite-difference step in u (and half of it, for Richardson extrapolation) for an f64
+/// sampler: truncation O(h⁴) after extrapolation, round-off ε/h ≈ 2e-12.
 const STEP: f64 = 1e-4;
+/// The step for a float32 sampler: central differences balance truncation h² against
+/// round-off ε₃₂/h at h ≈ ε₃₂^(1/3) ≈ 5e-3; 4e-3 (round-off ≈ 3e-5 per derivative, the
+/// extrapolated truncation O(h⁴) ≈ 3e-10) keeps the stencil (±2h) inside the margin.
+const STEP_F32: f64 = 4e-3;
+/// [`UNRESOLVED`] for a float32 sampler: the two steps' densities differ by their round-off
+/// (≈ 3e-5 × the map's condition, ≤ 20) and truncation (≈ h² ≈ 1.6e-5): 1e-2.
+const UNRESOLVED_F32: f64 = 1e-2;
+
+/// The step and the unresolved threshold for a sampler computing in `precision`.
+fn stencil(precision: Precision) -> (f64, f64) {
+    match precision {
+        Precision::F64 => (STEP, UNRESOLVED),
+        Precision::F32 => (STEP_F32, UNRESOLVED_F32),
+    }
+}
 /// Interior margin of the unit square: the points keep 2·STEP away from its edges.
 const MARGIN: f64 = 0.01;
 /// Where the two step sizes disagree by more than this (relative), the map has a kink or a
@@ -72,6 +89,12 @@ pub struct JacobianResult {
 
 /// Measures `pdf_wm` against the density of the sampling map.
 pub fn measure(sampler: &dyn NormalSampler) -> JacobianResult {
+    measure_at(sampler, Precision::F64)
+}
+
+/// [`measure`] with the steps for a sampler computing in `precision`.
+pub fn measure_at(sampler: &dyn NormalSampler, precision: Precision) -> JacobianResult {
+    let (step, unresolved) = stencil(precision);
     let golden = 0.618_033_988_749_894_9;
     let mut out = JacobianResult {
         worst: 0.0,
@@ -85,15 +108,15 @@ pub fn measure(sampler: &dyn NormalSampler) -> JacobianResult {
             MARGIN + span * (f64::from(i) + 0.5) / f64::from(POINTS),
             MARGIN + span * (f64::from(i) * golden).fract(),
         ];
-        let coarse = map_density(sampler, u, STEP);
-        let fine = map_density(sampler, u, STEP / 2.0);
+        let coarse = map_density(sampler, u, step);
+        let fine = map_density(sampler, u, step / 2.0);
         // Central differences err as h²: (4 fine − coarse)/3 cancels that term.
         let density = (4.0 * fine - coarse) / 3.0;
         let pdf = sampler.pdf_wm(sampler.sample_wm(u));
         let error = if !pdf.is_finite() || pdf < 0.0 {
             f64::INFINITY
         } else if !(density.is_finite() && density > 0.0)
-            || (coarse - fine).abs() > UNRESOLVED * fine.abs()
+            || (coarse - fine).abs() > unresolved * fine.abs()
         {
             continue;
         } else {
@@ -112,7 +135,10 @@ pub fn measure(sampler: &dyn NormalSampler) -> JacobianResult {
 /// Plans the Jacobian check of a model with a sampler.
 pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> PlannedCheck<'a> {
     let family = subject.family();
-    let case = json!({"points": POINTS, "step": STEP});
+    let precision = subject.precision;
+    let (step, _) = stencil(precision);
+    let tolerance = PDF_JACOBIAN.at(precision);
+    let case = json!({"points": POINTS, "step": step});
     let s = subject.clone();
     Check::new(
         "sampling.pdf_jacobian",
@@ -126,7 +152,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> PlannedCheck<'a> {
     .covers(vec![covers(family, "pdf_wm", "default")])
     .run(move |r, _| {
         let sampler = need(s.model.as_sampler(), "normal sampler")?;
-        let j = measure(sampler);
+        let j = measure_at(sampler, precision);
         r.value = Some(j.pdf_and_density.0);
         r.oracle = Some(OracleValue {
             value: j.pdf_and_density.1,
@@ -134,8 +160,8 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> PlannedCheck<'a> {
             kind: "error_bound",
         });
         r.measured = Some(Measured::Relative { error: j.worst });
-        r.tolerance = Some(applied(&PDF_JACOBIAN));
-        r.case = json!({"points": POINTS, "step": STEP, "resolved": j.resolved,
+        r.tolerance = Some(applied(&tolerance));
+        r.case = json!({"points": POINTS, "step": step, "resolved": j.resolved,
                                 "worst_at_u": j.at});
         r.verdict = if f64::from(j.resolved) < MIN_RESOLVED * f64::from(POINTS) {
             Verdict::Error {
@@ -145,7 +171,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> PlannedCheck<'a> {
                     j.resolved
                 ),
             }
-        } else if j.worst <= PDF_JACOBIAN.value {
+        } else if j.worst <= tolerance.value {
             Verdict::Pass
         } else {
             Verdict::Fail

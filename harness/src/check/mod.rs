@@ -220,7 +220,18 @@ pub fn compare(record: &mut CheckRecord, value: f64, oracle: Estimate, tolerance
     record.tolerance = Some(applied(tolerance));
     let resolved = bound.is_finite() && bound <= ORACLE_BOUND_FRACTION * tolerance.value;
     // The pass rule `mfh merge` re-judges stored verdicts by: one function for both.
-    record.verdict = if !oracle.value.is_finite() || !bound.is_finite() {
+    record.verdict = if (!oracle.value.is_finite() || !bound.is_finite())
+        && oracle.evaluations >= crate::oracle::quadrature::EVALUATION_BUDGET
+    {
+        Verdict::Error {
+            message: format!(
+                "{UNRESOLVED}: the oracle's evaluation budget ({} evaluations of the model, \
+                 oracle::quadrature::EVALUATION_BUDGET) ran out before it converged (an \
+                 integrand with steps or oscillations no quadrature resolves)",
+                crate::oracle::quadrature::EVALUATION_BUDGET
+            ),
+        }
+    } else if !oracle.value.is_finite() || !bound.is_finite() {
         unresolved(bound, tolerance)
     } else if !value.is_finite() || record.meets_tolerance() != Some(true) {
         Verdict::Fail

@@ -38,12 +38,17 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> 
                 theta: &|_| kinks.clone(),
                 phi: &[],
             }),
-            Accuracy::relative(1e-11),
+            Accuracy::relative(1e-11).at(s.precision),
         );
         // The value under test is the quadrature of the closed form, so the
         // quadrature's error bound is the slack `compare` grants (reported as the
         // oracle's uncertainty).
-        compare(r, e.value, Estimate { value: 1.0, ..e }, &NORMALIZATION);
+        compare(
+            r,
+            e.value,
+            Estimate { value: 1.0, ..e },
+            &NORMALIZATION.at(s.precision),
+        );
         Ok(())
     })]
 }

@@ -23,11 +23,13 @@ use crate::check::{need, Check};
 use crate::oracle::chi2::{chi2_test_batches_cut, BatchPdf, BatchSampler, Chi2Config};
 use crate::oracle::ks::Marginal;
 use crate::oracle::monte_carlo::{estimate_batch, two_sided_p};
+use crate::precision::Precision;
 use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
 use crate::subject::Subject;
 use crate::tolerance::{
-    CELL_ABSOLUTE_TOLERANCE, CELL_RELATIVE_TOLERANCE, KINKED_CELL_RELATIVE_TOLERANCE,
-    PDF_CONSISTENCY, REMOTE_CELL_ABSOLUTE_TOLERANCE, STATISTICAL_ALPHA,
+    cell_relative_tolerance, CELL_ABSOLUTE_TOLERANCE, CELL_RELATIVE_TOLERANCE,
+    KINKED_CELL_RELATIVE_TOLERANCE, PDF_CONSISTENCY, REMOTE_CELL_ABSOLUTE_TOLERANCE,
+    STATISTICAL_ALPHA,
 };
 use mfh_reference::geometry::{dot, from_spherical, Vec3};
 use mfh_reference::Ndf;
@@ -71,7 +73,10 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                         &|u: &[[f64; 2]], out: &mut [Vec3]| sampler.sample_wm_batch(u, out),
                         &|mm: &[Vec3], out: &mut [f64]| sampler.pdf_wm_batch(mm, out),
                         &config,
-                        (CELL_RELATIVE_TOLERANCE, CELL_ABSOLUTE_TOLERANCE),
+                        (
+                            cell_relative_tolerance(CELL_RELATIVE_TOLERANCE, m.precision),
+                            CELL_ABSOLUTE_TOLERANCE,
+                        ),
                         Some(m.lobe()),
                         &kinks,
                     );
@@ -125,7 +130,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                     };
                     worst = worst.max(e);
                 }
-                compare_exact(r, worst, 0.0, &PDF_CONSISTENCY);
+                compare_exact(r, worst, 0.0, &PDF_CONSISTENCY.at(m.precision));
                 // `worst` is itself a relative error (against 0, `compare` says absolute).
                 r.measured = Some(Measured::Relative { error: worst });
                 Ok(())
@@ -267,7 +272,7 @@ fn chi2_kinked(
     (resolution, samples): (usize, u64),
     sample: &BatchSampler<'_>,
     pdf: &BatchPdf<'_>,
-    remote: bool,
+    (remote, precision): (bool, Precision),
 ) {
     let config = Chi2Config {
         resolution,
@@ -280,7 +285,10 @@ fn chi2_kinked(
     } else {
         CELL_ABSOLUTE_TOLERANCE
     };
-    let tolerance = (KINKED_CELL_RELATIVE_TOLERANCE, absolute);
+    let tolerance = (
+        cell_relative_tolerance(KINKED_CELL_RELATIVE_TOLERANCE, precision),
+        absolute,
+    );
     let result = chi2_test_batches_cut(sample, pdf, &config, tolerance, None, &[]);
     fill_chi2(r, &result, ctx, samples);
 }

@@ -8,6 +8,7 @@
 use super::{compare, covers, Planned, PlannedCheck};
 use crate::check::Check;
 use crate::oracle::smith_lambda::lambda_oracle;
+use crate::precision::Precision;
 use crate::record::Verdict;
 use crate::subject::Subject;
 use crate::tolerance::{CLOSED_FORM, IDENTITY, NUMERICAL_ROUTE};
@@ -45,6 +46,24 @@ pub fn edge_points() -> Vec<[f64; 2]> {
 
 /// Everything that is wrong with a model at the hard inputs, as readable lines (empty: none).
 pub fn probe(model: &dyn Ndf) -> Vec<String> {
+    probe_at(model, Precision::F64)
+}
+
+/// How far from 1 a sampled normal's length may be: 1e-12 (≈ 4500 ε) for f64, and for a
+/// float32 sampler `identity_f32` (64 ε₃₂ = 7.6e-6): a float32 unit vector normalized in
+/// float32 is off by a few ε₃₂.
+fn unit_tolerance(precision: Precision) -> f64 {
+    match precision {
+        Precision::F64 => 1e-12,
+        p => IDENTITY.at(p).value,
+    }
+}
+
+/// [`probe`] for a model computing in `precision` (the unit-length and monotonicity
+/// tolerances are that precision's).
+pub fn probe_at(model: &dyn Ndf, precision: Precision) -> Vec<String> {
+    let identity = IDENTITY.at(precision).value;
+    let unit = unit_tolerance(precision);
     let mut problems = Vec::new();
     let thetas = [
         0.0,
@@ -80,7 +99,7 @@ pub fn probe(model: &dyn Ndf) -> Vec<String> {
                 if !ok {
                     problems.push(format!("Λ = {l} at θ = {t}, φ = {phi}"));
                 }
-                if l < last * (1.0 - IDENTITY.value) {
+                if l < last * (1.0 - identity) {
                     problems.push(format!("Λ decreases: {l} < {last} at θ = {t}, φ = {phi}"));
                 }
                 last = l;
@@ -105,7 +124,7 @@ pub fn probe(model: &dyn Ndf) -> Vec<String> {
         for u in edge_points() {
             let m = sampler.sample_wm(u);
             let len = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
-            if !(m[2] >= 0.0 && (len - 1.0).abs() < 1e-12) {
+            if !(m[2] >= 0.0 && (len - 1.0).abs() < unit) {
                 problems.push(format!("sample_wm({u:?}) = {m:?}"));
                 continue;
             }
@@ -130,7 +149,7 @@ pub fn plan_incidence<'a>(subject: &Arc<Subject<'a>>, why: &str) -> PlannedCheck
         ))
         .covers(covered)
         .run(move |r, _| {
-            let problems = probe(s.model.as_ref());
+            let problems = probe_at(s.model.as_ref(), s.precision);
             r.verdict = if problems.is_empty() {
                 Verdict::Pass
             } else {

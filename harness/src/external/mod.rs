@@ -109,7 +109,11 @@ fn plan<'a>(
     let description = model.description();
     let against = request.against.as_deref().map(Against::parse);
     let configure = |audit: Audit<'a>, wanted: fn(&Against) -> bool| {
-        let audit = audit.name(name).profile(request.profile).seed(request.seed);
+        let audit = audit
+            .name(name)
+            .profile(request.profile)
+            .seed(request.seed)
+            .precision(description.precision());
         match (&against, &request.against) {
             (Some(Ok(spec)), Some(text)) if wanted(spec) => audit.against(text),
             _ => audit,

@@ -290,6 +290,10 @@ pub struct Description {
     /// checked by [`Description::validate`], read by [`Description::transport`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transport: Option<Value>,
+    /// The precision the implementation computes in, `"f64"` (absent: the default) or
+    /// `"f32"`; checked by [`Description::validate`], read by [`Description::precision`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub precision: Option<Value>,
 }
 
 impl Description {
@@ -313,6 +317,16 @@ impl Description {
     /// [`Description::validate`]).
     pub fn eta(&self) -> Option<f64> {
         self.eta.as_ref().and_then(Value::as_f64)
+    }
+
+    /// The precision the implementation computes in (f64 when absent or invalid: see
+    /// [`Description::validate`]).
+    pub fn precision(&self) -> crate::precision::Precision {
+        self.precision
+            .as_ref()
+            .and_then(Value::as_str)
+            .and_then(|p| p.parse().ok())
+            .unwrap_or_default()
     }
 
     /// The BSDF's transport convention (radiance when absent or invalid: see
@@ -394,6 +408,16 @@ impl Description {
             if !matches!(t.as_str(), Some("importance" | "radiance")) {
                 return Err(format!(
                     "\"transport\" is {t}; it must be \"importance\" or \"radiance\""
+                ));
+            }
+        }
+        if let Some(p) = &self.precision {
+            let valid = p
+                .as_str()
+                .is_some_and(|p| p.parse::<crate::precision::Precision>().is_ok());
+            if !valid {
+                return Err(format!(
+                    "\"precision\" is {p}; it must be \"f64\" (the default) or \"f32\""
                 ));
             }
         }
@@ -771,8 +795,26 @@ mod tests {
             parameters: Value::Null,
             eta: None,
             transport: None,
+            precision: None,
         };
         assert!(d(&["d", "lambda", "g2"], 1).validate().is_ok());
+        // "precision": "f64" or "f32"; anything else is an error naming the field.
+        use crate::precision::Precision;
+        let at = |p: Value| Description {
+            precision: Some(p),
+            ..d(&["d"], 2)
+        };
+        assert_eq!(at(Value::from("f32")).precision(), Precision::F32);
+        assert!(at(Value::from("f32")).validate().is_ok());
+        assert_eq!(d(&["d"], 2).precision(), Precision::F64);
+        for bad in [Value::from("float"), Value::from(32), Value::Null] {
+            let e = at(bad).validate().unwrap_err();
+            assert!(e.contains("\"precision\""), "{e}");
+        }
+        let parsed: Description =
+            serde_json::from_str(r#"{"protocol":2,"capabilities":["d"],"precision":"f32"}"#)
+                .unwrap();
+        assert_eq!(parsed.precision(), Precision::F32);
         assert!(d(&["lambda"], 1).validate().unwrap_err().contains("\"d\""));
         assert!(d(&["d"], 2).validate().is_ok());
         assert!(d(&["d"], 3).validate().unwrap_err().contains("version 3"));
@@ -797,6 +839,7 @@ mod tests {
             parameters: Value::Null,
             eta,
             transport,
+            precision: None,
         };
         let bsdf = ["bsdf_eval", "bsdf_pdf", "bsdf_sample"];
         let ok = d(&bsdf, Some(1.5.into()), Some("importance".into()));

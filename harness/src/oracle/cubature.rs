@@ -40,6 +40,15 @@ const WG: [f64; 4] = [
 /// The deepest quadrant bisection; past it the estimate is accepted with its error.
 pub const MAX_DEPTH: u32 = 10;
 
+/// The most rectangles one call of [`integrate_rectangles_batch`] may create by bisection
+/// (each 225 evaluations and one 80-byte node): 2¹⁸ ≈ 2.6·10⁵ rectangles, 5.9·10⁷
+/// evaluations, 21 MB. Past it no rectangle is bisected further and the leaves keep their
+/// (honest) error estimates. A correct model's chi-square masses at the `ci` profile create
+/// ~10³–10⁴; a density that oscillates faster than any cell (GGX × (1 + ½ sin(10⁴ x))) or is
+/// rounding noise asked for 1e-9 (a float32 pdf) would create 4¹⁰ per piece: the tree grew to
+/// 20 GB (issue 27).
+pub const MAX_RECTANGLES: usize = 1 << 18;
+
 pub use super::Estimate;
 
 pub mod global;
@@ -223,11 +232,12 @@ pub fn integrate_rectangles_batch(
         n.tolerance = t.absolute.max(t.relative * n.value.abs());
     }
     let mut level = 0..nodes.len();
+    let budget = rectangles.len() + MAX_RECTANGLES;
     while !level.is_empty() {
         let start = nodes.len();
         for i in level.clone() {
             let n = &nodes[i];
-            if !(n.error > n.tolerance) || n.depth >= MAX_DEPTH {
+            if !(n.error > n.tolerance) || n.depth >= MAX_DEPTH || nodes.len() + 4 > budget {
                 continue;
             }
             let (x, y, tolerance, depth) = (n.x, n.y, 0.25 * n.tolerance, n.depth + 1);

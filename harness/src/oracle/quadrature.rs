@@ -18,8 +18,12 @@ use std::cell::Cell;
 /// (honest) error bound rather than bisecting for ever at round-off.
 pub const MAX_PIECES: usize = 400;
 
-/// The relative round-off floor of a target: 32 ulps of the summed magnitudes of the pieces.
-const ROUNDOFF: f64 = 32.0 * f64::EPSILON;
+/// The relative round-off floor of a target, in units of the integrand's rounding
+/// ([`Accuracy::noise`]): 32 of them of the summed magnitudes of the pieces. For an f64
+/// integrand 32 ulps; for a float32 implementation 32 ε₃₂ = 3.8e-6: below it, refinement of a
+/// noisy integrand only trades one rounding error for another (a float32 GGX's normalization
+/// passed 2·10⁸ evaluations chasing 1e-11, issue 27).
+const ROUNDOFF: f64 = 32.0;
 
 /// How much rounding of the nodes themselves magnifies round-off on [lo, hi]: a node next to
 /// an end point x is known only to ~ε|x|, so on a piece narrow next to its own position (the
@@ -34,6 +38,25 @@ fn node_noise(lo: f64, hi: f64) -> f64 {
     }
 }
 
+/// The most integrand evaluations one nested (2-D) quadrature spends ([`integrate_cap`] and
+/// the hemisphere integrals on it, the Λ lune oracle): 10⁸, 5× the most a correct model is
+/// known to need (the normalization of an anisotropic GGX α = 10⁻⁴ × 10⁻², 2.0·10⁷, in
+/// `oracle::sweep_tests`), ~5 s of a closed-form D.
+/// Past it the inner integrals are no longer computed and the estimate is NaN with an infinite
+/// bound and `evaluations` ≥ the budget, which `check::compare` reports as an `error` naming
+/// the budget: a piecewise-constant D's `smith.lambda_route` took 125 s per record without it
+/// (issue 27).
+pub const EVALUATION_BUDGET: u64 = 100_000_000;
+
+/// The estimate of a nested quadrature that ran out of [`EVALUATION_BUDGET`].
+pub fn exhausted(evaluations: u64) -> Estimate {
+    Estimate {
+        value: f64::NAN,
+        error_bound: f64::INFINITY,
+        evaluations: evaluations.max(EVALUATION_BUDGET),
+    }
+}
+
 /// The accuracy asked of an integral: stop when the error bound is ≤ max(relative·|I|, absolute).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Accuracy {
@@ -41,15 +64,35 @@ pub struct Accuracy {
     pub relative: f64,
     /// Absolute floor.
     pub absolute: f64,
+    /// The relative rounding of one evaluation of the integrand: f64's ε for mfh's own
+    /// integrands, the declared precision's ε for an implementation's values (see
+    /// [`Accuracy::at`]). No target is asked below [`ROUNDOFF`] of it.
+    pub noise: f64,
 }
 
 impl Accuracy {
-    /// A relative target with a negligible absolute floor.
+    /// A relative target with a negligible absolute floor, for an f64 integrand.
     pub fn relative(relative: f64) -> Self {
         Self {
             relative,
             absolute: 1e-300,
+            noise: f64::EPSILON,
         }
+    }
+
+    /// This accuracy for an integrand computed in `precision`: its rounding floor is that
+    /// precision's (the target itself is unchanged; where it is below the floor, the floor
+    /// wins, and the estimate's error bound says what was reached).
+    pub fn at(self, precision: crate::precision::Precision) -> Self {
+        Self {
+            noise: precision.epsilon(),
+            ..self
+        }
+    }
+
+    /// The relative rounding floor this accuracy stops at (of ∫|f|).
+    pub fn floor(&self) -> f64 {
+        ROUNDOFF * self.noise
     }
 }
 
@@ -225,7 +268,7 @@ impl Pieces {
         // a nested cubature).
         let target = (self.accuracy.relative * value.abs())
             .max(self.accuracy.absolute)
-            .max(ROUNDOFF * magnitude);
+            .max(ROUNDOFF * self.accuracy.noise * magnitude);
         let unrefined = pieces.iter().position(|p| !p.refined);
         if unrefined.is_none() && (!(error > target) || pieces.len() >= MAX_PIECES) {
             return Step::Done(Estimate {
@@ -245,7 +288,8 @@ impl Pieces {
         let mut piece = pieces.swap_remove(worst);
         // A piece's share of the target, but not below its own round-off (a double-exponential
         // rule asked for less runs to its deepest level for nothing).
-        let floor = ROUNDOFF * piece.value.abs() * node_noise(piece.lo, piece.hi);
+        let floor =
+            ROUNDOFF * self.accuracy.noise * piece.value.abs() * node_noise(piece.lo, piece.hi);
         let span = self.span;
         let share = |lo: f64, hi: f64| {
             ((0.5 * target * (hi - lo) / span.max(f64::MIN_POSITIVE))
@@ -513,6 +557,18 @@ fn cap_polar(
     let inner_accuracy = Accuracy {
         relative: (0.2 * accuracy.relative).max(2e-15),
         absolute: 0.05 * accuracy.absolute / std::f64::consts::TAU,
+        noise: accuracy.noise,
+    };
+    // The outer integrand is the inner integrals, each rounded at its own floor: above f64,
+    // the outer rule's floor is twice the integrand's (the inner estimates' noise, ≤ 32 noise
+    // each, averages over the outer nodes to about the floor itself).
+    let accuracy = if accuracy.noise > f64::EPSILON {
+        Accuracy {
+            noise: 2.0 * accuracy.noise,
+            ..accuracy
+        }
+    } else {
+        accuracy
     };
     let points_at = |phi: f64| {
         let mut points = polar_cuts.to_vec();
@@ -529,8 +585,14 @@ fn cap_polar(
         points
     };
     let calls = Cell::new(0u64);
+    let over_budget = Cell::new(false);
     let inner =
         |phis: &[f64], out: &mut [f64]| {
+            if evaluations.get() >= EVALUATION_BUDGET {
+                over_budget.set(true);
+                out.fill(0.0);
+                return;
+            }
             calls.set(calls.get() + phis.len() as u64);
             let problems: Vec<(Vec<f64>, Accuracy)> = phis
                 .iter()
@@ -584,6 +646,9 @@ fn cap_polar(
     // The outer estimate's error bound covers its own rule; each inner error enters the outer
     // sum with a weight of at most the largest outer weight, bounded here by the mean inner
     // error times the azimuthal range.
+    if over_budget.get() {
+        return exhausted(evaluations.get());
+    }
     let mean_inner = inner_error.get() / (calls.get().max(1) as f64);
     Estimate {
         value: outer.value,

@@ -6,7 +6,8 @@
 //! errata and the claims hold every Λ route against it.
 
 use crate::oracle::quadrature::{
-    integrate_pieces, integrate_pieces_batch, integrate_pieces_many, integrate_upper, Accuracy,
+    exhausted, integrate_pieces, integrate_pieces_batch, integrate_pieces_many, integrate_upper,
+    Accuracy, EVALUATION_BUDGET,
 };
 use crate::oracle::{student_t, Estimate};
 use mfh_reference::model::SlopeDistribution;
@@ -30,6 +31,10 @@ pub trait LambdaSubject {
     fn lobe_width(&self) -> f64;
     /// Polar angles where D has kinks for every azimuth: cuts of the lune quadrature.
     fn theta_kinks(&self) -> Vec<f64>;
+    /// The precision D is computed in: the quadratures' rounding floor (default f64).
+    fn precision(&self) -> crate::precision::Precision {
+        crate::precision::Precision::F64
+    }
 }
 
 /// Below this exponent C of a Student-t slope marginal, the tail of (q − μ)P2 is out of reach
@@ -56,7 +61,7 @@ pub fn lambda_oracle_to(subject: &dyn LambdaSubject, w: Vec3, relative: f64) -> 
     if cos_t >= 1.0 || sin_t == 0.0 {
         return Estimate::default();
     }
-    let accuracy = Accuracy::relative(relative);
+    let accuracy = Accuracy::relative(relative).at(subject.precision());
     if let Some(slopes) = subject.ndf().as_slopes() {
         let mu = cos_t / sin_t;
         let phi = w[1].atan2(w[0]);
@@ -177,7 +182,13 @@ fn lambda_oracle_lune(subject: &dyn LambdaSubject, w: Vec3) -> Estimate {
     let inner_error = Cell::new(0.0f64);
     // The inner integrals of one outer step run in lockstep, D in batches (one round trip per
     // step for an external model); the arithmetic is that of one integral at a time.
+    let over_budget = Cell::new(false);
     let inner = |psis: &[f64], out: &mut [f64]| {
+        if evaluations.get() >= EVALUATION_BUDGET {
+            over_budget.set(true);
+            out.fill(0.0);
+            return;
+        }
         let (mut problems, mut geometry, mut index) = (Vec::new(), Vec::new(), Vec::new());
         for (i, &psi) in psis.iter().enumerate() {
             out[i] = 0.0;
@@ -191,7 +202,7 @@ fn lambda_oracle_lune(subject: &dyn LambdaSubject, w: Vec3) -> Estimate {
             points.extend(kinks.iter().copied().filter(|k| *k > 0.0 && *k < eps_t));
             points.push(eps_t);
             points.sort_by(f64::total_cmp);
-            problems.push((points, Accuracy::relative(2e-13)));
+            problems.push((points, Accuracy::relative(2e-13).at(subject.precision())));
             geometry.push((r, eps_t, sin_cos(psi)));
             index.push(i);
         }
@@ -241,7 +252,14 @@ fn lambda_oracle_lune(subject: &dyn LambdaSubject, w: Vec3) -> Estimate {
     }
     points.retain(|p| *p >= lo && *p <= hi);
     points.sort_by(f64::total_cmp);
-    let outer = integrate_pieces_batch(&inner, &points, Accuracy::relative(1e-12));
+    let outer = integrate_pieces_batch(
+        &inner,
+        &points,
+        Accuracy::relative(1e-12).at(subject.precision()),
+    );
+    if over_budget.get() {
+        return exhausted(evaluations.get());
+    }
     Estimate {
         value: outer.value / ct,
         error_bound: (outer.error_bound + inner_error.get() * (hi - lo)) / ct,

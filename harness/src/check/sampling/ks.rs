@@ -46,13 +46,14 @@ pub(super) fn plan_ks<'a>(
                 seed: ctx.seed,
                 alpha: STATISTICAL_ALPHA.value,
             };
-            let kept = ks::ks_test_lobe_batch_kept(
+            let kept = ks::ks_test_lobe_batch_kept_at(
                 &|u: &[[f64; 2]], out: &mut [Vec3]| sampler.sample_wm_batch(u, out),
                 &|m: &[Vec3], out: &mut [f64]| sampler.pdf_wm_batch(m, out),
                 marginal,
                 model.lobe(),
                 &kinks,
                 &config,
+                model.precision,
             );
             fill_ks(r, &kept.result);
             r.data = ks_marginal_data(&kept);

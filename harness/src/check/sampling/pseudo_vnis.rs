@@ -116,7 +116,7 @@ pub fn plan_pseudo_vnis(
                             *o = v.pdf_wm(wi, m);
                         }
                     },
-                    false,
+                    (false, crate::precision::Precision::F64),
                 );
                 Ok(())
             }),

@@ -89,7 +89,7 @@ pub fn plan_visible<'a>(
                         (resolution, samples),
                         &|u: &[[f64; 2]], out: &mut [Vec3]| v.sample_wm_visible_batch(wi, u, out),
                         &|mm: &[Vec3], out: &mut [f64]| v.pdf_wm_visible_batch(wi, mm, out),
-                        m.model.is_remote(),
+                        (m.model.is_remote(), m.precision),
                     );
                     Ok(())
                 }),
@@ -118,9 +118,9 @@ pub fn plan_visible<'a>(
                         theta: &kinks,
                         phi: &terminator_azimuths(phi),
                     }),
-                    Accuracy::relative(1e-11),
+                    Accuracy::relative(1e-11).at(m.precision),
                 );
-                compare(r, 1.0, e, &NORMALIZATION);
+                compare(r, 1.0, e, &NORMALIZATION.at(m.precision));
                 Ok(())
             }),
         );

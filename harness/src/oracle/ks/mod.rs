@@ -50,13 +50,15 @@ mod table;
 
 pub use kolmogorov::{kolmogorov_q, ks_p_value, stephens_lambda};
 pub use table::{
-    marginal_cdf, marginal_cdf_batch, marginal_cdf_lobe, marginal_cdf_lobe_batch, CdfTable,
+    marginal_cdf, marginal_cdf_batch, marginal_cdf_lobe, marginal_cdf_lobe_batch,
+    marginal_cdf_lobe_batch_at, CdfTable,
 };
 
 use crate::oracle::chi2::{BatchSampler, OutsideDomain, Verdict, CHUNK};
 use crate::oracle::domain::{validate, DomainError};
 use crate::oracle::lobe::{self, Lobe};
 use crate::oracle::quadrature::Accuracy;
+use crate::precision::Precision;
 use crate::random::stream;
 use crate::tolerance::MASS_TOLERANCE;
 use mfh_reference::geometry::Vec3;
@@ -85,7 +87,23 @@ pub const TABLE_FRACTION: f64 = 0.01;
 pub const INNER_ACCURACY: Accuracy = Accuracy {
     relative: 1e-10,
     absolute: 1e-13,
+    noise: f64::EPSILON,
 };
+/// The rounding floor of the outer Simpson quadrature, in units of the pdf's rounding
+/// (`Precision::epsilon`): a span is accepted once |S₂ − S₁| and the interpolation error are
+/// within this many roundings of its mass. For f64 it never binds (16 ε ≈ 3.6e-15 of a span's
+/// mass against shares ≥ 1e-10); for a float32 pdf (16 ε₃₂ ≈ 1.9e-6 of the span's mass,
+/// summing to ≤ 1.9e-6 of the CDF) it stops the bisection of rounding noise, which ran every
+/// initial interval to [`MAX_SPANS`] (issue 27). The table's error bound still sums the
+/// accepted |S₂ − S₁|, so the bound stays honest and `TABLE_FRACTION` still judges it.
+pub(crate) const SIMPSON_NOISE_FLOOR: f64 = 16.0;
+/// The most density evaluations one KS table spends (the inner integrals included): 5·10⁷,
+/// ~50× a smooth model's table at the `thorough` profile. Past it the spans still open are
+/// accepted with an infinite error, so the test refuses to judge
+/// ([`Failure::TableInaccurate`], an `error` record) instead of refining for ever: the table
+/// of a D that oscillates faster than any span (GGX × (1 + ½ sin(10⁴ x))) ran for minutes
+/// (issue 27).
+pub const KS_EVALUATION_BUDGET: u64 = 50_000_000;
 /// Initial intervals per piece between cuts, before adaptive bisection.
 pub(crate) const INITIAL_PER_PIECE: usize = 8;
 /// Bisections below an initial interval before it is accepted whatever its error.
@@ -233,7 +251,15 @@ pub enum Failure {
     },
     /// The CDF table is not accurate enough for the number of samples: no verdict.
     #[error(
-        "CDF table error bound {error_bound:.2e} above {limit:.2e} ({TABLE_FRACTION} of 1/√N)"
+        "CDF table error bound {error_bound:.2e} above {limit:.2e} ({TABLE_FRACTION} of 1/√N){}",
+        if error_bound.is_infinite() {
+            format!(
+                ": the table's evaluation budget ({KS_EVALUATION_BUDGET} evaluations, \
+                 KS_EVALUATION_BUDGET) ran out"
+            )
+        } else {
+            String::new()
+        }
     )]
     TableInaccurate {
         /// The table's error bound.
@@ -495,11 +521,33 @@ pub fn ks_test_lobe_batch_kept(
     theta_kinks: &[f64],
     config: &KsConfig,
 ) -> KsKept {
+    ks_test_lobe_batch_kept_at(
+        sample,
+        pdf,
+        marginal,
+        lobe,
+        theta_kinks,
+        config,
+        Precision::F64,
+    )
+}
+
+/// [`ks_test_lobe_batch_kept`] for a pdf computed in `precision`: the table's quadratures stop
+/// at its rounding floor ([`marginal_cdf_lobe_batch_at`]).
+pub fn ks_test_lobe_batch_kept_at(
+    sample: &BatchSampler<'_>,
+    pdf: &(dyn Fn(&[Vec3], &mut [f64]) + Sync),
+    marginal: Marginal,
+    lobe: &Lobe,
+    theta_kinks: &[f64],
+    config: &KsConfig,
+    precision: Precision,
+) -> KsKept {
     let t = Instant::now();
     let mut drawn = draw_batch(sample, marginal, config.samples, config.seed);
     let mut sampling_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let table = marginal_cdf_lobe_batch(pdf, marginal, lobe, theta_kinks);
+    let table = marginal_cdf_lobe_batch_at(pdf, marginal, lobe, theta_kinks, precision);
     let table_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
     sort_values(&mut drawn.values);

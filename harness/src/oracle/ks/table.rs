@@ -2,10 +2,13 @@
 //! procedure in the module documentation of [`crate::oracle::ks`]).
 
 use super::{LobeHints, Marginal, INITIAL_PER_PIECE, INNER_ACCURACY, INTERPOLATION_TOLERANCE};
-use super::{MAX_DEPTH, MAX_SPANS, QUADRATURE_TOLERANCE};
+use super::{
+    KS_EVALUATION_BUDGET, MAX_DEPTH, MAX_SPANS, QUADRATURE_TOLERANCE, SIMPSON_NOISE_FLOOR,
+};
 use crate::oracle::lobe::{self, Lobe};
 use crate::oracle::quadrature::integrate_pieces_many;
 use crate::oracle::Estimate;
+use crate::precision::Precision;
 use mfh_reference::geometry::Vec3;
 use rayon::prelude::*;
 use std::f64::consts::FRAC_PI_2;
@@ -66,6 +69,13 @@ impl CdfTable {
     /// accepted intervals are those of one interval at a time (same tests, same arithmetic);
     /// only the cap [`MAX_SPANS`] counts the intervals of a wave instead of a depth-first stack.
     pub fn build_batch(density: &DensityBatch<'_>, cuts: &[f64]) -> Self {
+        Self::build_batch_at(density, cuts, f64::EPSILON)
+    }
+
+    /// [`CdfTable::build_batch`] for a density whose values are rounded to `noise` relative
+    /// (the pdf's precision): a span within [`SIMPSON_NOISE_FLOOR`] roundings of its mass is
+    /// accepted.
+    pub fn build_batch_at(density: &DensityBatch<'_>, cuts: &[f64], noise: f64) -> Self {
         let mut initial = Vec::new();
         for w in cuts.windows(2).filter(|w| w[1] > w[0]) {
             for k in 0..INITIAL_PER_PIECE {
@@ -116,6 +126,26 @@ impl CdfTable {
             queued[s.interval] += 1;
         }
         while !active.is_empty() {
+            if evaluations >= KS_EVALUATION_BUDGET {
+                // Out of budget: the spans still open are accepted unrefined with an infinite
+                // quadrature error, so that the table's bound says it was not resolved.
+                for s in active.drain(..) {
+                    let h = s.b.x - s.a.x;
+                    let whole = h / 6.0 * (s.a.f + 4.0 * s.m.f + s.b.f);
+                    accepted[s.interval].push(Piece {
+                        a: s.a,
+                        m: s.m,
+                        b: s.b,
+                        left: 0.5 * whole,
+                        right: 0.5 * whole,
+                        quadrature_error: f64::INFINITY,
+                        interpolation_error: 0.0,
+                        inner_error: h * s.a.error.max(s.m.error).max(s.b.error),
+                        invalid: None,
+                    });
+                }
+                break;
+            }
             let xs: Vec<f64> = active
                 .iter()
                 .flat_map(|s| [0.5 * (s.a.x + s.m.x), 0.5 * (s.m.x + s.b.x)])
@@ -133,6 +163,7 @@ impl CdfTable {
                     q[0],
                     q[1],
                     budget * (s.b.x - s.a.x) / (b - a).max(f64::MIN_POSITIVE),
+                    SIMPSON_NOISE_FLOOR * noise,
                     capped,
                 ) {
                     Judged::Accept(piece) => accepted[i].push(piece),
@@ -307,7 +338,7 @@ enum Judged {
 /// One step of adaptive Simpson over a span (see the module documentation), with the nodes
 /// q1, q3 at its quarter points and its `share` of the budget: the accepted piece, or the two
 /// halves to refine. `capped`: accept whatever the error (the span cap is reached).
-fn judge(s: &Span, q1: Node, q3: Node, share: f64, capped: bool) -> Judged {
+fn judge(s: &Span, q1: Node, q3: Node, share: f64, noise: f64, capped: bool) -> Judged {
     let (na, nm, nb) = (s.a, s.m, s.b);
     let h = nb.x - na.x;
     let whole = h / 6.0 * (na.f + 4.0 * nm.f + nb.f);
@@ -316,7 +347,10 @@ fn judge(s: &Span, q1: Node, q3: Node, share: f64, capped: bool) -> Judged {
     let quadrature_error = (left + right - whole).abs();
     let interpolated = hermite([na.x, nb.x], [0.0, left + right], [na.f, nb.f], nm.x);
     let interpolation_error = (interpolated - left).abs();
-    let good = quadrature_error <= share && interpolation_error <= INTERPOLATION_TOLERANCE;
+    // The rounding floor of the span's values (`SIMPSON_NOISE_FLOOR`).
+    let floor = noise * (left.abs() + right.abs());
+    let good = quadrature_error <= share.max(floor)
+        && interpolation_error <= INTERPOLATION_TOLERANCE.max(floor);
     // An invalid density fails the test anyway: no point refining it.
     let invalid = [na, q1, nm, q3, nb]
         .iter()
@@ -484,6 +518,20 @@ pub fn marginal_cdf_lobe_batch(
     lobe: &Lobe,
     theta_kinks: &[f64],
 ) -> CdfTable {
+    marginal_cdf_lobe_batch_at(pdf, marginal, lobe, theta_kinks, Precision::F64)
+}
+
+/// [`marginal_cdf_lobe_batch`] for a pdf computed in `precision`: the inner integrals and the
+/// outer Simpson stop at its rounding floor.
+pub fn marginal_cdf_lobe_batch_at(
+    pdf: &(dyn Fn(&[Vec3], &mut [f64]) + Sync),
+    marginal: Marginal,
+    lobe: &Lobe,
+    theta_kinks: &[f64],
+    precision: Precision,
+) -> CdfTable {
+    let inner_accuracy = INNER_ACCURACY.at(precision);
+    let noise = precision.epsilon();
     let polar = lobe.polar_cuts_with(FRAC_PI_2, theta_kinks);
     let azimuth = lobe.azimuth_cuts();
     // The inner integrals of one wave of the table run in lockstep: one call of `pdf` per
@@ -496,7 +544,7 @@ pub fn marginal_cdf_lobe_batch(
                 let at: Vec<f64> = thetas.iter().copied().filter(|t| t.sin() != 0.0).collect();
                 let problems: Vec<_> = at
                     .iter()
-                    .map(|_| (azimuth.clone(), INNER_ACCURACY))
+                    .map(|_| (azimuth.clone(), inner_accuracy))
                     .collect();
                 // θ's sine and (snapped) cosine once per integral, not per node.
                 let trig: Vec<(f64, f64)> = at.iter().map(|&t| polar_sin_cos(t)).collect();
@@ -529,13 +577,13 @@ pub fn marginal_cdf_lobe_batch(
                     })
                     .collect()
             };
-            CdfTable::build_batch(&density, &polar)
+            CdfTable::build_batch_at(&density, &polar, noise)
         }
         Marginal::Phi => {
             let density = |phis: &[f64]| {
                 let problems: Vec<_> = phis
                     .iter()
-                    .map(|_| (polar.clone(), INNER_ACCURACY))
+                    .map(|_| (polar.clone(), inner_accuracy))
                     .collect();
                 // φ's sine and cosine once per integral, not per node.
                 let azimuthal: Vec<(f64, f64)> = phis.iter().map(|p| p.sin_cos()).collect();
@@ -555,7 +603,7 @@ pub fn marginal_cdf_lobe_batch(
                     &problems,
                 )
             };
-            CdfTable::build_batch(&density, &azimuth)
+            CdfTable::build_batch_at(&density, &azimuth, noise)
         }
     }
 }

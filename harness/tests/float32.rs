@@ -1,0 +1,352 @@
+//! A float32 implementation under audit (issue 27): GGX computed in f32 arithmetic the way a
+//! renderer writes it (D, Λ, the normal and visible-normal samplers and their pdfs), handed
+//! over as f64. Declared `Precision::F32`, it passes the `ci` profile with no false alarm;
+//! audited as f64, the report says it is a float32 model; a planted defect fails on its named
+//! check. The hostile f64 models of the issue (an oscillating D, a piecewise-constant D) finish
+//! with error or fail records instead of growing without bound.
+
+use mfh_harness::record::Verdict;
+use mfh_harness::{Audit, Precision, Profile};
+use mfh_reference::{Ndf, NormalSampler, Smith, Vec3, VisibleNormalSampler};
+use std::f32::consts::PI;
+
+/// Which defect the float32 GGX carries.
+#[derive(Clone, Copy, PartialEq)]
+enum Defect {
+    None,
+    /// The normal sampler's exponent off by 0.1 %: tan θ = α √(u/(1−u))^1.001.
+    SamplerExponent,
+    /// The visible-normal pdf without its G1 factor.
+    VisiblePdfWithoutG1,
+}
+
+struct Ggx32 {
+    alpha: f32,
+    defect: Defect,
+}
+
+fn v32(m: Vec3) -> [f32; 3] {
+    [m[0] as f32, m[1] as f32, m[2] as f32]
+}
+
+fn v64(m: [f32; 3]) -> Vec3 {
+    [f64::from(m[0]), f64::from(m[1]), f64::from(m[2])]
+}
+
+fn normalize(v: [f32; 3]) -> [f32; 3] {
+    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    [v[0] / l, v[1] / l, v[2] / l]
+}
+
+impl Ggx32 {
+    fn new(alpha: f32) -> Self {
+        Self {
+            alpha,
+            defect: Defect::None,
+        }
+    }
+
+    /// D(m) as pbrt-v4 writes it: tan²θ, cos⁴θ, e = tan²θ/α².
+    fn d32(&self, m: [f32; 3]) -> f32 {
+        if m[2] <= 0.0 {
+            return 0.0;
+        }
+        let cos2 = m[2] * m[2];
+        let sin2 = (m[0] * m[0] + m[1] * m[1]).max(0.0);
+        let tan2 = sin2 / cos2;
+        if !tan2.is_finite() {
+            return 0.0;
+        }
+        let cos4 = cos2 * cos2;
+        // pbrt-v4's guard: cos⁴θ underflows near grazing.
+        if cos4 < 1e-16 {
+            return 0.0;
+        }
+        let e = tan2 / (self.alpha * self.alpha);
+        1.0 / (PI * self.alpha * self.alpha * cos4 * (1.0 + e) * (1.0 + e))
+    }
+
+    fn lambda32(&self, w: [f32; 3]) -> f32 {
+        let tan2 = (w[0] * w[0] + w[1] * w[1]) / (w[2] * w[2]);
+        if !tan2.is_finite() {
+            // Grazing: Λ = ∞, G1 = 0.
+            return f32::INFINITY;
+        }
+        let l = ((1.0 + self.alpha * self.alpha * tan2).sqrt() - 1.0) / 2.0;
+        if w[2] < 0.0 {
+            -1.0 - l
+        } else {
+            l
+        }
+    }
+
+    fn g1_32(&self, w: [f32; 3]) -> f32 {
+        1.0 / (1.0 + self.lambda32(w))
+    }
+}
+
+impl Ndf for Ggx32 {
+    fn d(&self, m: Vec3) -> f64 {
+        f64::from(self.d32(v32(m)))
+    }
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        Some(self)
+    }
+    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+        Some(self)
+    }
+    fn as_visible_sampler(&self) -> Option<&dyn VisibleNormalSampler> {
+        Some(self)
+    }
+}
+
+impl Smith for Ggx32 {
+    fn lambda(&self, w: Vec3) -> f64 {
+        f64::from(self.lambda32(v32(w)))
+    }
+}
+
+impl NormalSampler for Ggx32 {
+    fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
+        let (u0, u1) = (u[0] as f32, u[1] as f32);
+        let mut ratio = u0 / (1.0 - u0);
+        if self.defect == Defect::SamplerExponent {
+            ratio = ratio.powf(1.001);
+        }
+        let tan2 = self.alpha * self.alpha * ratio;
+        let cos = 1.0 / (1.0 + tan2).sqrt();
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let phi = 2.0 * PI * u1;
+        v64([sin * phi.cos(), sin * phi.sin(), cos])
+    }
+    fn pdf_wm(&self, m: Vec3) -> f64 {
+        let m = v32(m);
+        f64::from(self.d32(m) * m[2].max(0.0))
+    }
+}
+
+impl VisibleNormalSampler for Ggx32 {
+    /// Heitz 2018, in f32.
+    fn sample_wm_visible(&self, wi: Vec3, u: [f64; 2]) -> Vec3 {
+        let wi = v32(wi);
+        let (u0, u1) = (u[0] as f32, u[1] as f32);
+        let a = self.alpha;
+        let vh = normalize([a * wi[0], a * wi[1], wi[2]]);
+        let len2 = vh[0] * vh[0] + vh[1] * vh[1];
+        let t1 = if len2 > 0.0 {
+            let inv = 1.0 / len2.sqrt();
+            [-vh[1] * inv, vh[0] * inv, 0.0]
+        } else {
+            [1.0, 0.0, 0.0]
+        };
+        let t2 = [
+            vh[1] * t1[2] - vh[2] * t1[1],
+            vh[2] * t1[0] - vh[0] * t1[2],
+            vh[0] * t1[1] - vh[1] * t1[0],
+        ];
+        let r = u0.sqrt();
+        let phi = 2.0 * PI * u1;
+        let p1 = r * phi.cos();
+        let s = 0.5 * (1.0 + vh[2]);
+        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+        let p3 = (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
+        let nh = [
+            p1 * t1[0] + p2 * t2[0] + p3 * vh[0],
+            p1 * t1[1] + p2 * t2[1] + p3 * vh[1],
+            p1 * t1[2] + p2 * t2[2] + p3 * vh[2],
+        ];
+        v64(normalize([a * nh[0], a * nh[1], nh[2].max(1e-6)]))
+    }
+    fn pdf_wm_visible(&self, wi: Vec3, m: Vec3) -> f64 {
+        let (wi, m) = (v32(wi), v32(m));
+        let dot = (wi[0] * m[0] + wi[1] * m[1] + wi[2] * m[2]).max(0.0);
+        let g1 = if self.defect == Defect::VisiblePdfWithoutG1 {
+            1.0
+        } else {
+            self.g1_32(wi)
+        };
+        f64::from(g1 * dot * self.d32(m) / wi[2].abs())
+    }
+}
+
+fn failing(report: &mfh_harness::run::AuditReport) -> Vec<String> {
+    report
+        .records
+        .iter()
+        .filter(|r| !matches!(r.verdict, Verdict::Pass | Verdict::Skipped { .. }))
+        .map(|r| format!("{} {} {:?}", r.check, r.case, r.verdict))
+        .collect()
+}
+
+#[test]
+fn a_float32_ggx_declared_f32_passes_the_ci_profile() {
+    let m = Ggx32::new(0.3);
+    let report = Audit::of(&m)
+        .precision(Precision::F32)
+        .profile(Profile::Ci)
+        .run();
+    eprintln!(
+        "float32 GGX at ci: {} records in {:.1} s",
+        report.records.len(),
+        report.summary.wall_seconds
+    );
+    assert!(report.passed(), "{:#?}", failing(&report));
+    assert!(report.records.iter().all(|r| r.precision == Precision::F32));
+}
+
+#[test]
+fn a_float32_ggx_audited_as_f64_is_named_by_audit_precision() {
+    let m = Ggx32::new(0.3);
+    let report = Audit::of(&m).profile(Profile::Quick).run();
+    let r = report
+        .records
+        .iter()
+        .find(|r| r.check == "audit.precision")
+        .expect("an audit.precision record");
+    assert!(
+        matches!(&r.verdict, Verdict::Error { message }
+            if message.contains("float32 values; declare precision f32")),
+        "{r:?}"
+    );
+    assert!(!report.passed());
+    // The rest was judged at f32 (and says so), not against f64 tolerances.
+    assert!(report.records.iter().all(|r| r.precision == Precision::F32));
+    assert_eq!(failing(&report).len(), 1, "{:#?}", failing(&report));
+}
+
+#[test]
+fn a_float32_sampler_exponent_off_by_a_tenth_percent_fails_its_check() {
+    let m = Ggx32 {
+        defect: Defect::SamplerExponent,
+        ..Ggx32::new(0.3)
+    };
+    let report = Audit::of(&m)
+        .precision(Precision::F32)
+        .profile(Profile::Ci)
+        .run();
+    let failed = failing(&report);
+    assert!(
+        failed
+            .iter()
+            .any(|f| f.starts_with("sampling.pdf_jacobian")),
+        "{failed:#?}"
+    );
+}
+
+#[test]
+fn a_float32_visible_pdf_without_g1_fails_its_check() {
+    let m = Ggx32 {
+        defect: Defect::VisiblePdfWithoutG1,
+        ..Ggx32::new(0.3)
+    };
+    let report = Audit::of(&m)
+        .precision(Precision::F32)
+        .profile(Profile::Quick)
+        .run();
+    let failed = failing(&report);
+    assert!(
+        failed
+            .iter()
+            .any(|f| f.starts_with("sampling.pdf_visible_normalization")),
+        "{failed:#?}"
+    );
+}
+
+/// GGX (f64) whose D oscillates: D·(1 + ½ sin(10⁴(7.3x + 3.1y))), sampled by GGX's sampler
+/// (issue 27: its chi-square expected masses grew to 20 GB).
+struct Oscillating(mfh_reference::ndf::Ggx);
+
+impl Ndf for Oscillating {
+    fn d(&self, m: Vec3) -> f64 {
+        self.0.d(m) * (1.0 + 0.5 * (1e4 * (7.3 * m[0] + 3.1 * m[1])).sin())
+    }
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        Some(self)
+    }
+    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+        Some(self)
+    }
+}
+impl Smith for Oscillating {
+    fn lambda(&self, w: Vec3) -> f64 {
+        self.0.lambda(w)
+    }
+}
+impl NormalSampler for Oscillating {
+    fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
+        self.0.sample_wm(u)
+    }
+}
+
+/// A piecewise-constant tabulated D: GGX at the centres of 32 θ bins (issue 27: its
+/// `smith.lambda_route` records took 125 s each).
+struct Tabulated {
+    table: [f64; 32],
+    ggx: mfh_reference::ndf::Ggx,
+}
+
+impl Tabulated {
+    fn new() -> Self {
+        let ggx = mfh_reference::ndf::Ggx::new(0.3, 0.3).unwrap();
+        let mut table = [0.0; 32];
+        for (i, t) in table.iter_mut().enumerate() {
+            let theta = (i as f64 + 0.5) / 32.0 * std::f64::consts::FRAC_PI_2;
+            *t = ggx.d([theta.sin(), 0.0, theta.cos()]);
+        }
+        Self { table, ggx }
+    }
+}
+
+impl Ndf for Tabulated {
+    fn d(&self, m: Vec3) -> f64 {
+        if m[2] <= 0.0 {
+            return 0.0;
+        }
+        let theta = m[2].min(1.0).acos();
+        let i = ((theta / std::f64::consts::FRAC_PI_2 * 32.0) as usize).min(31);
+        self.table[i]
+    }
+    fn as_smith(&self) -> Option<&dyn Smith> {
+        Some(self)
+    }
+}
+impl Smith for Tabulated {
+    fn lambda(&self, w: Vec3) -> f64 {
+        self.ggx.lambda(w)
+    }
+}
+
+/// Every record of a hostile model has a verdict, and the audit fails (with fail or error
+/// records, an `error` naming its budget where one was reached) instead of running on.
+fn assert_bounded_failure(report: &mfh_harness::run::AuditReport) {
+    assert!(!report.passed());
+    for r in &report.records {
+        if let Verdict::Error { message } = &r.verdict {
+            assert!(!message.is_empty(), "{r:?}");
+        }
+    }
+    assert!(
+        report
+            .records
+            .iter()
+            .any(|r| matches!(r.verdict, Verdict::Fail | Verdict::Error { .. })),
+        "{:#?}",
+        failing(report)
+    );
+}
+
+#[test]
+fn an_oscillating_d_finishes_with_failures() {
+    let m = Oscillating(mfh_reference::ndf::Ggx::new(0.3, 0.3).unwrap());
+    let report = Audit::of(&m).profile(Profile::Quick).run();
+    eprintln!("{:#?}", failing(&report));
+    assert_bounded_failure(&report);
+}
+
+#[test]
+fn a_piecewise_constant_d_finishes_with_failures() {
+    let m = Tabulated::new();
+    let report = Audit::of(&m).profile(Profile::Quick).run();
+    eprintln!("{:#?}", failing(&report));
+    assert_bounded_failure(&report);
+}
