@@ -171,8 +171,9 @@ int main(int argc, char** argv) {
     double alpha = opts.number("--alpha", 0.3, 1e-4, 10);
     ax = opts.number("--alpha-x", alpha, 1e-4, 10);
     ay = opts.number("--alpha-y", opts.has("--alpha-x") ? ax : alpha, 1e-4, 10);
-    protocol = static_cast<int>(opts.number("--protocol", 2, 1, 2));
-    if (protocol != 1 && protocol != 2) throw std::invalid_argument("--protocol must be 1 or 2");
+    double version = opts.number("--protocol", 2, 1, 2);
+    if (version != 1 && version != 2) throw std::invalid_argument("--protocol must be 1 or 2");
+    protocol = static_cast<int>(version);
     defect_name = opts.text("--defect", "none");
     if (defect_name == "vndf_pdf_without_g1") {
       defect = Defect::VndfPdfWithoutG1;

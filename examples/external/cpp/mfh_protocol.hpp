@@ -628,7 +628,7 @@ inline std::vector<double> base64_decode_f64(std::string_view text) {
       if (v < 0) {
         bool padding = last && c == '=' && k >= 4 - pad;
         if (!padding)
-          throw ProtocolError(std::string("invalid base64: character '") + c + "' at " +
+          throw ProtocolError("invalid base64: character '" + detail::printable(std::string_view(&c, 1)) + "' at " +
                               std::to_string(i + k) + " (standard alphabet A-Z a-z 0-9 + /, '=' only at the end)");
         v = 0;
       }
