@@ -13,7 +13,7 @@ Capabilities: D, Lambda, normal sampling (sample_wm, pdf_wm) and visible-normal 
 
     D(m)   = 1 / (pi ax ay (z^2 + (x/ax)^2 + (y/ay)^2)^2) for z > 0 (Walter et al. 2007 eq 33,
              multiplied out: no tan, no division by cos)
-    Lambda = 1 / (2a (a + sqrt(a^2 + 1))), a = z / hypot(ax x, ay y) (Heitz 2014 eq 86 without
+    Lambda = 1 / (2a (a + sqrt(a^2 + 1))), a = z / hypot(ax x, ay y) (Heitz 2014 for GGX, without
              its cancellation); below the horizon Lambda(w) = -1 - Lambda(-w)
     pdf_wm_visible = G1(wi) max(0, wi.m) D(m) / cos(theta_i), G1 = 1 / (1 + Lambda)
     sample_wm: phi = 2 pi u1, rho = (u2 / (1 - u2))^(1/2), slope (ax rho cos phi, ay rho sin phi),

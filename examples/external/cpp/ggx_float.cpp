@@ -13,8 +13,8 @@
 // Options: --alpha A, or --alpha-x AX --alpha-y AY (default 0.3; in [1e-4, 10]); --protocol 1|2
 // (default 2); --defect vndf_pdf_without_g1, which plants the classic defect: the visible-normal
 // density without G1(wi), D·max(0, wi·wm)/cos θi, whose integral over the hemisphere is
-// 1 + Λ(wi) instead of 1 (mfh's sampling.pdf_visible_normalization and sampling.chi2_visible
-// fail on it).
+// 1 + Λ(wi) instead of 1 (1.0067 at θi = 0.5, 1.24 at θi = 1.3 for α = 0.3): the check that
+// names it is mfh's sampling.pdf_visible_normalization.
 //
 // The formulas (derived here, not copied from any renderer), for a unit vector w = (x, y, z):
 //
@@ -22,16 +22,18 @@
 //            Walter et al. 2007 eq 33 with cos⁴θ (1 + tan²θ (cos²φ/αx² + sin²φ/αy²))² multiplied
 //            out: no tan θ, no division by cos θ, so no overflow or 0·∞ near the horizon.
 //   Λ(w)   = 1 / (2a (a + √(a² + 1))),  a = z / √((αx x)² + (αy y)²)   for z ≥ 0
-//            Heitz 2014 ("Understanding the masking-shadowing function") eq 86, (√(1 + 1/a²) − 1)/2,
+//            Heitz 2014 ("Understanding the masking-shadowing function"), GGX: (√(1 + 1/a²) − 1)/2,
 //            rewritten without the cancellation that makes the printed form 0 in float for
 //            α tan θ < 2.4e-4 (pbrt-v4 writes the printed form); a = ∞ at normal incidence
 //            gives 0, a = 0 at grazing gives +∞. Below the horizon Λ(w) = −1 − Λ(−w) (mfh's
 //            convention; pbrt's Lambda is even in z).
 //   G1(w)  = 1 / (1 + Λ(w));  the protocol's g1(w, m) is G1(w) where z > 0 and w·m > 0, else 0.
-//   D_w(m) = G1(w) max(0, w·m) D(m) / cos θ_w          (Heitz 2018 eq 1; pbrt-v4 uses |w·m|)
+//   D_w(m) = G1(w) max(0, w·m) D(m) / cos θ_w          (Heitz 2018; pbrt-v4 uses |w·m|)
 //   Visible-normal sampling (Heitz 2018, "Sampling the GGX distribution of visible normals",
 //   JCGT 7(4)): stretch w to α = 1, w_h = normalize(αx x, αy y, z); an orthonormal frame
-//   T1 = normalize(ẑ × w_h) (or x̂ at normal incidence), T2 = w_h × T1; a uniform point of the
+//   T1 = normalize(ẑ × w_h) (x̂ only at exactly normal incidence, as in Heitz's listing; pbrt-v4
+//   takes x̂ for w_h,z ≥ 0.99999, which turns the warp's axis within 4.5e-3 rad of the normal),
+//   T2 = w_h × T1; a uniform point of the
 //   unit disk (r = √u1, φ = 2π u2); its T2 coordinate warped to the projected hemisphere's
 //   half-disk, t2 ← (1 − s)√(1 − t1²) + s t2 with s = (1 + w_h,z)/2; lifted onto the
 //   hemisphere (t3 = √(1 − t1² − t2²)); unstretched: m = normalize(αx n_x, αy n_y, max(1e-6, n_z)).
