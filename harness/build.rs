@@ -4,5 +4,5 @@
 use mfh_test_tiers::Tool;
 
 fn main() {
-    mfh_test_tiers::emit(&[Tool::Numpy, Tool::Script]);
+    mfh_test_tiers::emit(&[Tool::Numpy, Tool::Script, Tool::Gxx]);
 }

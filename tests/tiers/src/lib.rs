@@ -46,11 +46,13 @@ pub enum Tool {
     Numpy,
     /// util-linux `script` (a pseudo-terminal), for the progress-bar test.
     Script,
+    /// The GNU C++ compiler `g++`, for the C++ example of the external protocol.
+    Gxx,
 }
 
 impl Tool {
     /// Every tool, so that each crate declares every flag (`rustc-check-cfg`).
-    pub const ALL: [Tool; 3] = [Tool::Chromium, Tool::Numpy, Tool::Script];
+    pub const ALL: [Tool; 4] = [Tool::Chromium, Tool::Numpy, Tool::Script, Tool::Gxx];
 
     /// The cfg flag set where the tool is present (or under CI).
     pub fn cfg(self) -> &'static str {
@@ -58,6 +60,7 @@ impl Tool {
             Tool::Chromium => "has_chromium",
             Tool::Numpy => "has_numpy",
             Tool::Script => "has_script",
+            Tool::Gxx => "has_gxx",
         }
     }
 
@@ -78,6 +81,7 @@ impl Tool {
                 .any(|name| runs(name, &["--version"])),
             Tool::Numpy => runs("python3", &["-c", "import numpy"]),
             Tool::Script => runs("script", &["--version"]),
+            Tool::Gxx => runs("g++", &["--version"]),
         }
     }
 }
