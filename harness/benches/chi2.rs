@@ -93,7 +93,7 @@ fn chi2_sampling(c: &mut Criterion) {
                     pool.install(|| {
                         black_box(observe_batch(
                             &|u: &[[f64; 2]], m: &mut [Vec3]| sampler.sample_wm_batch(u, m),
-                            grid,
+                            grid.clone(),
                             SAMPLES,
                             1,
                         ))

@@ -204,8 +204,9 @@ pub struct CheckRecord {
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum RecordData {
     /// The observed and expected counts of a chi-square test over the (φ, cos θ) grid of the
-    /// upper hemisphere: `rows` cos θ-rows (row 0 at the horizon, cos θ ∈ [i/R, (i+1)/R)) ×
-    /// `columns` = 2R φ-columns (φ ∈ [2πj/2R, 2π(j+1)/2R)), row-major.
+    /// upper hemisphere: `rows` cos θ-rows (row 0 at the horizon, cos θ ∈ [z_i, z_{i+1})) ×
+    /// `columns` = 2R φ-columns (φ ∈ [φ_j, φ_{j+1})), row-major; the edges are `z_edges` and
+    /// `phi_edges` (empty in records written before issue 26: the equal-area i/R and 2πj/2R).
     Chi2Table {
         /// cos θ-rows R.
         rows: usize,
@@ -220,6 +221,12 @@ pub enum RecordData {
         /// Expected counts per cell (pdf mass × samples).
         #[serde(deserialize_with = "crate::record_serde::nullable_f64_vec")]
         expected: Vec<f64>,
+        /// The row edges z₀ = 0 < … < z_R = 1 (cos θ; empty: i/R).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        z_edges: Vec<f64>,
+        /// The column edges φ₀ = 0 < … < φ_2R = 2π (empty: 2πj/2R).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        phi_edges: Vec<f64>,
     },
     /// The observed and expected counts of a BSDF's chi-square test over the whole sphere: each
     /// hemisphere on the grid of [`RecordData::Chi2Table`] (the lower one mirrored through the

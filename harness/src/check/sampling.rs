@@ -259,6 +259,8 @@ pub fn chi2_table(result: &crate::oracle::chi2::Chi2Result) -> crate::record::Re
         seed: result.seed,
         observed: result.observed.clone(),
         expected: result.expected.clone(),
+        z_edges: result.z_edges.clone(),
+        phi_edges: result.phi_edges.clone(),
     }
 }
 

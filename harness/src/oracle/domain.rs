@@ -7,17 +7,51 @@
 //! the edge z = 1 of the rectangle, and D(m)(m·n) is a smooth function of z and φ there), so
 //! no pole margin is needed: the top row is binned and integrated like every other row. The
 //! horizon z = 0 belongs to the bottom row.
+//!
+//! A grid may also have arbitrary row edges 0 = z₀ < z₁ < … < z_R = 1 and column edges 0 = φ₀ <
+//! … < φ_2R = 2π ([`HemisphereGrid::with_edges`]: the chi-square's cells at the quantiles of a
+//! lobe's marginals, `oracle::chi2::cells`); its cells then differ in solid angle. A direction's
+//! row is the number of interior edges z_k ≤ z / |m| (z / |m| as [`validate`] computes it), its
+//! column the number of interior edges φ_j ≤ atan2(y, x).
 
 use mfh_reference::geometry::{sin_cos_turns, Vec3};
-use std::f64::consts::TAU;
+use std::f64::consts::{PI, TAU};
+use std::sync::Arc;
 
 /// How far from unit length a sample may be before it is outside the domain.
 pub const UNIT_TOLERANCE: f64 = 1e-6;
 
-/// A grid of `2R` φ-columns over [0, 2π) by `R` z-rows over [0, 1] (z = cos θ).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// A grid of `2R` φ-columns over [0, 2π) by `R` z-rows over [0, 1] (z = cos θ): equal-area
+/// ([`HemisphereGrid::new`]) or with given edges ([`HemisphereGrid::with_edges`]).
+#[derive(Debug, Clone, PartialEq)]
 pub struct HemisphereGrid {
     resolution: usize,
+    /// The row edges z₀ = 0 < … < z_R = 1 (`None`: k/R).
+    z_edges: Option<Arc<[f64]>>,
+    /// The column edges φ₀ = 0 < … < φ_2R = 2π (`None`: 2πj/2R).
+    phi_edges: Option<Arc<[f64]>>,
+}
+
+/// Why edges do not make a grid.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GridError {
+    /// No rows.
+    #[error("a grid needs at least one row")]
+    NoRows,
+    /// The column edges are not 2R + 1 for R + 1 row edges.
+    #[error("{columns} column edges for {rows} row edges (2R + 1 for R + 1 are needed)")]
+    ColumnCount {
+        /// Row edges given.
+        rows: usize,
+        /// Column edges given.
+        columns: usize,
+    },
+    /// The row edges do not rise strictly from 0 to 1.
+    #[error("row edges must rise strictly from 0 to 1: {0:?}")]
+    Rows(Vec<f64>),
+    /// The column edges do not rise strictly from 0 to 2π by steps below π.
+    #[error("column edges must rise strictly from 0 to 2π by steps below π: {0:?}")]
+    Columns(Vec<f64>),
 }
 
 /// Why a direction lies outside the upper hemisphere.
@@ -47,7 +81,84 @@ impl HemisphereGrid {
     /// A grid with `resolution` z-rows and `2 * resolution` φ-columns; `None` if `resolution`
     /// is 0.
     pub fn new(resolution: usize) -> Option<Self> {
-        (resolution > 0).then_some(Self { resolution })
+        (resolution > 0).then_some(Self {
+            resolution,
+            z_edges: None,
+            phi_edges: None,
+        })
+    }
+
+    /// A grid with the row edges `z` (0 = z₀ < … < z_R = 1) and the column edges `phi` (0 =
+    /// φ₀ < … < φ_2R = 2π, each step below π so that a column's side tests stay exact; `None`:
+    /// equal columns), or why they do not make one.
+    pub fn with_edges(z: Vec<f64>, phi: Option<Vec<f64>>) -> Result<Self, GridError> {
+        let rows = z
+            .len()
+            .checked_sub(1)
+            .filter(|&r| r > 0)
+            .ok_or(GridError::NoRows)?;
+        let rising =
+            |e: &[f64]| e.windows(2).all(|w| w[0] < w[1]) && e.iter().all(|v| v.is_finite());
+        if z[0] != 0.0 || z[rows] != 1.0 || !rising(&z) {
+            return Err(GridError::Rows(z));
+        }
+        if let Some(phi) = &phi {
+            if phi.len() != 2 * rows + 1 {
+                return Err(GridError::ColumnCount {
+                    rows: z.len(),
+                    columns: phi.len(),
+                });
+            }
+            if phi[0] != 0.0
+                || phi[2 * rows] != TAU
+                || !rising(phi)
+                || phi.windows(2).any(|w| w[1] - w[0] >= PI)
+            {
+                return Err(GridError::Columns(phi.clone()));
+            }
+        }
+        Ok(Self {
+            resolution: rows,
+            z_edges: Some(z.into()),
+            phi_edges: phi.map(Into::into),
+        })
+    }
+
+    /// Whether the grid is the equal-area one of [`HemisphereGrid::new`].
+    pub fn is_equal_area(&self) -> bool {
+        self.z_edges.is_none() && self.phi_edges.is_none()
+    }
+
+    /// The row edges z₀ = 0, …, z_R = 1.
+    pub fn z_edges(&self) -> Vec<f64> {
+        match &self.z_edges {
+            Some(z) => z.to_vec(),
+            None => (0..=self.rows()).map(|k| self.z_edge(k)).collect(),
+        }
+    }
+
+    /// The column edges φ₀ = 0, …, φ_2R = 2π.
+    pub fn phi_edges(&self) -> Vec<f64> {
+        match &self.phi_edges {
+            Some(phi) => phi.to_vec(),
+            None => (0..=self.columns()).map(|j| self.phi_edge(j)).collect(),
+        }
+    }
+
+    /// Row edge k (0 ≤ k ≤ R).
+    fn z_edge(&self, k: usize) -> f64 {
+        match &self.z_edges {
+            Some(z) => z[k],
+            None => (k as f64 * (1.0 / self.rows() as f64)).min(1.0),
+        }
+    }
+
+    /// Column edge j (0 ≤ j ≤ 2R).
+    fn phi_edge(&self, j: usize) -> f64 {
+        match &self.phi_edges {
+            Some(phi) => phi[j],
+            None => j as f64 * (TAU / self.columns() as f64),
+        }
     }
 
     /// The number of z-rows R.
@@ -75,7 +186,10 @@ impl HemisphereGrid {
             phi += TAU;
         }
         let columns = self.columns();
-        let column = ((phi / TAU * columns as f64) as usize).min(columns - 1);
+        let column = match &self.phi_edges {
+            Some(edges) => edges[1..columns].partition_point(|&e| e <= phi),
+            None => ((phi / TAU * columns as f64) as usize).min(columns - 1),
+        };
         Ok(row * columns + column)
     }
 
@@ -85,6 +199,9 @@ impl HemisphereGrid {
         let len = validate(m)?;
         let z = m[2] / len;
         let rows = self.rows();
+        if let Some(edges) = &self.z_edges {
+            return Ok(edges[1..rows].partition_point(|&e| e <= z));
+        }
         // Through i64: the saturating f64 → usize cast costs ~20 instructions, → i64 ~5.
         Ok(((z * rows as f64) as i64 as usize).min(rows - 1))
     }
@@ -92,11 +209,9 @@ impl HemisphereGrid {
     /// The (φ, z) rectangle of cell `index` (row-major, as [`HemisphereGrid::cell_of`]).
     pub fn cell(&self, index: usize) -> Cell {
         let (row, column) = (index / self.columns(), index % self.columns());
-        let dz = 1.0 / self.rows() as f64;
-        let dphi = TAU / self.columns() as f64;
         Cell {
-            phi: [column as f64 * dphi, (column + 1) as f64 * dphi],
-            z: [row as f64 * dz, ((row + 1) as f64 * dz).min(1.0)],
+            phi: [self.phi_edge(column), self.phi_edge(column + 1)],
+            z: [self.z_edge(row), self.z_edge(row + 1)],
         }
     }
 
@@ -163,7 +278,11 @@ impl CellFinder {
         let columns = grid.columns();
         let boundaries = (0..=columns)
             .map(|j| {
-                let (s, c) = sin_cos_turns(j as f64 / columns as f64);
+                let (s, c) = match &grid.phi_edges {
+                    // Given edges: their sines and cosines (exact at 0 and 2π by the turns).
+                    Some(phi) if j > 0 && j < columns => phi[j].sin_cos(),
+                    _ => sin_cos_turns(j as f64 / columns as f64),
+                };
                 [c, s]
             })
             .collect();
@@ -179,8 +298,8 @@ impl CellFinder {
     }
 
     /// The grid binned into.
-    pub fn grid(&self) -> HemisphereGrid {
-        self.grid
+    pub fn grid(&self) -> &HemisphereGrid {
+        &self.grid
     }
 
     /// The cell index of a direction, or why it is not in the domain: the same answer as
@@ -200,7 +319,9 @@ impl CellFinder {
         let t = m[2] * self.rows;
         let floor = t as i64;
         let fraction = t - floor as f64;
-        let row = if fraction > self.row_margin && fraction < 1.0 - self.row_margin {
+        let row = if self.grid.z_edges.is_some() {
+            self.grid.row_of(m)?
+        } else if fraction > self.row_margin && fraction < 1.0 - self.row_margin {
             (floor as usize).min(self.grid.rows() - 1)
         } else {
             self.grid.row_of(m)?
@@ -260,7 +381,11 @@ impl CellFinder {
             type Output = bool;
             #[inline(always)]
             fn with_simd<S: pulp::Simd>(self, _simd: S) -> bool {
-                self.finder.cells_of_block(self.m, self.cells)
+                if self.finder.grid.is_equal_area() {
+                    self.finder.cells_of_block(self.m, self.cells)
+                } else {
+                    self.finder.cells_of_block_edges(self.m, self.cells)
+                }
             }
         }
         arch.dispatch(Op {
@@ -351,6 +476,98 @@ impl CellFinder {
         inside
     }
 
+    /// The body of [`CellFinder::cells_of`] for a grid with given edges, inlined into each
+    /// dispatch target. Straight-line passes as in [`CellFinder::cells_of_block`], the
+    /// row and column found by counting edges (lanes inner, edges outer, so it vectorizes):
+    ///
+    /// - the row is the number of interior row edges ≤ z / |m|, with |m| and the quotient
+    ///   computed as [`validate`] and [`HemisphereGrid::cell_of`] do (correctly rounded square
+    ///   root and division: the same bits on every path), so no row margin is needed;
+    /// - the column is the number of interior column edges ≤ the azimuth estimate φ̃, clear
+    ///   when φ̃ is farther than [`COLUMN_MARGIN`] from every edge (0 and 2π included) and x² +
+    ///   y² > [`POLE_CLEARANCE`] (as for the equal-area grid); equal columns are found as
+    ///   there. The rest goes through [`CellFinder::cell_of`].
+    #[inline(always)]
+    fn cells_of_block_edges(&self, m: &[Vec3], cells: &mut [usize]) -> bool {
+        let [low, high] = self.squared_length;
+        let columns_f = self.grid.columns() as f64;
+        let last_column_f = columns_f - 1.0;
+        let per_radian = self.columns_per_radian;
+        let z_edges = self.grid.z_edges();
+        let interior_z = &z_edges[1..self.grid.rows()];
+        let phi_edges = self.grid.phi_edges.as_deref();
+        let (mut x, mut y, mut z) = ([0.0; FIND_BLOCK], [0.0; FIND_BLOCK], [0.0; FIND_BLOCK]);
+        let (mut row, mut column) = ([0.0f64; FIND_BLOCK], [0.0f64; FIND_BLOCK]);
+        let (mut zn, mut u) = ([0.0f64; FIND_BLOCK], [0.0f64; FIND_BLOCK]);
+        let mut clear = [true; FIND_BLOCK];
+        let mut inside = true;
+        for (m, cells) in m.chunks(FIND_BLOCK).zip(cells.chunks_mut(FIND_BLOCK)) {
+            let n = m.len();
+            for (((m, x), y), z) in m.iter().zip(&mut x).zip(&mut y).zip(&mut z) {
+                (*x, *y, *z) = (m[0], m[1], m[2]);
+            }
+            for i in 0..n {
+                let planar = x[i] * x[i] + y[i] * y[i];
+                let squared = planar + z[i] * z[i];
+                let valid = (squared >= low) & (squared <= high) & (z[i] >= 0.0);
+                zn[i] = z[i] / squared.sqrt();
+                u[i] = approximate_azimuth(x[i], y[i]);
+                row[i] = 0.0;
+                clear[i] = valid & (planar > POLE_CLEARANCE);
+            }
+            for &e in interior_z {
+                for (row, &zn) in row[..n].iter_mut().zip(&zn[..n]) {
+                    *row += if zn >= e { 1.0 } else { 0.0 };
+                }
+            }
+            match phi_edges {
+                Some(edges) => {
+                    column[..n].fill(0.0);
+                    for (j, &e) in edges.iter().enumerate() {
+                        let interior = j > 0 && j + 1 < edges.len();
+                        for ((column, clear), &u) in
+                            column[..n].iter_mut().zip(&mut clear[..n]).zip(&u[..n])
+                        {
+                            if interior {
+                                *column += if u >= e { 1.0 } else { 0.0 };
+                            }
+                            *clear &= (u - e).abs() > COLUMN_MARGIN;
+                        }
+                    }
+                }
+                None => {
+                    let column_margin = COLUMN_MARGIN * per_radian;
+                    for ((column, clear), &u) in
+                        column[..n].iter_mut().zip(&mut clear[..n]).zip(&u[..n])
+                    {
+                        let t = u * per_radian;
+                        let c = t.floor();
+                        let fraction = t - c;
+                        *clear &= (fraction > column_margin)
+                            & (fraction < 1.0 - column_margin)
+                            & (c >= 0.0)
+                            & (c <= last_column_f);
+                        *column = c;
+                    }
+                }
+            }
+            for i in 0..n {
+                cells[i] = if clear[i] {
+                    (row[i] * columns_f + column[i]) as usize
+                } else {
+                    match self.cell_of(m[i]) {
+                        Ok(c) => c,
+                        Err(_) => {
+                            inside = false;
+                            0
+                        }
+                    }
+                };
+            }
+        }
+        inside
+    }
+
     /// [`CellFinder::cells_of`] by [`CellFinder::cell_of`] alone.
     #[cold]
     fn cells_of_one_by_one(&self, m: &[Vec3], cells: &mut [usize]) -> bool {
@@ -393,8 +610,11 @@ impl CellFinder {
             return 0;
         }
         let columns = self.grid.columns();
-        let mut j = ((approximate_azimuth(x, y) * self.columns_per_radian) as i64 as usize)
-            .min(columns - 1);
+        let estimate = approximate_azimuth(x, y);
+        let mut j = match &self.grid.phi_edges {
+            Some(edges) => edges[1..columns].partition_point(|&e| e <= estimate),
+            None => ((estimate * self.columns_per_radian) as i64 as usize).min(columns - 1),
+        };
         // Whether the direction is at or past boundary j: φ − φ_j ∈ [0, π) (on the boundary
         // counts as past; the antipode of b_j, reachable only when 2R ≤ 2, does not).
         let past = |j: usize| self.past(j, x, y);
@@ -506,7 +726,7 @@ mod tests {
         let mut uniform = || rng.uniform();
         for resolution in [1, 2, 3, 7, 64, 1000] {
             let grid = HemisphereGrid::new(resolution).unwrap();
-            let finder = CellFinder::new(grid);
+            let finder = CellFinder::new(grid.clone());
             for _ in 0..20_000 {
                 let m = HemisphereGrid::direction(uniform() * TAU, uniform());
                 assert_eq!(
@@ -614,7 +834,7 @@ mod tests {
         let mut rejected = 0usize;
         for resolution in [1, 2, 3, 4, 7, 64, 1000, 300_000] {
             let grid = HemisphereGrid::new(resolution).unwrap();
-            let finder = CellFinder::new(grid);
+            let finder = CellFinder::new(grid.clone());
             let mut directions: Vec<Vec3> = Vec::new();
             for _ in 0..20_000 {
                 directions.push(HemisphereGrid::direction(uniform() * TAU, uniform()));
@@ -757,13 +977,130 @@ mod tests {
     /// on the baseline path (`pulp::Arch::Scalar`, what a CPU without AVX2 runs) finds the cell of
     /// `cell_of` for every direction: random ones, and ones at angular distances around the
     /// column margin (1e-4 rad) and the estimate's error (1.2e-5 rad) from every column edge.
+    /// A grid with given edges (rows crowded at the pole as a narrow lobe's quantiles are,
+    /// uneven columns): the block finder, its baseline path, the scalar finder and atan2
+    /// binning agree on random directions, on and beside every row and column edge (z exactly
+    /// on an edge, nudged by ulps, non-unit by the unit tolerance), at the pole, at φ = 0 and
+    /// 2π and below the horizon.
+    #[test]
+    fn a_grid_with_edges_bins_like_atan2_on_every_path() {
+        let rows = 16;
+        let mut z: Vec<f64> = (0..=rows)
+            .map(|k| 1.0 - (1.0 - k as f64 / rows as f64).powi(6))
+            .collect();
+        z[rows] = 1.0;
+        let phi: Vec<f64> = (0..=2 * rows)
+            .map(|j| {
+                let t = j as f64 / (2 * rows) as f64;
+                (TAU * (t + 0.05 * (TAU * t).sin())).clamp(0.0, TAU)
+            })
+            .collect();
+        let grid = HemisphereGrid::with_edges(z.clone(), Some(phi.clone())).unwrap();
+        let finder = CellFinder::new(grid.clone());
+        let mut rng = crate::random::Stream::new(17, 0);
+        let mut uniform = || rng.uniform();
+        let mut directions: Vec<Vec3> = (0..20_000)
+            .map(|_| HemisphereGrid::direction(uniform() * TAU, 1.0 - uniform().powi(8)))
+            .collect();
+        for &ze in &z {
+            for steps in [-2, -1, 0, 1, 2] {
+                let zz = nudge(ze, steps).clamp(0.0, 1.0);
+                for p in [0.3, 2.0, 5.0] {
+                    let m = HemisphereGrid::direction(p, zz);
+                    directions.push(m);
+                    let s = 1.0 + 0.9e-6;
+                    directions.push([m[0] * s, m[1] * s, m[2] * s]);
+                }
+            }
+        }
+        for &pe in &phi {
+            for d in [0.0, 1e-12, 1e-5, 9.9e-5, 1e-4, 1.01e-4] {
+                for p in [pe + d, pe - d] {
+                    directions.push(HemisphereGrid::direction(p, uniform()));
+                }
+            }
+        }
+        directions.extend([
+            [0.0, 0.0, 1.0],
+            [1e-120, 1e-120, 1.0],
+            [1.0, 0.0, 0.0],
+            [1.0, -1e-17, 0.0],
+            [0.6, 0.0, -0.8],
+            [f64::NAN, 0.0, 1.0],
+        ]);
+        let mut detected = vec![usize::MAX; directions.len()];
+        let mut baseline = vec![usize::MAX; directions.len()];
+        assert!(!finder.cells_of(&directions, &mut detected));
+        assert!(!finder.cells_of_on(pulp::Arch::Scalar, &directions, &mut baseline));
+        let mut inside = 0;
+        for ((&m, &a), &b) in directions.iter().zip(&detected).zip(&baseline) {
+            match (finder.cell_of(m), grid.cell_of(m)) {
+                (Ok(c), Ok(g)) => {
+                    assert_eq!((a, b), (c, c), "{m:?}");
+                    // At the exact pole the finder takes column 0 where atan2(±0, −0) = π, and
+                    // within ~1e-16 rad of a column edge either side is right (side tests
+                    // against the rounded b_j, atan2 against φ_j): rows always agree.
+                    let azimuth = m[1].atan2(m[0]).rem_euclid(TAU);
+                    let near_edge = phi.iter().any(|&e| (azimuth - e).abs() < 1e-12);
+                    if (m[0] != 0.0 || m[1] != 0.0) && !near_edge {
+                        assert_eq!(c, g, "{m:?}");
+                    } else {
+                        assert_eq!(c / 32, g / 32, "{m:?}");
+                    }
+                    inside += 1;
+                }
+                (Err(e), Err(f)) => assert_eq!(format!("{e}"), format!("{f}")),
+                other => panic!("{m:?}: {other:?}"),
+            }
+        }
+        assert!(inside > 20_000);
+        // The cells are where the edges put them.
+        let c = grid.cell(3 * 32 + 5);
+        assert_eq!((c.z, c.phi), ([z[3], z[4]], [phi[5], phi[6]]));
+    }
+
+    #[test]
+    fn edges_that_do_not_make_a_grid_are_refused() {
+        let phi = |n: usize| {
+            (0..=n)
+                .map(|j| TAU * j as f64 / n as f64)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(
+            HemisphereGrid::with_edges(vec![0.0], None),
+            Err(GridError::NoRows)
+        );
+        assert!(matches!(
+            HemisphereGrid::with_edges(vec![0.0, 0.5, 0.5, 1.0], None),
+            Err(GridError::Rows(_))
+        ));
+        assert!(matches!(
+            HemisphereGrid::with_edges(vec![0.0, 0.5, 0.9], None),
+            Err(GridError::Rows(_))
+        ));
+        assert!(matches!(
+            HemisphereGrid::with_edges(vec![0.0, 0.5, 1.0], Some(phi(3))),
+            Err(GridError::ColumnCount { .. })
+        ));
+        // Four columns, one of them π wide: its side tests would not be exact.
+        assert!(matches!(
+            HemisphereGrid::with_edges(
+                vec![0.0, 0.5, 1.0],
+                Some(vec![0.0, 0.1, 0.2, 0.2 + PI, TAU])
+            ),
+            Err(GridError::Columns(_))
+        ));
+        let ok = HemisphereGrid::with_edges(vec![0.0, 0.5, 1.0], Some(phi(4))).unwrap();
+        assert!(!ok.is_equal_area() && ok.cells() == 8);
+    }
+
     #[test]
     fn cells_of_is_the_same_on_the_dispatched_and_baseline_paths() {
         let mut rng = crate::random::Stream::new(13, 0);
         let mut uniform = || rng.uniform();
         for resolution in [1, 2, 5, 64, 512] {
             let grid = HemisphereGrid::new(resolution).unwrap();
-            let finder = CellFinder::new(grid);
+            let finder = CellFinder::new(grid.clone());
             let mut directions: Vec<Vec3> = (0..50_000)
                 .map(|_| HemisphereGrid::direction(uniform() * TAU, uniform()))
                 .collect();

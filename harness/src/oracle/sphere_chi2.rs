@@ -170,7 +170,7 @@ pub fn observe_sphere(
     samples: u64,
     seed: u64,
 ) -> SphereObserved {
-    let finder = CellFinder::new(grid);
+    let finder = CellFinder::new(grid.clone());
     // Each chunk's counts with its buffer of sampled directions (reused block to block).
     draw_chunks(
         samples,
@@ -281,7 +281,7 @@ pub fn expected_sphere(
     target: f64,
 ) -> (Expected, Expected) {
     (
-        expected_hemisphere(pdf, grid, false, target),
+        expected_hemisphere(pdf, grid.clone(), false, target),
         expected_hemisphere(pdf, grid, true, target),
     )
 }
@@ -311,7 +311,7 @@ pub fn sphere_chi2_against(
 ) -> SphereChi2Result {
     let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
     let t = Instant::now();
-    let observed = observe_sphere(sample, grid, config.samples, config.seed);
+    let observed = observe_sphere(sample, grid.clone(), config.samples, config.seed);
     let sampling_seconds = t.elapsed().as_secs_f64();
     let integration_seconds = 0.0;
     let mut result = SphereChi2Result {

@@ -149,8 +149,8 @@ pub fn hemispheres(data: &RecordData) -> Vec<(&'static str, &'static str, &[u64]
 #[cfg(feature = "html")]
 pub fn chi2_heat_maps(
     title: &str,
-    rows: usize,
-    columns: usize,
+    (rows, columns): (usize, usize),
+    (z_edges, phi_edges): (&[f64], &[f64]),
     observed: &[u64],
     expected: &[f64],
 ) -> Result<Vec<(&'static str, String)>, PlotError> {
@@ -209,6 +209,8 @@ pub fn chi2_heat_maps(
                 columns,
                 values,
                 scale,
+                z_edges,
+                phi_edges,
             })?;
             Ok((name, svg))
         })
@@ -219,17 +221,23 @@ pub fn chi2_heat_maps(
 /// (row 0 at the horizon), columns of φ from 0.
 pub fn chi2_tables(
     generated_by: &str,
-    rows: usize,
-    columns: usize,
+    (rows, columns): (usize, usize),
+    (z_edges, phi_edges): (&[f64], &[f64]),
     samples: u64,
     seed: u64,
     observed: &[u64],
     expected: &[f64],
 ) -> [(&'static str, String); 2] {
-    let layout = format!(
-        "rows: cos θ in [i/R, (i+1)/R), row 0 at the horizon; columns: φ in \
-         [2πj/{columns}, 2π(j+1)/{columns}); R = {rows}"
-    );
+    let layout = match (z_edges.is_empty(), phi_edges.is_empty()) {
+        (true, true) => format!(
+            "rows: cos θ in [i/R, (i+1)/R), row 0 at the horizon; columns: φ in \
+             [2πj/{columns}, 2π(j+1)/{columns}); R = {rows}"
+        ),
+        _ => format!(
+            "rows: cos θ in [z_edges[i], z_edges[i+1]), row 0 at the horizon; columns: φ in \
+             [phi_edges[j], phi_edges[j+1]) (empty edges: i/R and 2πj/{columns}); R = {rows}"
+        ),
+    };
     let table = |counts: Value| {
         let value = json!({
             "generated_by": generated_by,
@@ -238,6 +246,8 @@ pub fn chi2_tables(
             "seed": seed,
             "rows": rows,
             "columns": columns,
+            "z_edges": z_edges,
+            "phi_edges": phi_edges,
             "counts": counts,
         });
         format!("{value:#}\n")
@@ -298,18 +308,26 @@ pub fn write_record_data(
             seed,
             observed,
             expected,
+            z_edges,
+            phi_edges,
         } => {
             files.extend(chi2_tables(
                 generated_by,
-                *rows,
-                *columns,
+                (*rows, *columns),
+                (z_edges, phi_edges),
                 *samples,
                 *seed,
                 observed,
                 expected,
             ));
             #[cfg(feature = "html")]
-            files.extend(chi2_heat_maps(title, *rows, *columns, observed, expected)?);
+            files.extend(chi2_heat_maps(
+                title,
+                (*rows, *columns),
+                (z_edges, phi_edges),
+                observed,
+                expected,
+            )?);
             #[cfg(not(feature = "html"))]
             let _ = title;
         }
@@ -333,8 +351,8 @@ pub fn write_record_data(
             for (prefix, side, observed, expected) in hemispheres(data) {
                 for (name, text) in chi2_tables(
                     generated_by,
-                    *rows,
-                    *columns,
+                    (*rows, *columns),
+                    (&[], &[]),
                     *samples,
                     *seed,
                     observed,
@@ -345,8 +363,8 @@ pub fn write_record_data(
                 #[cfg(feature = "html")]
                 for (name, svg) in chi2_heat_maps(
                     &format!("{title} · {side}"),
-                    *rows,
-                    *columns,
+                    (*rows, *columns),
+                    (&[], &[]),
                     observed,
                     expected,
                 )? {
@@ -413,6 +431,8 @@ mod tests {
             seed: 5,
             observed: vec![0, 1, 2, 3, 0, 1, 2, 3],
             expected: vec![0.0, 1.5, 1.5, 3.0, 0.5, 1.0, 2.0, 2.5],
+            z_edges: vec![0.0, 0.9, 1.0],
+            phi_edges: vec![0.0, 1.0, 3.0, 4.0, std::f64::consts::TAU],
         };
         let paths = write_record_data(&dir, "ggx alpha=0.3", "test", &data).unwrap();
         assert_eq!(paths.len(), 5);

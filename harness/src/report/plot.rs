@@ -404,8 +404,9 @@ pub fn colour(value: f64, scale: ColourScale) -> RGBColor {
 }
 
 /// A heat map over the hemisphere's (φ, cos θ) grid: `rows` cos θ-rows (row 0 at the horizon,
-/// cos θ ∈ [i/R, (i+1)/R)) × `columns` φ-columns over [0, 2π), row-major. Drawn with φ in
-/// degrees across and θ in degrees down (cells of equal solid angle: rows are uneven in θ).
+/// cos θ ∈ [z_i, z_{i+1}), by default z_i = i/R) × `columns` φ-columns over [0, 2π) (by default
+/// equal), row-major. Drawn with φ in degrees across and θ in degrees down, each cell where its
+/// edges put it (rows are uneven in θ).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HeatMap<'a> {
     /// The caption (name the model and the case).
@@ -420,6 +421,10 @@ pub struct HeatMap<'a> {
     pub values: &'a [f64],
     /// The colour scale.
     pub scale: ColourScale,
+    /// The row edges z₀ = 0 < … < z_R = 1 (empty: i/R).
+    pub z_edges: &'a [f64],
+    /// The column edges φ₀ = 0 < … < φ_2R = 2π (empty: equal columns).
+    pub phi_edges: &'a [f64],
 }
 
 /// Height of a heat map, pixels.
@@ -530,7 +535,15 @@ const BITMAP_ROWS: usize = 90;
 /// BMP needs only a 54-byte header and browsers display it: the dependency tree has no PNG
 /// encoder, and at 64 × 90 pixels (17 kB) the image is an eighth of the per-cell SVG.
 pub fn cells_bitmap(map: &HeatMap<'_>) -> Vec<u8> {
-    let (w, h) = (map.columns, BITMAP_ROWS);
+    // Given edges: finer pixels (0.25° in θ, 1° in φ), each the cell its centre falls in.
+    let given_rows = map.z_edges.len() == map.rows + 1;
+    let given_columns = map.phi_edges.len() == map.columns + 1;
+    let w = if given_columns { 360 } else { map.columns };
+    let h = if given_rows {
+        4 * BITMAP_ROWS
+    } else {
+        BITMAP_ROWS
+    };
     let stride = (3 * w).div_ceil(4) * 4;
     let size = 54 + stride * h;
     let mut b = Vec::with_capacity(size);
@@ -546,10 +559,21 @@ pub fn cells_bitmap(map: &HeatMap<'_>) -> Vec<u8> {
     b.extend_from_slice(&[0; 24]); // BI_RGB, no sizes, no palette
     for k in (0..h).rev() {
         let theta = ((k as f64 + 0.5) * 90.0 / h as f64).to_radians();
-        let row = ((theta.cos() * map.rows as f64) as usize).min(map.rows - 1);
+        let row = if given_rows {
+            let z = theta.cos();
+            map.z_edges[1..map.rows].partition_point(|&e| e <= z)
+        } else {
+            ((theta.cos() * map.rows as f64) as usize).min(map.rows - 1)
+        };
         let start = b.len();
         for j in 0..w {
-            let RGBColor(r, g, bl) = colour(map.values[row * map.columns + j], map.scale);
+            let column = if given_columns {
+                let phi = ((j as f64 + 0.5) * 360.0 / w as f64).to_radians();
+                map.phi_edges[1..map.columns].partition_point(|&e| e <= phi)
+            } else {
+                j
+            };
+            let RGBColor(r, g, bl) = colour(map.values[row * map.columns + column], map.scale);
             b.extend_from_slice(&[bl, g, r]);
         }
         b.resize(start + stride, 0);
@@ -697,6 +721,8 @@ mod tests {
         assert!(svg.contains("route a") && svg.contains("tolerance"));
         let values = [1.0, 2.0, f64::NAN, f64::INFINITY, -3.0, 0.5];
         let map = HeatMap {
+            z_edges: &[],
+            phi_edges: &[],
             title: "ggx α = 0.3, observed",
             quantity: "counts",
             rows: 2,
@@ -707,6 +733,8 @@ mod tests {
         let svg = heat_map_svg(&map).unwrap();
         assert!(svg.contains("θ (degrees)") && svg.contains("φ (degrees)"));
         let bad = HeatMap {
+            z_edges: &[],
+            phi_edges: &[],
             values: &values[..5],
             ..map
         };

@@ -18,9 +18,17 @@ pub(crate) fn data_plots(r: &CheckRecord) -> Result<String, PlotError> {
             columns,
             observed,
             expected,
+            z_edges,
+            phi_edges,
             ..
         }) => {
-            let maps = chi2_heat_maps(&title, *rows, *columns, observed, expected)?;
+            let maps = chi2_heat_maps(
+                &title,
+                (*rows, *columns),
+                (z_edges, phi_edges),
+                observed,
+                expected,
+            )?;
             Ok(maps
                 .iter()
                 .map(|(name, svg)| img(svg, &format!("{} {name}", r.check)))
@@ -31,8 +39,8 @@ pub(crate) fn data_plots(r: &CheckRecord) -> Result<String, PlotError> {
             for (_, side, observed, expected) in super::artefacts::hemispheres(data) {
                 let maps = chi2_heat_maps(
                     &format!("{title} · {side}"),
-                    *rows,
-                    *columns,
+                    (*rows, *columns),
+                    (&[], &[]),
                     observed,
                     expected,
                 )?;

@@ -289,7 +289,11 @@ pub fn calibrate_bsdf(
         .filter(|i| matches!(i.name, "oblique" | "total_internal_reflection"))
     {
         let t = Instant::now();
-        let expected = expected_sphere(&pdf_at(bsdf.as_ref(), inc.wi), grid, mass_target(samples));
+        let expected = expected_sphere(
+            &pdf_at(bsdf.as_ref(), inc.wi),
+            grid.clone(),
+            mass_target(samples),
+        );
         let p: Vec<Option<f64>> = (0..runs)
             .into_par_iter()
             .map(|i| {

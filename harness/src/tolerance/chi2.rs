@@ -35,3 +35,14 @@ pub const KINKED_CELL_RELATIVE_TOLERANCE: f64 = 1e-4;
 /// [`CELL_ABSOLUTE_TOLERANCE`] for a remote model: 1e-11 of mass per cell is 1e-3 counts at
 /// 10⁸ samples, far below the ≥ 5 counts a cell needs to enter the statistic unpooled.
 pub const REMOTE_CELL_ABSOLUTE_TOLERANCE: f64 = 1e-11;
+/// Relative tolerance of the strip masses from which the chi-square's cell layout
+/// (`oracle::chi2::cells`) places its rows and columns at the quantiles of the density's
+/// marginals: the layout only balances the cells (every cell's expected count is then
+/// integrated to [`CELL_RELATIVE_TOLERANCE`] over the cells as placed), so an edge off by a
+/// fraction 1e-3 of a row's mass changes that row's expected count by 0.1 % and the test's
+/// power by nothing measurable; tighter costs evaluations for no gain.
+pub const LAYOUT_RELATIVE_TOLERANCE: f64 = 1e-3;
+/// Absolute tolerance of the whole layout's strip masses (shared among the strips): 1e-6 of mass
+/// is a thousandth of a row's share at the finest resolution a test allows in practice (R =
+/// 1000, rows of mass 1e-3), so tail strips of negligible mass are not refined.
+pub const LAYOUT_ABSOLUTE_TOLERANCE: f64 = 1e-6;

@@ -99,7 +99,7 @@ where
     S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
 {
     let chunks = samples.div_ceil(CHUNK);
-    let finder = CellFinder::new(grid);
+    let finder = CellFinder::new(grid.clone());
     let block = block.clamp(1, CHUNK as usize);
     (0..chunks)
         .into_par_iter()

@@ -94,7 +94,7 @@ where
     let estimates: Vec<_> = (0..grid.cells())
         .into_par_iter()
         .map(|i| {
-            let (thetas, phis, pieces) = cell_pieces(grid, i, &polar, &azimuth);
+            let (thetas, phis, pieces) = cell_pieces(&grid, i, &polar, &azimuth);
             let tolerance = Tolerance {
                 absolute: CELL_ABSOLUTE_TOLERANCE / pieces as f64,
                 relative,
@@ -122,7 +122,7 @@ where
 /// The pieces of cell `i` between the lobe's cuts: the polar and azimuthal breakpoints inside
 /// the cell (θ decreases with z: the top of the row, z₁, is the smaller θ) and their count.
 fn cell_pieces(
-    grid: HemisphereGrid,
+    grid: &HemisphereGrid,
     i: usize,
     polar: &[f64],
     azimuth: &[f64],
@@ -154,7 +154,7 @@ pub fn expected_mass_in_batch(
     let mut rectangles = Vec::new();
     let mut per_cell = Vec::with_capacity(grid.cells());
     for i in 0..grid.cells() {
-        let (thetas, phis, pieces) = cell_pieces(grid, i, &polar, &azimuth);
+        let (thetas, phis, pieces) = cell_pieces(&grid, i, &polar, &azimuth);
         let tolerance = Tolerance {
             absolute: absolute / pieces as f64,
             relative,
@@ -187,7 +187,7 @@ pub fn expected_mass_in_batch(
 
 /// A batch density over directions as a batch integrand over (φ, θ): pdf(direction) · sin θ,
 /// evaluated in parallel chunks of 16 384 points.
-fn in_angles<'p>(pdf: &'p BatchPdf<'p>) -> impl Fn(&[[f64; 2]], &mut [f64]) + 'p {
+pub(super) fn in_angles<'p>(pdf: &'p BatchPdf<'p>) -> impl Fn(&[[f64; 2]], &mut [f64]) + 'p {
     move |pt: &[[f64; 2]], out: &mut [f64]| {
         const CHUNK: usize = 16_384;
         out.par_chunks_mut(CHUNK)
@@ -232,7 +232,7 @@ pub fn expected_mass_global(
     let mut rectangles = Vec::new();
     let mut per_cell = Vec::with_capacity(grid.cells());
     for i in 0..grid.cells() {
-        let (thetas, phis, pieces) = cell_pieces(grid, i, &polar, &azimuth);
+        let (thetas, phis, pieces) = cell_pieces(&grid, i, &polar, &azimuth);
         for p in phis.windows(2) {
             for t in thetas.windows(2) {
                 rectangles.push(([p[0], p[1]], [t[0], t[1]]));

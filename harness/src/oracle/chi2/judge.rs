@@ -32,6 +32,8 @@ pub(super) fn judge(
         integration_seconds,
         expected: expected.mass.iter().map(|m| m * n).collect(),
         observed: observed.counts,
+        z_edges: grid.z_edges(),
+        phi_edges: grid.phi_edges(),
     };
     result.reason = sanity(&result, &expected, observed.outside, observed.first_outside);
     if result.reason.is_some() {

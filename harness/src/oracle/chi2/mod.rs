@@ -34,6 +34,7 @@
 //! [`CELL_ABSOLUTE_TOLERANCE`]: crate::tolerance::CELL_ABSOLUTE_TOLERANCE
 
 mod binning;
+pub mod cells;
 mod expected;
 mod judge;
 
@@ -47,6 +48,7 @@ use crate::oracle::domain::{DomainError, HemisphereGrid};
 use crate::oracle::lobe::{self, Lobe};
 use crate::tolerance::CELL_RELATIVE_TOLERANCE;
 use binning::scalar_batch;
+pub use cells::Layout;
 use judge::judge;
 pub(crate) use judge::pooled_statistic;
 use mfh_reference::geometry::Vec3;
@@ -178,6 +180,10 @@ pub struct Chi2Result {
     pub observed: Vec<u64>,
     /// Expected counts per cell (mass × samples).
     pub expected: Vec<f64>,
+    /// The row edges z₀ = 0 < … < z_R = 1 (cos θ) of the cells ([`cells::layout`]).
+    pub z_edges: Vec<f64>,
+    /// The column edges φ₀ = 0 < … < φ_2R = 2π of the cells.
+    pub phi_edges: Vec<f64>,
 }
 
 impl Chi2Result {
@@ -238,30 +244,69 @@ where
     S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
     P: Fn(Vec3) -> f64 + Sync + ?Sized,
 {
-    timed(
+    chi2_test_batch_layout(
+        sample,
+        pdf,
         config,
-        |grid| observe_batch(sample, grid, config.samples, config.seed),
-        |grid| match lobe {
-            Some(lobe) => expected_mass_in(pdf, grid, cell_relative, lobe, theta_kinks),
-            None => expected_mass_to(pdf, grid, cell_relative, theta_kinks),
-        },
+        (cell_relative, lobe, theta_kinks),
+        Layout::default(),
     )
 }
 
-/// The test on `config`'s grid: the observed counts (`observe`), then the expected masses
-/// (`expect`), each timed, judged by [`judge`].
+/// [`chi2_test_batch_in`] on the cells of `layout` (the default, [`Layout::FollowLobe`]: rows
+/// and columns at the quantiles of `pdf`'s marginals; [`Layout::EqualArea`]: the equal-area
+/// grid), with (cell relative tolerance, lobe, θ kinks) as there.
+pub fn chi2_test_batch_layout<S, P>(
+    sample: &S,
+    pdf: &P,
+    config: &Chi2Config,
+    (cell_relative, lobe, theta_kinks): (f64, Option<&Lobe>, &[f64]),
+    layout: Layout,
+) -> Chi2Result
+where
+    S: Fn(&[[f64; 2]], &mut [Vec3]) + Sync + ?Sized,
+    P: Fn(Vec3) -> f64 + Sync + ?Sized,
+{
+    let t = Instant::now();
+    let measured;
+    let (lobe, lobe_evaluations) = match lobe {
+        Some(lobe) => (lobe, 0),
+        None => {
+            measured = lobe::measure_density(&|m| pdf(m));
+            (&measured, measured.evaluations)
+        }
+    };
+    let batch = |m: &[Vec3], out: &mut [f64]| {
+        for (o, &m) in out.iter_mut().zip(m) {
+            *o = pdf(m);
+        }
+    };
+    let (grid, spent) = cells::layout(&batch, lobe, config.resolution, theta_kinks, layout);
+    let spent = spent + lobe_evaluations;
+    timed(
+        config,
+        (grid, spent, t.elapsed().as_secs_f64()),
+        |grid| observe_batch(sample, grid.clone(), config.samples, config.seed),
+        |grid| expected_mass_in(pdf, grid.clone(), cell_relative, lobe, theta_kinks),
+    )
+}
+
+/// The test on `grid` (placed with `layout_evaluations` pdf evaluations in `layout_seconds`):
+/// the observed counts (`observe`), then the expected masses (`expect`), each timed (the
+/// layout counts as integration), judged by [`judge`].
 fn timed(
     config: &Chi2Config,
-    observe: impl FnOnce(HemisphereGrid) -> Observed,
-    expect: impl FnOnce(HemisphereGrid) -> Expected,
+    (grid, layout_evaluations, layout_seconds): (HemisphereGrid, u64, f64),
+    observe: impl FnOnce(&HemisphereGrid) -> Observed,
+    expect: impl FnOnce(&HemisphereGrid) -> Expected,
 ) -> Chi2Result {
-    let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
     let t = Instant::now();
-    let observed = observe(grid);
+    let observed = observe(&grid);
     let sampling_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let expected = expect(grid);
-    let integration_seconds = t.elapsed().as_secs_f64();
+    let mut expected = expect(&grid);
+    expected.evaluations += layout_evaluations;
+    let integration_seconds = t.elapsed().as_secs_f64() + layout_seconds;
     judge(
         config,
         grid,
@@ -300,18 +345,35 @@ pub fn chi2_test_batches_cut(
     lobe: Option<&Lobe>,
     theta_kinks: &[f64],
 ) -> Chi2Result {
+    let t = Instant::now();
+    let (lobe, lobe_evaluations) = match lobe {
+        Some(lobe) => (lobe.clone(), 0),
+        None => {
+            let lobe = lobe::measure_with_batch(pdf, &lobe::Options::default());
+            let spent = lobe.evaluations;
+            (lobe, spent)
+        }
+    };
+    let (grid, spent) = cells::layout(
+        pdf,
+        &lobe,
+        config.resolution,
+        theta_kinks,
+        Layout::default(),
+    );
     timed(
         config,
-        |grid| observe_blocks(sample, grid, config.samples, config.seed, CHUNK as usize),
-        |grid| match lobe {
-            Some(lobe) => expected_mass_in_batch(pdf, grid, cell_tolerance, lobe, theta_kinks),
-            None => {
-                let lobe = lobe::measure_with_batch(pdf, &lobe::Options::default());
-                let mut e = expected_mass_in_batch(pdf, grid, cell_tolerance, &lobe, theta_kinks);
-                e.evaluations += lobe.evaluations;
-                e
-            }
+        (grid, spent + lobe_evaluations, t.elapsed().as_secs_f64()),
+        |grid| {
+            observe_blocks(
+                sample,
+                grid.clone(),
+                config.samples,
+                config.seed,
+                CHUNK as usize,
+            )
         },
+        |grid| expected_mass_in_batch(pdf, grid.clone(), cell_tolerance, &lobe, theta_kinks),
     )
 }
 
