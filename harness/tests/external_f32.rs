@@ -8,11 +8,9 @@
 //! reference); the C++ helper answers every malformed request with an error naming what is
 //! wrong and keeps serving.
 //!
-//! What waits for the harness's float32 support (branch f32: tolerances and noise-aware oracles
-//! for a model that declares `"precision":"f32"`): the `ci` audits, where the clean examples
-//! must pass and each defect must fail on its named check. On main an f32 model is judged at
-//! f64 tolerances (and its rounding noise drives the adaptive oracles' refinement for minutes),
-//! so those tests are ignored with that reason.
+//! The `ci` audits at the declared `"precision":"f32"` (ε32 tolerance budgets, oracles that stop
+//! at the implementation's rounding floor): the clean examples pass and each defect fails on
+//! its named check.
 
 #[path = "external/common.rs"]
 mod common;
@@ -660,7 +658,7 @@ fn base64_f64(text: &str) -> Vec<f64> {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The ci audits: they need the harness's float32 support (branch f32).
+// The ci audits at the declared float32 precision.
 // ---------------------------------------------------------------------------------------------
 
 const AGAINST: &str = r#"{"family":"ggx","alpha":0.3}"#;
@@ -712,7 +710,6 @@ fn checks(report: &Value) -> Vec<&str> {
 /// The C++ float32 GGX passes the ci audit with `"precision":"f32"`: D, Λ, G1, both samplers
 /// and the values against the reference (issue 27's target: within 1 min on 2 cores).
 #[test]
-#[ignore = "needs the precision support of branch f32"]
 fn the_cpp_example_passes_the_ci_audit_at_f32() {
     let (code, failing, report) = audit(&cpp_command(""), "cpp");
     assert_eq!(code, 0, "failing: {failing:?}");
@@ -734,7 +731,6 @@ fn the_cpp_example_passes_the_ci_audit_at_f32() {
 /// 1.3 for α = 0.3): `sampling.pdf_visible_normalization` fails; nothing outside visible
 /// sampling does.
 #[test]
-#[ignore = "needs the precision support of branch f32"]
 fn the_cpp_vndf_pdf_without_g1_fails_the_visible_pdf_normalization() {
     let cmd = cpp_command("--defect vndf_pdf_without_g1");
     let (code, failing, _) = audit(&cmd, "cpp-defect");
@@ -756,7 +752,6 @@ fn the_cpp_vndf_pdf_without_g1_fails_the_visible_pdf_normalization() {
 /// The float32 numpy GGX passes the ci audit with `"precision":"f32"` (issue 27's target:
 /// within 2 min on 2 cores).
 #[test]
-#[ignore = "needs the precision support of branch f32"]
 fn the_numpy_f32_example_passes_the_ci_audit_at_f32() {
     require_numpy();
     let (code, failing, report) = audit(&example("ggx_f32_numpy.py", ""), "numpy");
@@ -775,7 +770,6 @@ fn the_numpy_f32_example_passes_the_ci_audit_at_f32() {
 /// `sampling.pdf_jacobian` (pdf_wm against the density of the map u ↦ m) fails; the visible
 /// sampler and the values are right, so nothing else outside the normal sampler's checks does.
 #[test]
-#[ignore = "needs the precision support of branch f32"]
 fn the_numpy_exponent_defect_fails_the_jacobian_check() {
     require_numpy();
     let cmd = example("ggx_f32_numpy.py", "--defect exponent");

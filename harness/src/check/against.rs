@@ -138,7 +138,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, spec: &ModelSpec, why: &str) -> Vec<
                     }
                 }
                 let (e, u, v, t, p) = worst;
-                compare_exact(r, u, v, &AGAINST_REFERENCE);
+                compare_exact(r, u, v, &AGAINST_REFERENCE.at(s.precision));
                 if e == f64::INFINITY {
                     r.verdict = Verdict::Fail;
                 }
