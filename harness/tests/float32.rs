@@ -336,6 +336,10 @@ fn assert_bounded_failure(report: &mfh_harness::run::AuditReport) {
 }
 
 #[test]
+#[cfg_attr(
+    not(mfh_extensive),
+    ignore = "extensive tier: set MFH_EXTENSIVE=1 (the oscillating D's quick audit spends its evaluation budgets: 93 s on a quiet 2-core machine, > 300 s at load 6)"
+)]
 fn an_oscillating_d_finishes_with_failures() {
     let m = Oscillating(mfh_reference::ndf::Ggx::new(0.3, 0.3).unwrap());
     let report = Audit::of(&m).profile(Profile::Quick).run();
@@ -344,6 +348,10 @@ fn an_oscillating_d_finishes_with_failures() {
 }
 
 #[test]
+#[cfg_attr(
+    not(mfh_extensive),
+    ignore = "extensive tier: set MFH_EXTENSIVE=1 (the tabulated D's quick audit spends its evaluation budgets: 174 s at load 6)"
+)]
 fn a_piecewise_constant_d_finishes_with_failures() {
     let m = Tabulated::new();
     let report = Audit::of(&m).profile(Profile::Quick).run();

@@ -535,12 +535,15 @@ const BITMAP_ROWS: usize = 90;
 /// BMP needs only a 54-byte header and browsers display it: the dependency tree has no PNG
 /// encoder, and at 64 × 90 pixels (17 kB) the image is an eighth of the per-cell SVG.
 pub fn cells_bitmap(map: &HeatMap<'_>) -> Vec<u8> {
-    // Given edges: finer pixels (0.25° in θ, 1° in φ), each the cell its centre falls in.
+    // Given edges: finer pixels (0.5° in θ, 2° in φ), each the cell its centre falls in
+    // (uneven columns only: equal φ-columns keep one pixel a column). At most 180 × 180 × 3 B
+    // = 97 kB, 173 kB once base64 in the SVG and again in report.html (whose images stay
+    // under 200 kB: tests/tests/html_report.rs).
     let given_rows = map.z_edges.len() == map.rows + 1;
-    let given_columns = map.phi_edges.len() == map.columns + 1;
-    let w = if given_columns { 360 } else { map.columns };
+    let given_columns = map.phi_edges.len() == map.columns + 1 && !equal_columns(map);
+    let w = if given_columns { 180 } else { map.columns };
     let h = if given_rows {
-        4 * BITMAP_ROWS
+        2 * BITMAP_ROWS
     } else {
         BITMAP_ROWS
     };
@@ -579,6 +582,15 @@ pub fn cells_bitmap(map: &HeatMap<'_>) -> Vec<u8> {
         b.resize(start + stride, 0);
     }
     b
+}
+
+/// Whether the map's φ edges are the equal columns j·2π/columns (to 1e-12 rad).
+fn equal_columns(map: &HeatMap<'_>) -> bool {
+    let step = std::f64::consts::TAU / map.columns as f64;
+    map.phi_edges
+        .iter()
+        .enumerate()
+        .all(|(j, &e)| (e - j as f64 * step).abs() <= 1e-12)
 }
 
 /// The indices of the Pareto frontier of (time, error) points ([`crate::cost::frontier`]).

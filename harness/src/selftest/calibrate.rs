@@ -275,7 +275,7 @@ pub fn calibrate_bsdf(
 ) -> Result<Vec<TestCalibration>, String> {
     use crate::check::bsdf::{incidences, pdf_at};
     use crate::oracle::domain::HemisphereGrid;
-    use crate::oracle::sphere_chi2::{expected_sphere, mass_target, sphere_chi2_against};
+    use crate::oracle::sphere_chi2::{chi2_masses, sphere_chi2_against};
     let spec: mfh_reference::bsdf::BsdfSpec =
         serde_json::from_str(BSDF_MODEL).map_err(|e| format!("calibration BSDF: {e}"))?;
     let bsdf = spec.build().map_err(|e| format!("calibration BSDF: {e}"))?;
@@ -289,11 +289,7 @@ pub fn calibrate_bsdf(
         .filter(|i| matches!(i.name, "oblique" | "total_internal_reflection"))
     {
         let t = Instant::now();
-        let expected = expected_sphere(
-            &pdf_at(bsdf.as_ref(), inc.wi),
-            grid.clone(),
-            mass_target(samples),
-        );
+        let expected = chi2_masses(&pdf_at(bsdf.as_ref(), inc.wi), grid.clone(), samples);
         let p: Vec<Option<f64>> = (0..runs)
             .into_par_iter()
             .map(|i| {

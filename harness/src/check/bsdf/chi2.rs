@@ -64,6 +64,10 @@ pub fn plan<'a>(
             if let Value::Object(case) = &mut r.case {
                 case.insert("pdf_mass".into(), json!(result.mass()));
                 case.insert("failed_samples".into(), json!(result.observed.failed));
+                case.insert(
+                    "mass_noncentrality".into(),
+                    json!(result.mass_noncentrality()),
+                );
             }
             let expected = result.expected_counts();
             let cells = result.observed.upper.len();

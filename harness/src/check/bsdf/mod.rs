@@ -30,7 +30,7 @@ pub use chi2::RESOLUTION as CHI2_RESOLUTION;
 use super::{PlannedCheck, Profile};
 use crate::oracle::chi2::Expected;
 use crate::oracle::domain::HemisphereGrid;
-use crate::oracle::sphere_chi2::{draw_chunks, expected_sphere, mass_target};
+use crate::oracle::sphere_chi2::{chi2_masses, draw_chunks, expected_sphere};
 use crate::oracle::Estimate;
 use crate::subject::bsdf::BsdfSubject;
 use mfh_reference::bsdf::{Bsdf, BsdfSample};
@@ -163,11 +163,11 @@ impl Integrals {
     }
 
     /// The pdf's masses over the cells of both hemispheres (upper, lower) on the chi-square's
-    /// grid, to the [`mass_target`] of its samples, and the evaluations they cost.
+    /// grid, to the accuracy its `samples` need ([`chi2_masses`]), and the evaluations they cost.
     pub fn pdf_masses(&self, bsdf: &dyn Bsdf) -> (&(Expected, Expected), u64) {
         let masses = self.pdf.get_or_init(|| {
             let grid = HemisphereGrid::new(chi2::RESOLUTION).expect("R ≥ 1");
-            let e = expected_sphere(&pdf_at(bsdf, self.wi), grid, mass_target(self.samples));
+            let e = chi2_masses(&pdf_at(bsdf, self.wi), grid, self.samples);
             let spent = e.0.evaluations + e.1.evaluations;
             (e, spent)
         });
@@ -203,7 +203,7 @@ impl Integrals {
 /// The summed error bound ∫ eval aims at in each hemisphere for `samples` sampled weights:
 /// 10/N (1e-5 at the ci profile's 10⁶), with a floor of 1e-9.
 ///
-/// Why not the chi-square's 1/N ([`mass_target`]): `bsdf.albedo` compares the integral with
+/// Why not the chi-square's 1/N ([`crate::oracle::sphere_chi2::mass_target`]): `bsdf.albedo` compares the integral with
 /// the mean sampled weight, whose standard error is σ_w/√N (σ_w, the weights' spread, is
 /// 0.05–1 for the microfacet BSDFs we audit), and takes the bound off the deviation; a bound
 /// of 2 × 10/N is then 20/(σ_w √N) ≤ 0.4 standard errors at 10⁶ samples for σ_w ≥ 0.05, a

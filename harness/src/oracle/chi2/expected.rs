@@ -22,6 +22,8 @@ pub struct Expected {
     pub total: f64,
     /// The sum of the per-cell error bounds of the cubature.
     pub error_bound: f64,
+    /// The error bound of each cell (the order of `mass`).
+    pub cell_bound: Vec<f64>,
     /// Pdf evaluations spent.
     pub evaluations: u64,
 }
@@ -34,6 +36,7 @@ impl Expected {
             mass: estimates.iter().map(|e| e.value).collect(),
             total: estimates.iter().map(|e| e.value).sum(),
             error_bound: estimates.iter().map(|e| e.error_bound).sum(),
+            cell_bound: estimates.iter().map(|e| e.error_bound).collect(),
             evaluations: estimates.iter().map(|e| e.evaluations).sum(),
         }
     }
@@ -227,6 +230,20 @@ pub fn expected_mass_global(
     target: f64,
     budget: u64,
 ) -> (Expected, bool) {
+    expected_mass_global_until(pdf, grid, lobe, target, budget, &|_| false)
+}
+
+/// [`expected_mass_global`] that also stops, converged, once the masses so far satisfy
+/// `enough` (a caller's criterion on the cells' estimates; see
+/// [`crate::oracle::cubature::global::integrate_global_until`]).
+pub fn expected_mass_global_until(
+    pdf: &BatchPdf<'_>,
+    grid: HemisphereGrid,
+    lobe: &Lobe,
+    target: f64,
+    budget: u64,
+    enough: &dyn Fn(&Expected) -> bool,
+) -> (Expected, bool) {
     let polar = lobe.polar_cuts_with(FRAC_PI_2, &[]);
     let azimuth = lobe.azimuth_cuts();
     let mut rectangles = Vec::new();
@@ -241,22 +258,30 @@ pub fn expected_mass_global(
         per_cell.push(pieces);
     }
     let f = in_angles(pdf);
-    let result = crate::oracle::cubature::global::integrate_global(&f, &rectangles, target, budget);
-    let mut at = 0;
-    let estimates: Vec<Estimate> = per_cell
-        .iter()
-        .map(|&n| {
-            let mut sum = Estimate::default();
-            for e in &result.estimates[at..at + n] {
-                sum.value += e.value;
-                sum.error_bound += e.error_bound;
-                sum.evaluations += e.evaluations;
-            }
-            at += n;
-            sum
-        })
-        .collect();
-    let mut e = Expected::of_cells(&estimates);
+    let cells = |pieces: &[Estimate]| {
+        let mut at = 0;
+        per_cell
+            .iter()
+            .map(|&n| {
+                let mut sum = Estimate::default();
+                for e in &pieces[at..at + n] {
+                    sum.value += e.value;
+                    sum.error_bound += e.error_bound;
+                    sum.evaluations += e.evaluations;
+                }
+                at += n;
+                sum
+            })
+            .collect::<Vec<Estimate>>()
+    };
+    let result = crate::oracle::cubature::global::integrate_global_until(
+        &f,
+        &rectangles,
+        target,
+        budget,
+        &|pieces| enough(&Expected::of_cells(&cells(pieces))),
+    );
+    let mut e = Expected::of_cells(&cells(&result.estimates));
     e.evaluations = result.evaluations;
     (e, result.converged)
 }

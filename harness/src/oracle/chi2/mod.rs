@@ -40,8 +40,8 @@ mod judge;
 
 pub use binning::{observe, observe_batch, observe_blocks, Observed, CHUNK};
 pub use expected::{
-    expected_mass, expected_mass_global, expected_mass_in, expected_mass_in_batch,
-    expected_mass_to, Expected,
+    expected_mass, expected_mass_global, expected_mass_global_until, expected_mass_in,
+    expected_mass_in_batch, expected_mass_to, Expected,
 };
 
 use crate::oracle::domain::{DomainError, HemisphereGrid};

@@ -55,6 +55,19 @@ pub fn integrate_global(
     target: f64,
     budget: u64,
 ) -> GlobalResult {
+    integrate_global_until(f, rectangles, target, budget, &|_| false)
+}
+
+/// [`integrate_global`] that also stops, converged, after the first round whose per-rectangle
+/// estimates satisfy `enough` (a caller's own accuracy criterion, checked before each round;
+/// `target` stays the floor below which no piece is refined).
+pub fn integrate_global_until(
+    f: &BatchFn2<'_>,
+    rectangles: &[([f64; 2], [f64; 2])],
+    target: f64,
+    budget: u64,
+    enough: &dyn Fn(&[Estimate]) -> bool,
+) -> GlobalResult {
     let mut owners: Vec<usize> = (0..rectangles.len()).collect();
     let mut leaves: Vec<Node> = rectangles.iter().map(|&(x, y)| node(x, y, 0)).collect();
     evaluate(f, &mut leaves);
@@ -62,7 +75,7 @@ pub fn integrate_global(
     let mut converged;
     loop {
         let total: f64 = leaves.iter().map(|n| n.error).sum();
-        converged = total <= target;
+        converged = total <= target || enough(&per_rectangle(rectangles.len(), &leaves, &owners));
         if converged || evaluations >= budget || !total.is_finite() {
             break;
         }
@@ -109,11 +122,9 @@ pub fn integrate_global(
         leaves = next;
         owners = next_owners;
     }
-    let mut estimates = vec![Estimate::default(); rectangles.len()];
+    let mut estimates = per_rectangle(rectangles.len(), &leaves, &owners);
     let mut count = vec![0u64; rectangles.len()];
-    for (n, &o) in leaves.iter().zip(&owners) {
-        estimates[o].value += n.value;
-        estimates[o].error_bound += n.error;
+    for &o in &owners {
         count[o] += 1;
     }
     // Evaluations are shared out among the rectangles by their final pieces (the interior
@@ -127,6 +138,16 @@ pub fn integrate_global(
         converged,
         evaluations,
     }
+}
+
+/// The sums of the leaves' values and error estimates per rectangle (evaluations 0).
+fn per_rectangle(rectangles: usize, leaves: &[Node], owners: &[usize]) -> Vec<Estimate> {
+    let mut estimates = vec![Estimate::default(); rectangles];
+    for (n, &o) in leaves.iter().zip(owners) {
+        estimates[o].value += n.value;
+        estimates[o].error_bound += n.error;
+    }
+    estimates
 }
 
 #[cfg(test)]
@@ -154,6 +175,29 @@ mod tests {
         assert!(!r.converged);
         assert!((e.value - truth).abs() <= e.error_bound, "{e:?}");
         assert!(r.evaluations <= 100_000 + 4 * 225);
+    }
+
+    #[test]
+    fn a_caller_criterion_stops_the_refinement_early() {
+        let f = |p: &[[f64; 2]], out: &mut [f64]| {
+            for (o, &[x, y]) in out.iter_mut().zip(p) {
+                *o = f64::from(u8::from(x * x + y * y < 0.5));
+            }
+        };
+        let rect = [([0.0, 1.0], [0.0, 1.0])];
+        let full = integrate_global(&f, &rect, 1e-9, 20_000_000);
+        let early =
+            integrate_global_until(&f, &rect, 1e-9, 20_000_000, &|e| e[0].error_bound <= 1e-5);
+        assert!(early.converged);
+        let e = early.estimates[0];
+        assert!(e.error_bound <= 1e-5 && e.error_bound > 1e-9, "{e:?}");
+        assert!((e.value - std::f64::consts::PI / 8.0).abs() <= e.error_bound);
+        assert!(
+            early.evaluations * 4 < full.evaluations,
+            "{} vs {}",
+            early.evaluations,
+            full.evaluations
+        );
     }
 
     #[test]
