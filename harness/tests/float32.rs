@@ -192,6 +192,51 @@ fn a_float32_ggx_declared_f32_passes_the_ci_profile() {
     );
     assert!(report.passed(), "{:#?}", failing(&report));
     assert!(report.records.iter().all(|r| r.precision == Precision::F32));
+    // The oracles that integrate the model's values stopped at its rounding floor, and the
+    // records say so (issue 27: "integrand noise 1e-7 relative, bound …").
+    for check in [
+        "normalization.projected_area",
+        "smith.lambda_route",
+        "smith.white_furnace",
+        "smith.g1_g2",
+        "sampling.chi2",
+        "sampling.ks_marginals",
+    ] {
+        let records: Vec<_> = report.records.iter().filter(|r| r.check == check).collect();
+        assert!(!records.is_empty(), "no {check} record");
+        for r in records {
+            let oracle = r
+                .oracle
+                .unwrap_or_else(|| panic!("{check}: no oracle: {r:?}"));
+            let floor = oracle
+                .noise_floor
+                .unwrap_or_else(|| panic!("{check}: no noise floor: {r:?}"));
+            assert_eq!(floor.noise, f64::from(f32::EPSILON), "{check}");
+            assert!(floor.floor >= 16.0 * floor.noise, "{check}: {floor:?}");
+            let note = oracle.noise_note().unwrap();
+            assert!(note.contains("integrand noise 1.2e-7 relative"), "{note}");
+            let json = serde_json::to_value(r).unwrap();
+            assert!(json["oracle"]["noise_floor"]["floor"].is_number(), "{json}");
+            let back: mfh_harness::record::CheckRecord = serde_json::from_value(json).unwrap();
+            assert_eq!(back.oracle.unwrap().noise_floor, Some(floor));
+        }
+    }
+}
+
+#[test]
+fn an_f64_model_claims_no_noise_floor() {
+    let m = mfh_reference::ndf::Ggx::new(0.3, 0.3).unwrap();
+    let report = Audit::of(&m).profile(Profile::Ci).run();
+    assert!(report.passed(), "{:#?}", failing(&report));
+    assert!(report.records.iter().any(|r| r.oracle.is_some()));
+    for r in &report.records {
+        assert!(
+            r.oracle.and_then(|o| o.noise_floor).is_none(),
+            "an f64 record claims a rounding floor: {r:?}"
+        );
+        let json = serde_json::to_value(r).unwrap();
+        assert!(json["oracle"].get("noise_floor").is_none(), "{json}");
+    }
 }
 
 #[test]
@@ -350,3 +395,4 @@ fn a_piecewise_constant_d_finishes_with_failures() {
     eprintln!("{:#?}", failing(&report));
     assert_bounded_failure(&report);
 }
+
