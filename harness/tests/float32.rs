@@ -396,3 +396,52 @@ fn a_piecewise_constant_d_finishes_with_failures() {
     assert_bounded_failure(&report);
 }
 
+/// GGX (f64) whose pdf_wm oscillates: D(m)(m·n)·(1 + ½ sin(10⁴(7.3x + 3.1y))), with GGX's own
+/// D and sampler, so that only the pdf's oracles meet the oscillation.
+struct OscillatingPdf(mfh_reference::ndf::Ggx);
+
+impl Ndf for OscillatingPdf {
+    fn d(&self, m: Vec3) -> f64 {
+        self.0.d(m)
+    }
+    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+        Some(self)
+    }
+}
+impl NormalSampler for OscillatingPdf {
+    fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
+        self.0.sample_wm(u)
+    }
+    fn pdf_wm(&self, m: Vec3) -> f64 {
+        self.0.pdf_wm(m) * (1.0 + 0.5 * (1e4 * (7.3 * m[0] + 3.1 * m[1])).sin())
+    }
+}
+
+/// A chi-square whose expected-mass cubature runs out of rectangles is an `error` naming the
+/// budget, with the bound it reached against its target — never a pass on masses that missed
+/// their bound (issue 27).
+#[test]
+fn a_chi2_cubature_out_of_rectangles_is_an_error_naming_its_budget() {
+    let m = OscillatingPdf(mfh_reference::ndf::Ggx::new(0.3, 0.3).unwrap());
+    let report = Audit::of(&m).profile(Profile::Ci).run();
+    let r = report
+        .records
+        .iter()
+        .find(|r| r.check == "sampling.chi2")
+        .expect("a sampling.chi2 record");
+    eprintln!("{:?} in {:.1} s", r.verdict, report.summary.wall_seconds);
+    let Verdict::Error { message } = &r.verdict else {
+        panic!("{r:?}");
+    };
+    let budget = format!(
+        "(budget oracle::cubature::MAX_RECTANGLES = {})",
+        mfh_harness::oracle::cubature::MAX_RECTANGLES
+    );
+    assert!(
+        message.starts_with("expected-mass cubature stopped at "),
+        "{message}"
+    );
+    assert!(message.contains(&budget), "{message}");
+    assert!(message.contains(" > target "), "{message}");
+    assert!(!report.passed());
+}

@@ -242,6 +242,12 @@ fn fill_chi2(
         });
     }
     match &result.reason {
+        // The oracle out of budget: an error naming it, never a pass nor a model's failure.
+        Some(reason @ crate::oracle::chi2::Failure::CubatureBudget { .. }) => {
+            r.verdict = Verdict::Error {
+                message: reason.to_string(),
+            };
+        }
         Some(reason) if !matches!(reason, crate::oracle::chi2::Failure::Rejected { .. }) => {
             r.verdict = Verdict::Fail;
             if let Value::Object(case) = &mut r.case {
