@@ -77,6 +77,53 @@ pub struct OracleValue {
     /// What the uncertainty is: `error_bound` or `standard_error`.
     #[serde(deserialize_with = "interned")]
     pub kind: crate::record_serde::StaticStr,
+    /// The rounding floor the oracle stopped at, where the implementation's declared precision
+    /// set it above the accuracy the oracle was asked for (a float32 model): its uncertainty is
+    /// then what that floor allows, not what the target asked. Absent for an f64 model and in
+    /// reports written before it (issue 27).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise_floor: Option<NoiseFloor>,
+}
+
+/// The rounding floor an oracle integrating an implementation's values stopped at: below it
+/// refinement only trades one rounding error for another (ARCHITECTURE.md, "Tolerances and
+/// expected failures").
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NoiseFloor {
+    /// The relative rounding of one evaluation of the integrand (the declared precision's ε).
+    #[serde(deserialize_with = "nullable_f64")]
+    pub noise: f64,
+    /// The relative error the oracle's stopping rule accepts because of it, at least the
+    /// accuracy asked: 32 ε of ∫|f| for the adaptive quadratures, 64 ε per cell for the
+    /// chi-square masses, 16 ε per span for the KS table.
+    #[serde(deserialize_with = "nullable_f64")]
+    pub floor: f64,
+}
+
+impl OracleValue {
+    /// The oracle's bound relative to its value (absolute where the value is 0).
+    pub fn relative_uncertainty(&self) -> f64 {
+        if self.value == 0.0 {
+            self.uncertainty
+        } else {
+            self.uncertainty / self.value.abs()
+        }
+    }
+
+    /// One line on the rounding floor the oracle stopped at, if it did: "oracle stopped at the
+    /// implementation's rounding floor: integrand noise 1.2e-7 relative, floor 3.8e-6, bound
+    /// 2.1e-7".
+    pub fn noise_note(&self) -> Option<String> {
+        self.noise_floor.map(|n| {
+            format!(
+                "oracle stopped at the implementation's rounding floor: integrand noise {:.1e} \
+                 relative, floor {:.1e}, bound {:.1e}",
+                n.noise,
+                n.floor,
+                self.relative_uncertainty()
+            )
+        })
+    }
 }
 
 /// The measured discrepancy.
@@ -376,6 +423,7 @@ mod tests {
             value: 2.0,
             uncertainty: bound,
             kind: "error_bound",
+            noise_floor: None,
         });
         r.measured = Some(Measured::Relative { error });
         r.tolerance = Some(AppliedTolerance {

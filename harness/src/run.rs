@@ -292,6 +292,9 @@ pub fn failure_table(report: &AuditReport) -> String {
                 o.value, o.uncertainty
             );
         }
+        if let Some(note) = r.oracle.and_then(|o| o.noise_note()) {
+            let _ = writeln!(out, "    oracle    {note}");
+        }
         match (r.measured, &r.tolerance) {
             (Some(m), Some(t)) => {
                 let measured = match m {

@@ -192,6 +192,51 @@ fn a_float32_ggx_declared_f32_passes_the_ci_profile() {
     );
     assert!(report.passed(), "{:#?}", failing(&report));
     assert!(report.records.iter().all(|r| r.precision == Precision::F32));
+    // The oracles that integrate the model's values stopped at its rounding floor, and the
+    // records say so (issue 27: "integrand noise 1e-7 relative, bound …").
+    for check in [
+        "normalization.projected_area",
+        "smith.lambda_route",
+        "smith.white_furnace",
+        "smith.g1_g2",
+        "sampling.chi2",
+        "sampling.ks_marginals",
+    ] {
+        let records: Vec<_> = report.records.iter().filter(|r| r.check == check).collect();
+        assert!(!records.is_empty(), "no {check} record");
+        for r in records {
+            let oracle = r
+                .oracle
+                .unwrap_or_else(|| panic!("{check}: no oracle: {r:?}"));
+            let floor = oracle
+                .noise_floor
+                .unwrap_or_else(|| panic!("{check}: no noise floor: {r:?}"));
+            assert_eq!(floor.noise, f64::from(f32::EPSILON), "{check}");
+            assert!(floor.floor >= 16.0 * floor.noise, "{check}: {floor:?}");
+            let note = oracle.noise_note().unwrap();
+            assert!(note.contains("integrand noise 1.2e-7 relative"), "{note}");
+            let json = serde_json::to_value(r).unwrap();
+            assert!(json["oracle"]["noise_floor"]["floor"].is_number(), "{json}");
+            let back: mfh_harness::record::CheckRecord = serde_json::from_value(json).unwrap();
+            assert_eq!(back.oracle.unwrap().noise_floor, Some(floor));
+        }
+    }
+}
+
+#[test]
+fn an_f64_model_claims_no_noise_floor() {
+    let m = mfh_reference::ndf::Ggx::new(0.3, 0.3).unwrap();
+    let report = Audit::of(&m).profile(Profile::Ci).run();
+    assert!(report.passed(), "{:#?}", failing(&report));
+    assert!(report.records.iter().any(|r| r.oracle.is_some()));
+    for r in &report.records {
+        assert!(
+            r.oracle.and_then(|o| o.noise_floor).is_none(),
+            "an f64 record claims a rounding floor: {r:?}"
+        );
+        let json = serde_json::to_value(r).unwrap();
+        assert!(json["oracle"].get("noise_floor").is_none(), "{json}");
+    }
 }
 
 #[test]
@@ -357,4 +402,54 @@ fn a_piecewise_constant_d_finishes_with_failures() {
     let report = Audit::of(&m).profile(Profile::Quick).run();
     eprintln!("{:#?}", failing(&report));
     assert_bounded_failure(&report);
+}
+
+/// GGX (f64) whose pdf_wm oscillates: D(m)(m·n)·(1 + ½ sin(10⁴(7.3x + 3.1y))), with GGX's own
+/// D and sampler, so that only the pdf's oracles meet the oscillation.
+struct OscillatingPdf(mfh_reference::ndf::Ggx);
+
+impl Ndf for OscillatingPdf {
+    fn d(&self, m: Vec3) -> f64 {
+        self.0.d(m)
+    }
+    fn as_sampler(&self) -> Option<&dyn NormalSampler> {
+        Some(self)
+    }
+}
+impl NormalSampler for OscillatingPdf {
+    fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
+        self.0.sample_wm(u)
+    }
+    fn pdf_wm(&self, m: Vec3) -> f64 {
+        self.0.pdf_wm(m) * (1.0 + 0.5 * (1e4 * (7.3 * m[0] + 3.1 * m[1])).sin())
+    }
+}
+
+/// A chi-square whose expected-mass cubature runs out of rectangles is an `error` naming the
+/// budget, with the bound it reached against its target — never a pass on masses that missed
+/// their bound (issue 27).
+#[test]
+fn a_chi2_cubature_out_of_rectangles_is_an_error_naming_its_budget() {
+    let m = OscillatingPdf(mfh_reference::ndf::Ggx::new(0.3, 0.3).unwrap());
+    let report = Audit::of(&m).profile(Profile::Ci).run();
+    let r = report
+        .records
+        .iter()
+        .find(|r| r.check == "sampling.chi2")
+        .expect("a sampling.chi2 record");
+    eprintln!("{:?} in {:.1} s", r.verdict, report.summary.wall_seconds);
+    let Verdict::Error { message } = &r.verdict else {
+        panic!("{r:?}");
+    };
+    let budget = format!(
+        "(budget oracle::cubature::MAX_RECTANGLES = {})",
+        mfh_harness::oracle::cubature::MAX_RECTANGLES
+    );
+    assert!(
+        message.starts_with("expected-mass cubature stopped at "),
+        "{message}"
+    );
+    assert!(message.contains(&budget), "{message}");
+    assert!(message.contains(" > target "), "{message}");
+    assert!(!report.passed());
 }

@@ -94,6 +94,7 @@ fn judge(r: &mut CheckRecord, value: &VisibleMoments, o: &Oracle) {
         value: o.values[i],
         uncertainty: o.bounds[i],
         kind: "error_bound",
+        noise_floor: None,
     });
     r.cost.evaluations += o.evaluations;
     r.measured = Some(Measured::Relative { error: err });

@@ -158,6 +158,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> PlannedCheck<'a> {
             value: j.pdf_and_density.1,
             uncertainty: 0.0,
             kind: "error_bound",
+            noise_floor: None,
         });
         r.measured = Some(Measured::Relative { error: j.worst });
         r.tolerance = Some(applied(&tolerance));

@@ -203,12 +203,27 @@ impl std::fmt::Debug for PlannedCheck<'_> {
 /// is an error ("oracle could not resolve"). A discrepancy beyond the tolerance plus the
 /// whole bound is still a failure: no value within the oracle's bound could meet it.
 pub fn compare(record: &mut CheckRecord, value: f64, oracle: Estimate, tolerance: &Tolerance) {
+    compare_at(record, value, oracle, tolerance, None);
+}
+
+/// [`compare`] against an oracle that stopped at the implementation's rounding floor
+/// (`Accuracy::noise_floor`, `Some` for a float32 model): the record's oracle says so, and so
+/// does the message of an oracle too uncertain to judge it.
+pub fn compare_at(
+    record: &mut CheckRecord,
+    value: f64,
+    oracle: Estimate,
+    tolerance: &Tolerance,
+    noise_floor: Option<crate::record::NoiseFloor>,
+) {
     record.value = Some(value);
-    record.oracle = Some(OracleValue {
+    let stated = OracleValue {
         value: oracle.value,
         uncertainty: oracle.error_bound,
         kind: "error_bound",
-    });
+        noise_floor,
+    };
+    record.oracle = Some(stated);
     record.cost.evaluations += oracle.evaluations;
     let error = relative_error(value, oracle.value);
     let bound = oracle_relative_bound(&oracle);
@@ -240,6 +255,10 @@ pub fn compare(record: &mut CheckRecord, value: f64, oracle: Estimate, tolerance
     } else {
         Verdict::Pass
     };
+    if let (Verdict::Error { message }, Some(note)) = (&mut record.verdict, stated.noise_note()) {
+        message.push_str("; ");
+        message.push_str(&note);
+    }
 }
 
 /// The oracle's error bound relative to its value (absolute where the value is 0); NaN where

@@ -146,6 +146,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> 
                                 value: far.value,
                                 uncertainty: far.error_bound,
                                 kind: "error_bound",
+                                noise_floor: None,
                             });
                             // The growth is evidence of divergence, not an error: it
                             // stays out of the worst-error summaries.

@@ -1,6 +1,6 @@
 //! Normalization: ∫ D(m)(m·n) dm = 1 over the hemisphere, by nested adaptive quadrature.
 
-use super::{compare, covers, PlannedCheck};
+use super::{compare_at, covers, PlannedCheck};
 use crate::check::Check;
 use crate::oracle::quadrature::{integrate_hemisphere_lobe_batch, Accuracy, Cuts};
 use crate::oracle::Estimate;
@@ -43,11 +43,12 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> 
         // The value under test is the quadrature of the closed form, so the
         // quadrature's error bound is the slack `compare` grants (reported as the
         // oracle's uncertainty).
-        compare(
+        compare_at(
             r,
             e.value,
             Estimate { value: 1.0, ..e },
             &NORMALIZATION.at(s.precision),
+            Accuracy::relative(1e-11).at(s.precision).noise_floor(),
         );
         Ok(())
     })]

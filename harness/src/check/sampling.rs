@@ -24,7 +24,7 @@ use crate::oracle::chi2::{chi2_test_batches_cut, BatchPdf, BatchSampler, Chi2Con
 use crate::oracle::ks::Marginal;
 use crate::oracle::monte_carlo::{estimate_batch, two_sided_p};
 use crate::precision::Precision;
-use crate::record::{CheckRecord, Measured, OracleValue, Verdict};
+use crate::record::{CheckRecord, Measured, NoiseFloor, OracleValue, Verdict};
 use crate::subject::Subject;
 use crate::tolerance::{
     cell_relative_tolerance, CELL_ABSOLUTE_TOLERANCE, CELL_RELATIVE_TOLERANCE,
@@ -80,7 +80,8 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                         Some(m.lobe()),
                         &kinks,
                     );
-                    fill_chi2(r, &result, ctx, samples);
+                    let floor = cell_noise_floor(CELL_RELATIVE_TOLERANCE, m.precision);
+                    fill_chi2(r, &result, ctx, samples, floor);
                     Ok(())
                 }),
         );
@@ -183,6 +184,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
                     value: e.mean,
                     uncertainty: e.standard_error,
                     kind: "standard_error",
+                    noise_floor: None,
                 });
                 r.cost.samples = mc_samples;
                 let z = (value - e.mean) / e.standard_error;
@@ -217,16 +219,35 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, profile: Profile, why: &str) -> Vec<
 /// provisionally judged at the unshared α (the audit re-decides with the Šidák level). The
 /// observed and expected tables go into the record's data (no I/O here: the sinks write them
 /// and their heat maps into `out/chi2/<model and case>/`).
+///
+/// Where the cell tolerance was raised to the implementation's rounding floor (`floor`, a
+/// float32 pdf), the record's oracle is the expected masses — their total and summed error
+/// bound — with that floor.
 fn fill_chi2(
     r: &mut CheckRecord,
     result: &crate::oracle::chi2::Chi2Result,
     _ctx: &super::RunContext,
     samples: u64,
+    floor: Option<NoiseFloor>,
 ) {
     r.cost.samples = samples;
     r.tolerance = Some(applied(&STATISTICAL_ALPHA));
     r.data = Some(chi2_table(result));
+    if floor.is_some() {
+        r.oracle = Some(OracleValue {
+            value: result.expected_mass,
+            uncertainty: result.expected_error_bound / result.samples.max(1) as f64,
+            kind: "error_bound",
+            noise_floor: floor,
+        });
+    }
     match &result.reason {
+        // The oracle out of budget: an error naming it, never a pass nor a model's failure.
+        Some(reason @ crate::oracle::chi2::Failure::CubatureBudget { .. }) => {
+            r.verdict = Verdict::Error {
+                message: reason.to_string(),
+            };
+        }
         Some(reason) if !matches!(reason, crate::oracle::chi2::Failure::Rejected { .. }) => {
             r.verdict = Verdict::Fail;
             if let Value::Object(case) = &mut r.case {
@@ -247,6 +268,16 @@ fn fill_chi2(
             };
         }
     }
+}
+
+/// The rounding floor of the chi-square cell masses of a pdf computed in `precision`, where it
+/// raises the per-cell relative tolerance `asked` (`cell_relative_tolerance`: 64 ε per cell).
+fn cell_noise_floor(asked: f64, precision: Precision) -> Option<NoiseFloor> {
+    let floor = cell_relative_tolerance(asked, precision);
+    (floor > asked).then_some(NoiseFloor {
+        noise: precision.epsilon(),
+        floor,
+    })
 }
 
 /// The observed and expected counts of a chi-square test as a record's table (what the sinks
@@ -292,7 +323,8 @@ fn chi2_kinked(
         absolute,
     );
     let result = chi2_test_batches_cut(sample, pdf, &config, tolerance, None, &[]);
-    fill_chi2(r, &result, ctx, samples);
+    let floor = cell_noise_floor(KINKED_CELL_RELATIVE_TOLERANCE, precision);
+    fill_chi2(r, &result, ctx, samples, floor);
 }
 
 /// A skipped record for a check the scene calls for but the model cannot support.

@@ -2,10 +2,10 @@
 //! slope-space models, ∫⟨−w·m⟩⁺D(m)dm otherwise), the weak white furnace ∫G1(w,m)⟨w·m⟩⁺D(m)dm = cos θ, and the
 //! identities Λ(−w) = −1 − Λ(w), 0 ≤ G1 ≤ 1, G2 ≤ min G1.
 
-use super::{apply_expected, compare, compare_exact, covers, PlannedCheck, Profile};
+use super::{apply_expected, compare_at, compare_exact, covers, PlannedCheck, Profile};
 use crate::check::{need, Check};
 use crate::oracle::quadrature::{integrate_hemisphere_polar_batch, Accuracy, Cuts};
-use crate::oracle::smith_lambda::lambda_oracle;
+use crate::oracle::smith_lambda::{lambda_oracle, lambda_oracle_noise_floor};
 use crate::oracle::Estimate;
 use crate::precision::Precision;
 use crate::record::Verdict;
@@ -177,7 +177,13 @@ pub fn plan_lambda_routes<'a>(
                         CLOSED_FORM
                     };
                     if m.precision == Precision::F64 {
-                        compare(r, value, oracle, &tol);
+                        compare_at(
+                            r,
+                            value,
+                            oracle,
+                            &tol,
+                            lambda_oracle_noise_floor(m.precision),
+                        );
                     } else {
                         // Λ enters every use as 1 + Λ (G1 = 1/(1 + Λ), G2 = 1/(1 + Λo + Λi)):
                         // a float32 Λ is judged there, where its rounding is ~ε(1 + Λ) (Λ
@@ -187,7 +193,13 @@ pub fn plan_lambda_routes<'a>(
                             value: 1.0 + e.value,
                             ..e
                         };
-                        compare(r, 1.0 + value, shift(oracle), &tol.at(m.precision));
+                        compare_at(
+                            r,
+                            1.0 + value,
+                            shift(oracle),
+                            &tol.at(m.precision),
+                            lambda_oracle_noise_floor(m.precision),
+                        );
                         r.case["judged"] = json!("1 + Λ");
                     }
                     apply_expected(r, family, route);
@@ -275,11 +287,12 @@ pub fn plan_white_furnace<'a>(
                 let q_bar = mean_slope(&m, 0.4);
                 // The closed form enters through G1; the integral is the value under test and
                 // its quadrature error bound is the slack `compare` grants.
-                compare(
+                compare_at(
                     r,
                     e.value + g1 * theta.sin() * q_bar,
                     Estimate { value: w[2], ..e },
                     &default_tolerance(&m),
+                    projected_area_accuracy(&m).noise_floor(),
                 );
                 Ok(())
             }),
@@ -346,8 +359,13 @@ fn projected_area(m: &Subject, w: Vec3, g1: f64) -> Estimate {
             theta: &theta_cut,
             phi: &phis,
         }),
-        Accuracy::relative(1e-11).at(m.precision),
+        projected_area_accuracy(m),
     )
+}
+
+/// The accuracy of [`projected_area`]'s quadrature.
+fn projected_area_accuracy(m: &Subject) -> Accuracy {
+    Accuracy::relative(1e-11).at(m.precision)
 }
 
 /// `smith.g1_g2`: G1 and both G2 forms through the methods a renderer calls, against
@@ -415,7 +433,7 @@ pub fn plan_g1_g2<'a>(
                             )
                         }
                     };
-                    compare(
+                    compare_at(
                         r,
                         value,
                         Estimate {
@@ -424,6 +442,7 @@ pub fn plan_g1_g2<'a>(
                             evaluations: lo.evaluations + li.evaluations,
                         },
                         &default_tolerance(&m),
+                        lambda_oracle_noise_floor(m.precision),
                     );
                     Ok(())
                 }),

@@ -215,6 +215,28 @@ pub fn integrate_rectangles_batch(
     f: &BatchFn2<'_>,
     rectangles: &[([f64; 2], [f64; 2], Tolerance)],
 ) -> Vec<Estimate> {
+    integrate_rectangles_batch_budgeted(f, rectangles).0
+}
+
+/// A bisection that [`MAX_RECTANGLES`] stopped: some rectangle above its tolerance (and
+/// above [`MAX_DEPTH`]) was left unrefined, so the estimates' summed `bound` may exceed the
+/// summed `target` the caller asked for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BudgetHit {
+    /// The rectangles bisection created (≥ [`MAX_RECTANGLES`] − 4).
+    pub rectangles: usize,
+    /// The summed error bound of the estimates.
+    pub bound: f64,
+    /// The summed tolerance of the input rectangles (each max(absolute, relative × |first
+    /// estimate|)).
+    pub target: f64,
+}
+
+/// [`integrate_rectangles_batch`], and whether [`MAX_RECTANGLES`] stopped the bisection.
+pub fn integrate_rectangles_batch_budgeted(
+    f: &BatchFn2<'_>,
+    rectangles: &[([f64; 2], [f64; 2], Tolerance)],
+) -> (Vec<Estimate>, Option<BudgetHit>) {
     let mut nodes: Vec<Node> = rectangles
         .iter()
         .map(|&(x, y, _)| Node {
@@ -231,13 +253,19 @@ pub fn integrate_rectangles_batch(
     for (n, (_, _, t)) in nodes.iter_mut().zip(rectangles) {
         n.tolerance = t.absolute.max(t.relative * n.value.abs());
     }
+    let target: f64 = nodes.iter().map(|n| n.tolerance).sum();
     let mut level = 0..nodes.len();
     let budget = rectangles.len() + MAX_RECTANGLES;
+    let mut denied = false;
     while !level.is_empty() {
         let start = nodes.len();
         for i in level.clone() {
             let n = &nodes[i];
-            if !(n.error > n.tolerance) || n.depth >= MAX_DEPTH || nodes.len() + 4 > budget {
+            if !(n.error > n.tolerance) || n.depth >= MAX_DEPTH {
+                continue;
+            }
+            if nodes.len() + 4 > budget {
+                denied = true;
                 continue;
             }
             let (x, y, tolerance, depth) = (n.x, n.y, 0.25 * n.tolerance, n.depth + 1);
@@ -289,7 +317,12 @@ pub fn integrate_rectangles_batch(
     for s in &mut sums {
         s.evaluations += 225;
     }
-    sums
+    let hit = denied.then(|| BudgetHit {
+        rectangles: nodes.len() - rectangles.len(),
+        bound: sums.iter().map(|s| s.error_bound).sum(),
+        target,
+    });
+    (sums, hit)
 }
 
 #[cfg(test)]

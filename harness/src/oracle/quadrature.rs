@@ -94,6 +94,17 @@ impl Accuracy {
     pub fn floor(&self) -> f64 {
         ROUNDOFF * self.noise
     }
+
+    /// The rounding floor for the record (`OracleValue::noise_floor`) where it is above the
+    /// relative target, so that the oracle stops at it rather than at the target (an
+    /// integrand in float32: 32 ε₃₂ = 3.8e-6 against targets of 1e-11); `None` where the
+    /// target rules (every f64 integrand: its floor, 7e-15, is below every target asked).
+    pub fn noise_floor(&self) -> Option<crate::record::NoiseFloor> {
+        (self.floor() > self.relative).then_some(crate::record::NoiseFloor {
+            noise: self.noise,
+            floor: self.floor(),
+        })
+    }
 }
 
 /// ∫_a^b f over the pieces between consecutive `points` (sorted; the end points included), so

@@ -49,6 +49,16 @@ pub fn lambda_oracle(subject: &dyn LambdaSubject, w: Vec3) -> Estimate {
     lambda_oracle_to(subject, w, LAMBDA_ORACLE_RELATIVE)
 }
 
+/// The rounding floor [`lambda_oracle`] stops at for a model computed in `precision`, where it
+/// is above the accuracy asked (`Accuracy::noise_floor`): what its record says.
+pub fn lambda_oracle_noise_floor(
+    precision: crate::precision::Precision,
+) -> Option<crate::record::NoiseFloor> {
+    Accuracy::relative(LAMBDA_ORACLE_RELATIVE)
+        .at(precision)
+        .noise_floor()
+}
+
 /// The relative accuracy the Λ oracle asks of its quadrature: a hundredth of the tightest
 /// tolerance it serves (`CLOSED_FORM`, 1e-10).
 const LAMBDA_ORACLE_RELATIVE: f64 = 1e-12;

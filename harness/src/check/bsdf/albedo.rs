@@ -83,6 +83,7 @@ pub fn plan<'a>(
                     value: quad.value,
                     uncertainty: quad.error_bound,
                     kind: "error_bound",
+                    noise_floor: None,
                 });
                 r.measured = Some(Measured::PValue {
                     p,
@@ -126,6 +127,7 @@ pub fn plan<'a>(
                     value: 1.0,
                     uncertainty: quad.error_bound,
                     kind: "error_bound",
+                    noise_floor: None,
                 });
                 let excess = (quad.value - 1.0).max(0.0);
                 r.measured = Some(Measured::Absolute { error: excess });

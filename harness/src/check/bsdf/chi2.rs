@@ -60,6 +60,7 @@ pub fn plan<'a>(
                 value: result.mass(),
                 uncertainty: result.mass_error_bound(),
                 kind: "error_bound",
+                noise_floor: None,
             });
             if let Value::Object(case) = &mut r.case {
                 case.insert("pdf_mass".into(), json!(result.mass()));

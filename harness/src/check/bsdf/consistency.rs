@@ -144,6 +144,7 @@ fn judge_rate(
         value: p,
         uncertainty: mass.error_bound,
         kind: "error_bound",
+        noise_floor: None,
     });
     r.measured = Some(Measured::PValue {
         p: pv,

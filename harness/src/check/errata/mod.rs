@@ -292,6 +292,7 @@ fn decide(record: &mut CheckRecord, id: &str, description: &str, shown: &Shown) 
         value: o.value,
         uncertainty: o.error_bound,
         kind: "error_bound",
+        noise_floor: None,
     });
     record.cost.evaluations += o.evaluations;
     record.measured = Some(if o.value == 0.0 {

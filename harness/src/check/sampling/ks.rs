@@ -5,7 +5,8 @@ use super::SOURCE;
 use crate::check::Check;
 use crate::check::{applied, covers, PlannedCheck};
 use crate::oracle::ks::{self, KsConfig, Marginal};
-use crate::record::{CheckRecord, Measured, Verdict};
+use crate::precision::Precision;
+use crate::record::{CheckRecord, Measured, NoiseFloor, OracleValue, Verdict};
 use crate::subject::Subject;
 use crate::tolerance::STATISTICAL_ALPHA;
 use mfh_reference::Vec3;
@@ -56,6 +57,7 @@ pub(super) fn plan_ks<'a>(
                 model.precision,
             );
             fill_ks(r, &kept.result);
+            note_table_floor(r, &kept.result, model.precision);
             r.data = ks_marginal_data(&kept);
             Ok(())
         })
@@ -92,6 +94,24 @@ pub(super) fn ks_marginal_data(kept: &ks::KsKept) -> Option<crate::record::Recor
         samples: result.samples,
         seed: result.seed,
     })
+}
+
+/// Where the CDF table of a pdf computed in `precision` stopped at its rounding floor (16 ε
+/// per span, `SIMPSON_NOISE_FLOOR`: every precision above f64's), the record's oracle is the
+/// table — its total mass and error bound — with that floor.
+fn note_table_floor(r: &mut CheckRecord, result: &ks::KsResult, precision: Precision) {
+    if precision == Precision::F64 {
+        return;
+    }
+    r.oracle = Some(OracleValue {
+        value: result.pdf_mass,
+        uncertainty: result.table_error_bound,
+        kind: "error_bound",
+        noise_floor: Some(NoiseFloor {
+            noise: precision.epsilon(),
+            floor: ks::SIMPSON_NOISE_FLOOR * precision.epsilon(),
+        }),
+    });
 }
 
 /// Fills a `sampling.ks_marginals` record from a KS result.

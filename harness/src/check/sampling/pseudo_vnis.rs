@@ -205,6 +205,7 @@ fn pseudo_vnis_record(
         value: truth.value,
         uncertainty: truth.error_bound,
         kind: "error_bound",
+        noise_floor: None,
     });
     r.cost.samples = samples;
     r.cost.evaluations = truth.evaluations;

@@ -2,7 +2,7 @@
 //! fixed incidences and the normalization of `pdf_wm_visible` (Heitz & d'Eon 2014, Heitz 2018).
 
 use super::{chi2_kinked, skipped};
-use crate::check::{compare, covers, PlannedCheck, Profile};
+use crate::check::{compare_at, covers, PlannedCheck, Profile};
 use crate::check::{need, Check};
 use crate::oracle::quadrature::{integrate_hemisphere_batch, Accuracy, Cuts};
 use crate::subject::Subject;
@@ -120,7 +120,13 @@ pub fn plan_visible<'a>(
                     }),
                     Accuracy::relative(1e-11).at(m.precision),
                 );
-                compare(r, 1.0, e, &NORMALIZATION.at(m.precision));
+                compare_at(
+                    r,
+                    1.0,
+                    e,
+                    &NORMALIZATION.at(m.precision),
+                    Accuracy::relative(1e-11).at(m.precision).noise_floor(),
+                );
                 Ok(())
             }),
         );

@@ -144,6 +144,7 @@ pub(super) fn plan_asg(profile: Profile, why: &str, out: &mut Vec<Planned>) {
                         value: peak,
                         uncertainty: 0.0,
                         kind: "error_bound",
+                        noise_floor: None,
                     });
                     r.measured = Some(Measured::Absolute { error: err });
                     r.tolerance = Some(applied(&ASG_PRODUCT_FIT));

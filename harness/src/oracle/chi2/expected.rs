@@ -3,7 +3,9 @@
 //! per-cell error bound.
 
 use super::BatchPdf;
-use crate::oracle::cubature::{integrate_rectangle, integrate_rectangles_batch, Tolerance};
+use crate::oracle::cubature::{
+    integrate_rectangle, integrate_rectangles_batch_budgeted, BudgetHit, Tolerance,
+};
 use crate::oracle::domain::HemisphereGrid;
 use crate::oracle::lobe::{self, Lobe};
 use crate::oracle::Estimate;
@@ -26,6 +28,9 @@ pub struct Expected {
     pub cell_bound: Vec<f64>,
     /// Pdf evaluations spent.
     pub evaluations: u64,
+    /// Where the cubature's rectangle budget ([`crate::oracle::cubature::MAX_RECTANGLES`])
+    /// stopped its refinement: the bound it reached against the target asked.
+    pub budget_hit: Option<BudgetHit>,
 }
 
 impl Expected {
@@ -38,6 +43,7 @@ impl Expected {
             error_bound: estimates.iter().map(|e| e.error_bound).sum(),
             cell_bound: estimates.iter().map(|e| e.error_bound).collect(),
             evaluations: estimates.iter().map(|e| e.evaluations).sum(),
+            budget_hit: None,
         }
     }
 }
@@ -170,7 +176,7 @@ pub fn expected_mass_in_batch(
         per_cell.push(pieces);
     }
     let f = in_angles(pdf);
-    let pieces = integrate_rectangles_batch(&f, &rectangles);
+    let (pieces, budget_hit) = integrate_rectangles_batch_budgeted(&f, &rectangles);
     let mut at = 0;
     let estimates: Vec<Estimate> = per_cell
         .iter()
@@ -185,7 +191,10 @@ pub fn expected_mass_in_batch(
             sum
         })
         .collect();
-    Expected::of_cells(&estimates)
+    Expected {
+        budget_hit,
+        ..Expected::of_cells(&estimates)
+    }
 }
 
 /// A batch density over directions as a batch integrand over (φ, θ): pdf(direction) · sin θ,

@@ -36,6 +36,18 @@ pub(super) fn judge(
         phi_edges: grid.phi_edges(),
     };
     result.reason = sanity(&result, &expected, observed.outside, observed.first_outside);
+    // Masses whose cubature ran out of budget above its target judge nothing (not even a
+    // mass off or a zero-pdf cell); samples outside the domain are wrong whatever they are.
+    if let Some(hit) = expected.budget_hit.filter(|h| !(h.bound <= h.target)) {
+        if !matches!(result.reason, Some(Failure::OutsideDomain(_))) {
+            result.reason = Some(Failure::CubatureBudget {
+                rectangles: hit.rectangles,
+                budget: crate::oracle::cubature::MAX_RECTANGLES,
+                bound: hit.bound,
+                target: hit.target,
+            });
+        }
+    }
     if result.reason.is_some() {
         return result;
     }

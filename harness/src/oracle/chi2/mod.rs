@@ -129,6 +129,24 @@ pub enum Failure {
         /// Bins after pooling.
         bins: usize,
     },
+    /// The expected-mass cubature ran out of its rectangle budget
+    /// ([`crate::oracle::cubature::MAX_RECTANGLES`]) with its summed error bound above the
+    /// target: the masses cannot judge the samples (an `error` record, never a pass).
+    #[error(
+        "expected-mass cubature stopped at {rectangles} rectangles (budget \
+         oracle::cubature::MAX_RECTANGLES = {budget}) with bound {bound:.1e} > target \
+         {target:.1e} (a density that oscillates or steps faster than any cell)"
+    )]
+    CubatureBudget {
+        /// The rectangles the bisection created.
+        rectangles: usize,
+        /// The budget.
+        budget: usize,
+        /// The masses' summed error bound.
+        bound: f64,
+        /// The summed target.
+        target: f64,
+    },
     /// The distribution of samples differs from the pdf.
     #[error("p-value {p_value:.3e} below α = {alpha:.3e}")]
     Rejected {
