@@ -154,7 +154,7 @@ fn chi2_maps(r: &CheckRecord) -> Result<String, PlotError> {
     Ok(h)
 }
 
-/// The albedo records' points: (θi in degrees, cos θi, the record).
+/// The albedo records' points: (θi in degrees, cos θi, the record), from outside first.
 fn albedo_points<'r>(albedo: &[&'r CheckRecord]) -> Vec<(f64, f64, &'r CheckRecord)> {
     let mut points: Vec<(f64, f64, &CheckRecord)> = albedo
         .iter()
@@ -163,7 +163,8 @@ fn albedo_points<'r>(albedo: &[&'r CheckRecord]) -> Vec<(f64, f64, &'r CheckReco
             Some((c.abs().min(1.0).acos().to_degrees(), c, *r))
         })
         .collect();
-    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // From outside first, then from inside; by θi within each.
+    points.sort_by(|a, b| (a.1 < 0.0).cmp(&(b.1 < 0.0)).then(a.0.total_cmp(&b.0)));
     points
 }
 
