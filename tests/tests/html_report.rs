@@ -358,3 +358,158 @@ fn an_unwritable_out_exits_2_and_a_failing_sink_keeps_report_json() {
     assert!(report["records"].as_array().unwrap().len() > 5);
     assert!(out.join("junit.xml").is_file());
 }
+
+/// A number as report.html's tables write it (`report::page::fmt_num`).
+fn fmt_num(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else if !x.is_finite() {
+        format!("{x}")
+    } else if x.abs() >= 1e4 || x.abs() < 1e-3 {
+        format!("{x:.3e}")
+    } else {
+        format!("{x:.6}")
+    }
+}
+
+/// Issue 25: the BSDF section of a dielectric's audit — both hemispheres' observed / expected /
+/// residual maps at each of the five incidences, the albedo plot, and the albedo, consistency
+/// and reciprocity tables holding the records' numbers (read back from report.json).
+#[test]
+fn the_report_html_has_a_bsdf_section() {
+    let dir = out_folder().join("bsdf");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("scene.json");
+    std::fs::write(
+        &scene,
+        r#"{"name": "bsdf section", "materials": [{"name": "glass", "bsdf": {"type":
+            "dielectric", "eta": 1.5, "ndf": {"family": "ggx", "alpha": 0.3}}}]}"#,
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let _ = std::fs::remove_dir_all(&out);
+    let (code, stdout, stderr) = mfh(&[
+        "audit",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--seed",
+        "5",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("<a href=#bsdf>BSDFs</a>"));
+    let start = html.find("<h2 id=bsdf>").expect("a BSDF section");
+    let section = &html[start..start + html[start..].find("<h2 id=limits>").unwrap()];
+    assert!(
+        section.contains("<h3 id=bsdf-0>dielectric eta=1.5"),
+        "{}",
+        &section[..400]
+    );
+    // The BSDF's records are in its section, not under the materials.
+    let materials = &html[html.find("<h2 id=materials>").unwrap()..start];
+    assert!(!materials.contains("bsdf."), "{materials}");
+    // Maps: reflection and transmission × observed, expected, residual at every incidence.
+    let alts = image_alts(section);
+    for incidence in [
+        "normal",
+        "oblique",
+        "grazing",
+        "inside",
+        "total internal reflection",
+    ] {
+        for side in ["reflection", "transmission"] {
+            for map in ["observed", "expected", "difference"] {
+                let alt = format!("bsdf.chi2 {incidence} {side} chi2_{map}.svg");
+                assert!(alts.contains(&alt.as_str()), "no {alt} in {alts:?}");
+            }
+        }
+    }
+    assert!(alts.contains(&"bsdf.albedo against incidence"), "{alts:?}");
+    assert_eq!(alts.len(), 5 * 2 * 3 + 1, "{alts:?}");
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let records = report["records"].as_array().unwrap();
+    let of = |check: &str| -> Vec<&Value> {
+        records
+            .iter()
+            .filter(|r| r["check"] == check && r["case"]["variant"].is_null())
+            .collect()
+    };
+    let num = |v: &Value| fmt_num(v.as_f64().unwrap_or_else(|| panic!("not a number: {v}")));
+    let has = |text: String| assert!(section.contains(&text), "the section lacks {text:?}");
+    // Albedo: quadrature ± bound, mean weight ± standard error, and both parts.
+    let albedo = of("bsdf.albedo");
+    assert_eq!(albedo.len(), 5);
+    for r in &albedo {
+        has(format!(
+            "{} ± {}",
+            num(&r["oracle"]["value"]),
+            num(&r["oracle"]["uncertainty"])
+        ));
+        has(format!(
+            "{} ± {}",
+            num(&r["value"]),
+            num(&r["case"]["standard_error"])
+        ));
+        for part in ["reflection", "transmission"] {
+            let p = &r["case"][part];
+            has(format!(
+                "{} ± {} / {} ± {}",
+                num(&p["albedo"]),
+                num(&p["error_bound"]),
+                num(&p["mean_weight"]),
+                num(&p["standard_error"])
+            ));
+        }
+        // The parts add up to the total (the record's numbers, not the sink's).
+        let sum = r["case"]["reflection"]["mean_weight"].as_f64().unwrap()
+            + r["case"]["transmission"]["mean_weight"].as_f64().unwrap();
+        assert!((sum - r["value"].as_f64().unwrap()).abs() < 1e-12, "{r}");
+    }
+    // Consistency: the pdf and weight errors apart, the failure rate against 1 − ∫ pdf.
+    for r in of("bsdf.sample_consistency") {
+        has(format!(
+            "<td class=num>{}</td><td class=num>{}</td>",
+            num(&r["case"]["worst_pdf_error"]),
+            num(&r["case"]["worst_weight_error"])
+        ));
+    }
+    let rates = of("bsdf.failure_rate");
+    assert_eq!(rates.len(), 5);
+    for r in rates {
+        has(format!(
+            "{} ({} of {})",
+            num(&r["value"]),
+            r["case"]["failed_samples"],
+            r["case"]["samples"]
+        ));
+        has(format!(
+            "{} ± {}",
+            num(&r["oracle"]["value"]),
+            num(&r["oracle"]["uncertainty"])
+        ));
+    }
+    // Reciprocity: the worst relative error, where, the tolerance and the verdict.
+    let rec = &of("bsdf.reciprocity")[0];
+    has(format!(
+        "{} direction pairs, transport radiance, η = 1.500000",
+        rec["case"]["pairs"]
+    ));
+    has(format!(
+        "<td class=num>{}</td><td>wi = (",
+        num(&rec["value"])
+    ));
+    has(format!(
+        "f(wi, wo) = {}",
+        num(&rec["case"]["worst"]["f_wi_wo"])
+    ));
+    has(format!(
+        "{} = {}</td><td>pass</td>",
+        rec["tolerance"]["name"].as_str().unwrap(),
+        num(&rec["tolerance"]["value"])
+    ));
+    // The stressed variants' stability records are listed in the section.
+    assert!(section.contains("stressed variants"));
+}

@@ -37,8 +37,8 @@ pub fn folder_name(model: &Value, case: &Value) -> String {
     }
 }
 
-/// A short human name of a model spec: its family, then its parameters (`ggx alpha=0.3`);
-/// arrays and objects stay compact JSON.
+/// A short human name of a model spec: its family (a BSDF spec's kind), then its parameters
+/// (`ggx alpha=0.3`); arrays and objects stay compact JSON.
 pub fn model_name(model: &Value) -> String {
     let Some(map) = model.as_object() else {
         return if model.is_null() {
@@ -47,12 +47,17 @@ pub fn model_name(model: &Value) -> String {
             model.to_string()
         };
     };
+    // A reference BSDF's spec names its kind under `bsdf` (`dielectric eta=1.5 …`).
+    let kind = ["family", "bsdf"]
+        .into_iter()
+        .find(|k| map.get(*k).is_some_and(Value::is_string))
+        .unwrap_or("family");
     let mut out = map
-        .get("family")
+        .get(kind)
         .and_then(Value::as_str)
         .unwrap_or("?")
         .to_string();
-    for (k, v) in map.iter().filter(|(k, _)| *k != "family") {
+    for (k, v) in map.iter().filter(|(k, _)| *k != kind) {
         out.push_str(&format!(" {k}={v}"));
     }
     out

@@ -1,63 +1,25 @@
 //! `report.html`: one self-contained page (plots embedded as SVG `data:` URIs, no scripts, no
 //! network) read top to bottom: verdict and counts, how to reproduce the run, the failures with
 //! their plots, per material Λ and G1 against the oracle with the relative error below, the
-//! chi-square heat maps and KS marginals of every sampling check, the γ → ∞ convergence, the
+//! chi-square heat maps and KS marginals of every sampling check, the BSDFs
+//! (`bsdf_html.rs`: both hemispheres' heat maps per incidence, albedo against incidence, the
+//! consistency and reciprocity tables), the γ → ∞ convergence, the
 //! stability sweep, the errata and claims tables, accuracy versus time (`cost.json`), and the
 //! time per check.
 
 use super::artefacts::{case_name, model_name, record_title};
-use super::page::{escape, fmt_num, STYLE};
+pub use super::page::measured_text;
+use super::page::{escape, fmt_num, verdict_text, STYLE};
 use super::plot::PlotError;
 use super::record_plots::{data_plots, limit_plot, plot_policy, smith_plots};
-use crate::record::{CheckRecord, Measured, Verdict};
+use crate::record::{CheckRecord, Verdict};
 use crate::run::AuditReport;
 use serde_json::Value;
 use std::fmt::Write as _;
 
-/// The measured discrepancy against the tolerance, as one line of text.
-pub fn measured_text(r: &CheckRecord) -> String {
-    let tol = r
-        .tolerance
-        .as_ref()
-        .map(|t| format!(" against {} = {}", t.name, fmt_num(t.value)))
-        .unwrap_or_default();
-    match r.measured {
-        Some(Measured::Absolute { error }) => format!("absolute error {}{tol}", fmt_num(error)),
-        Some(Measured::Relative { error }) => format!("relative error {}{tol}", fmt_num(error)),
-        Some(Measured::PValue {
-            p,
-            statistic,
-            dof,
-            alpha,
-        }) => format!(
-            "p = {} (statistic {}, dof {dof}) at α = {}",
-            fmt_num(p),
-            fmt_num(statistic),
-            fmt_num(alpha)
-        ),
-        Some(Measured::Rate { exponent, expected }) => format!(
-            "rate {} (expected {}){tol}",
-            fmt_num(exponent),
-            fmt_num(expected)
-        ),
-        None => "not measured".into(),
-    }
-}
-
-fn verdict_text(v: &Verdict) -> String {
-    match v {
-        Verdict::Pass => "pass".into(),
-        Verdict::Fail => "FAIL".into(),
-        Verdict::ExpectedFailure { reason } => format!("expected failure: {reason}"),
-        Verdict::Skipped { reason } => format!("skipped: {reason}"),
-        Verdict::Error { message } => format!("ERROR: {message}"),
-        Verdict::UnexpectedPass { reason } => format!("UNEXPECTED PASS: {reason}"),
-    }
-}
-
 /// The checks that have their own section (not under the materials).
 fn own_section(check: &str) -> bool {
-    ["errata.", "claims.", "limits.", "stability."]
+    ["errata.", "claims.", "limits.", "stability.", "bsdf."]
         .iter()
         .any(|p| check.starts_with(p))
 }
@@ -173,7 +135,7 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
     );
     h.push_str(
         "<nav><a href=#failures>failures</a><a href=#materials>materials</a>\
-         <a href=#limits>γ → ∞</a><a href=#stability>stability</a><a href=#errata>errata</a>\
+         <a href=#bsdf>BSDFs</a><a href=#limits>γ → ∞</a><a href=#stability>stability</a><a href=#errata>errata</a>\
          <a href=#claims>claims</a><a href=#cost>accuracy vs time</a><a href=#checks>by check</a>\
          </nav>\n",
     );
@@ -220,8 +182,20 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
             escape(&measured_text(r)),
             escape(&r.source)
         );
-        let plots = data_plots(r)?;
-        if !plots.is_empty() {
+        let bsdf = super::bsdf_html::is_bsdf(&r.check)
+            .then(|| super::bsdf_html::anchor(&report.records, &r.model))
+            .flatten();
+        let plots = if bsdf.is_some() {
+            String::new()
+        } else {
+            data_plots(r)?
+        };
+        if let Some(a) = bsdf {
+            let _ = write!(
+                h,
+                "<p>Plots and tables: <a href=#{a}>this BSDF in the BSDF section</a>.</p>"
+            );
+        } else if !plots.is_empty() {
             let _ = write!(h, "<div class=plots>{plots}</div>");
         } else if let (true, Some(a)) = (r.check.starts_with("smith."), anchor(&r.model)) {
             let _ = write!(
@@ -319,6 +293,10 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
             records_table(records)
         );
     }
+    h.push_str(&super::bsdf_html::bsdf_section(
+        &report.records,
+        records_table,
+    )?);
     h.push_str("<h2 id=limits>γ → ∞ convergence</h2>\n<div class=plots>");
     let limits: Vec<&CheckRecord> = report
         .records

@@ -3,6 +3,8 @@
 //! self-contained `report.html`. Checks do no I/O: everything written is written here.
 
 pub mod artefacts;
+#[cfg(feature = "html")]
+pub mod bsdf_html;
 pub mod cost;
 #[cfg(feature = "html")]
 pub mod cost_html;

@@ -69,6 +69,28 @@ pub struct LinePlot {
     pub legend: Corner,
 }
 
+/// Vertical error bars on the points of one series of a [`LinePlot`]: ±`half_widths[k]` about
+/// its k-th point (drawn only for a series short enough not to be decimated).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ErrorBars {
+    /// The index of the series in [`LinePlot::series`].
+    pub series: usize,
+    /// The half-width of each point's bar (non-finite or ≤ 0: no bar).
+    pub half_widths: Vec<f64>,
+}
+
+/// One panel of [`panels_svg`]: a line plot, error bars on its series, and an x range (the
+/// padded range of the points when None).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Panel<'a> {
+    /// The plot.
+    pub plot: &'a LinePlot,
+    /// Error bars on its series.
+    pub bars: &'a [ErrorBars],
+    /// The x axis' range.
+    pub x_range: Option<(f64, f64)>,
+}
+
 /// A corner of a plot, for its legend.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Corner {
@@ -195,9 +217,47 @@ pub fn decimate(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     out
 }
 
+/// The bars' segments in axis coordinates: (x, y_low, y_high) per bar, clipped on a log axis
+/// to the smallest positive value of the plot.
+fn bar_segments(plot: &LinePlot, bars: &[ErrorBars]) -> Vec<(f64, f64, f64)> {
+    let mut out = Vec::new();
+    for b in bars {
+        let Some(s) = plot.series.get(b.series) else {
+            continue;
+        };
+        if s.points.len() > MAX_DRAWN_POINTS {
+            continue;
+        }
+        for (&(x, y), &e) in s.points.iter().zip(&b.half_widths) {
+            if !(e.is_finite() && e > 0.0) {
+                continue;
+            }
+            let low = if plot.y_log && y - e <= 0.0 {
+                y * 1e-3
+            } else {
+                y - e
+            };
+            if let (Some(x), Some(lo), Some(hi)) = (
+                axis_value(x, plot.x_log),
+                axis_value(low, plot.y_log),
+                axis_value(y + e, plot.y_log),
+            ) {
+                out.push((x, lo, hi));
+            }
+        }
+    }
+    out
+}
+
 /// Draws a line plot into an area.
-fn draw_lines(area: &DrawingArea<SVGBackend<'_>, Shift>, plot: &LinePlot) -> Result<(), PlotError> {
+fn draw_lines(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    plot: &LinePlot,
+    bars: &[ErrorBars],
+    x_range: Option<(f64, f64)>,
+) -> Result<(), PlotError> {
     let err = plot_error(&plot.title);
+    let segments = bar_segments(plot, bars);
     let mut dropped = 0usize;
     let series: Vec<Vec<(f64, f64)>> = plot
         .series
@@ -220,13 +280,17 @@ fn draw_lines(area: &DrawingArea<SVGBackend<'_>, Shift>, plot: &LinePlot) -> Res
         .iter()
         .filter_map(|(y, l)| axis_value(*y, plot.y_log).map(|y| (y, l.as_str())))
         .collect();
-    let x_range = padded_range(series.iter().flatten().map(|p| p.0), plot.x_log);
+    let x_range = x_range
+        .and_then(|(a, b)| axis_value(a, plot.x_log).zip(axis_value(b, plot.x_log)))
+        .filter(|(a, b)| a < b)
+        .unwrap_or_else(|| padded_range(series.iter().flatten().map(|p| p.0), plot.x_log));
     let y_range = padded_range(
         series
             .iter()
             .flatten()
             .map(|p| p.1)
-            .chain(h_lines.iter().map(|h| h.0)),
+            .chain(h_lines.iter().map(|h| h.0))
+            .chain(segments.iter().flat_map(|b| [b.1, b.2])),
         plot.y_log,
     );
     let caption = if dropped > 0 {
@@ -275,6 +339,21 @@ fn draw_lines(area: &DrawingArea<SVGBackend<'_>, Shift>, plot: &LinePlot) -> Res
             }
         }
     }
+    for b in bars {
+        let colour = PALETTE[b.series % PALETTE.len()];
+        let style = ShapeStyle::from(&colour).stroke_width(1);
+        let cap = 0.006 * (x_range.1 - x_range.0);
+        let mine = bar_segments(plot, std::slice::from_ref(b));
+        chart
+            .draw_series(mine.iter().flat_map(|&(x, lo, hi)| {
+                [
+                    PathElement::new(vec![(x, lo), (x, hi)], style),
+                    PathElement::new(vec![(x - cap, lo), (x + cap, lo)], style),
+                    PathElement::new(vec![(x - cap, hi), (x + cap, hi)], style),
+                ]
+            }))
+            .map_err(&err)?;
+    }
     for (y, label) in &h_lines {
         let style = ShapeStyle::from(&RGBColor(200, 0, 0)).stroke_width(1);
         chart
@@ -307,7 +386,7 @@ pub fn line_svg(plot: &LinePlot) -> Result<String, PlotError> {
     {
         let root = SVGBackend::with_string(&mut svg, (WIDTH, HEIGHT)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error(&plot.title))?;
-        draw_lines(&root, plot)?;
+        draw_lines(&root, plot, &[], None)?;
         root.present().map_err(plot_error(&plot.title))?;
     }
     Ok(svg)
@@ -321,9 +400,30 @@ pub fn stacked_svg(top: &LinePlot, bottom: &LinePlot) -> Result<String, PlotErro
         let root = SVGBackend::with_string(&mut svg, (WIDTH, 2 * HEIGHT)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error(&top.title))?;
         let (a, b) = root.split_vertically(HEIGHT);
-        draw_lines(&a, top)?;
-        draw_lines(&b, bottom)?;
+        draw_lines(&a, top, &[], None)?;
+        draw_lines(&b, bottom, &[], None)?;
         root.present().map_err(plot_error(&top.title))?;
+    }
+    Ok(svg)
+}
+
+/// Line plots with error bars, stacked in one SVG, each `height` pixels high (e.g. a BSDF's
+/// albedo against incidence from outside above, from inside below).
+pub fn panels_svg(panels: &[Panel<'_>], height: u32) -> Result<String, PlotError> {
+    let title = panels.first().map_or("", |p| p.plot.title.as_str());
+    let mut svg = String::new();
+    {
+        let n = panels.len().max(1) as u32;
+        let root = SVGBackend::with_string(&mut svg, (WIDTH, n * height)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error(title))?;
+        for (area, p) in root
+            .split_evenly((panels.len().max(1), 1))
+            .iter()
+            .zip(panels)
+        {
+            draw_lines(area, p.plot, p.bars, p.x_range)?;
+        }
+        root.present().map_err(plot_error(title))?;
     }
     Ok(svg)
 }
@@ -751,6 +851,45 @@ mod tests {
             ..map
         };
         assert!(heat_map_svg(&bad).is_err());
+    }
+
+    /// Whether an SVG has a text line `tick` (plotters writes a label's text on its own line).
+    fn plot_svg_has_tick(svg: &str, tick: &str) -> bool {
+        svg.lines().any(|l| l.trim() == tick)
+    }
+
+    #[test]
+    fn error_bars_widen_the_range_and_are_drawn_per_point() {
+        let plot = LinePlot {
+            title: "albedo from outside".into(),
+            x_label: "θi".into(),
+            y_label: "albedo".into(),
+            x_log: false,
+            y_log: false,
+            series: vec![Series::new("mean weight", vec![(0.0, 0.5), (60.0, 0.4)])],
+            h_lines: vec![],
+            legend: Corner::UpperRight,
+        };
+        let bars = [ErrorBars {
+            series: 0,
+            half_widths: vec![0.3, f64::NAN],
+        }];
+        // One bar (the NaN half-width has none), from 0.2 to 0.8.
+        assert_eq!(bar_segments(&plot, &bars), vec![(0.0, 0.2, 0.8)]);
+        let panel = |bars| Panel {
+            plot: &plot,
+            bars,
+            x_range: Some((0.0, 90.0)),
+        };
+        let with = panels_svg(&[panel(&bars), panel(&[])], 400).unwrap();
+        let without = panels_svg(&[panel(&[]), panel(&[])], 400).unwrap();
+        assert!(with.starts_with("<svg") && with.contains("height=\"800\""));
+        // A bar is three thin paths in its series' colour (the bar and its caps); the x axis
+        // reaches 90 (its range).
+        let bar_paths = |svg: &str| svg.matches("stroke=\"#0072B2\" stroke-width=\"1\"").count();
+        assert_eq!((bar_paths(&with), bar_paths(&without)), (3, 0), "{with}");
+        assert!(plot_svg_has_tick(&with, "90"), "{with}");
+        assert!(!plot_svg_has_tick(&line_svg(&plot).unwrap(), "90"));
     }
 
     #[test]

@@ -1,6 +1,10 @@
 //! `bsdf.albedo`: ∫ eval(wi, wo) dωo by cubature with an error bound against the mean weight
 //! of sampled directions (Monte Carlo with its standard error; a failed sample weighs 0). It
 //! sees `eval` errors that the chi-square cannot (which compares `sample` with `pdf` only).
+//! The record's case also splits both into the reflected (wo on wi's side) and transmitted
+//! parts (`reflection`, `transmission`: each ∫ over its hemisphere with its bound, and the mean
+//! of the weights of the samples that land there, the others counting 0, with its standard
+//! error), which the HTML report plots against the incidence.
 //! `bsdf.energy`: the same integral ≤ 1 where the transport makes that a law (reflection, and
 //! transmission where (η_i/η_o)² ≤ 1 or the transport is importance).
 
@@ -20,6 +24,30 @@ struct Sums {
     sum: f64,
     squares: f64,
     non_finite: u64,
+    /// Sum and sum of squares of the weights of the samples on wi's side (reflected).
+    reflected: (f64, f64),
+}
+
+impl Sums {
+    fn add(self, b: Sums) -> Sums {
+        Sums {
+            n: self.n + b.n,
+            sum: self.sum + b.sum,
+            squares: self.squares + b.squares,
+            non_finite: self.non_finite + b.non_finite,
+            reflected: (
+                self.reflected.0 + b.reflected.0,
+                self.reflected.1 + b.reflected.1,
+            ),
+        }
+    }
+}
+
+/// The mean of n values of sum `sum` and sum of squares `squares`, and its standard error.
+fn mean_and_error(n: f64, sum: f64, squares: f64) -> (f64, f64) {
+    let mean = sum / n;
+    let variance = ((squares / n - mean * mean) * n / (n - 1.0)).max(0.0);
+    (mean, (variance / n).sqrt())
 }
 
 /// Plans the albedo (and, where it is a law, the energy) check of `subject` at `incidence`.
@@ -48,25 +76,35 @@ pub fn plan<'a>(
                 let wi = incidence.wi;
                 let quad = integrals.albedo(bsdf);
                 let parts = fold_samples(bsdf, wi, n, ctx.seed, Sums::default, |acc, _, _, s| {
-                    let w = s.filter(|s| s.pdf != 0.0).map_or(0.0, |s| s.weight);
+                    let s = s.filter(|s| s.pdf != 0.0);
+                    let w = s.map_or(0.0, |s| s.weight);
                     acc.n += 1.0;
                     if w.is_finite() {
                         acc.sum += w;
                         acc.squares += w * w;
+                        if s.is_some_and(|s| s.wo[2] * wi[2] > 0.0) {
+                            acc.reflected.0 += w;
+                            acc.reflected.1 += w * w;
+                        }
                     } else {
                         acc.non_finite += 1;
                     }
                 });
-                let all = parts.iter().fold(Sums::default(), |a, b| Sums {
-                    n: a.n + b.n,
-                    sum: a.sum + b.sum,
-                    squares: a.squares + b.squares,
-                    non_finite: a.non_finite + b.non_finite,
-                });
-                let mean = all.sum / all.n;
-                let variance =
-                    ((all.squares / all.n - mean * mean) * all.n / (all.n - 1.0)).max(0.0);
-                let se = (variance / all.n).sqrt();
+                let all = parts.iter().fold(Sums::default(), |a, &b| a.add(b));
+                let (mean, se) = mean_and_error(all.n, all.sum, all.squares);
+                let (r_mean, r_se) = mean_and_error(all.n, all.reflected.0, all.reflected.1);
+                let (t_mean, t_se) = mean_and_error(
+                    all.n,
+                    all.sum - all.reflected.0,
+                    all.squares - all.reflected.1,
+                );
+                // The hemispheres' integrals: the reflected one is wi's side.
+                let (upper, lower) = integrals.albedo_hemispheres(bsdf);
+                let (reflected, transmitted) = if wi[2] > 0.0 {
+                    (upper, lower)
+                } else {
+                    (lower, upper)
+                };
                 let deviation = ((mean - quad.value).abs() - quad.error_bound).max(0.0);
                 let z = if deviation == 0.0 {
                     0.0
@@ -94,6 +132,20 @@ pub fn plan<'a>(
                 r.tolerance = Some(applied(&STATISTICAL_ALPHA));
                 if let Value::Object(case) = &mut r.case {
                     case.insert("standard_error".into(), json!(se));
+                    for (name, quad, mean, se) in [
+                        ("reflection", reflected, r_mean, r_se),
+                        ("transmission", transmitted, t_mean, t_se),
+                    ] {
+                        case.insert(
+                            name.into(),
+                            json!({
+                                "albedo": quad.value,
+                                "error_bound": quad.error_bound,
+                                "mean_weight": mean,
+                                "standard_error": se,
+                            }),
+                        );
+                    }
                     case.insert("non_finite_weights".into(), json!(all.non_finite));
                 }
                 r.verdict = if all.non_finite == 0

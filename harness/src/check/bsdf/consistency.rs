@@ -1,5 +1,6 @@
 //! `bsdf.sample_consistency`: at every sampled direction, the pdf and the weight `sample`
-//! returns equal `pdf(wi, wo)` and `eval(wi, wo) / pdf(wi, wo)`; `bsdf.failure_rate`: the rate
+//! returns equal `pdf(wi, wo)` and `eval(wi, wo) / pdf(wi, wo)` (the record's value the worst
+//! of both relative errors, its case each apart: `worst_pdf_error`, `worst_weight_error`); `bsdf.failure_rate`: the rate
 //! of failed samples equals 1 − ∫ pdf dωo (a sampler that silently loses mass fails).
 
 use super::{fold_samples, BsdfSubject, Incidence, Integrals, SOURCE};
@@ -24,6 +25,9 @@ pub fn samples(profile: Profile) -> u64 {
 #[derive(Debug, Clone, Default)]
 struct Worst {
     error: f64,
+    /// The worst relative errors of the sample's pdf and of its weight, apart.
+    pdf_error: f64,
+    weight_error: f64,
     at: Option<Value>,
     failed: u64,
     drawn: u64,
@@ -71,8 +75,14 @@ pub fn plan<'a>(
             bsdf.eval_batch(&wis, &wo, &mut eval);
             for (k, &(index, u, s)) in ok.iter().enumerate() {
                 let weight = eval[k] / pdf[k];
-                let e = relative_error(s.pdf, pdf[k]).max(relative_error(s.weight, weight));
-                let e = if e.is_nan() { f64::INFINITY } else { e };
+                let nan_inf = |e: f64| if e.is_nan() { f64::INFINITY } else { e };
+                let (ep, ew) = (
+                    nan_inf(relative_error(s.pdf, pdf[k])),
+                    nan_inf(relative_error(s.weight, weight)),
+                );
+                worst.pdf_error = worst.pdf_error.max(ep);
+                worst.weight_error = worst.weight_error.max(ew);
+                let e = ep.max(ew);
                 if worst.at.is_none() || e > worst.error {
                     worst.error = e;
                     worst.at = Some(json!({
@@ -90,6 +100,8 @@ pub fn plan<'a>(
         if let (Value::Object(case), Some(at)) = (&mut r.case, worst.at) {
             case.insert("worst".into(), at);
             case.insert("failed_samples".into(), json!(worst.failed));
+            case.insert("worst_pdf_error".into(), json!(worst.pdf_error));
+            case.insert("worst_weight_error".into(), json!(worst.weight_error));
         }
         r.verdict = if worst.error <= BSDF_SAMPLE_CONSISTENCY.value {
             Verdict::Pass

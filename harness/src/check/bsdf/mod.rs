@@ -148,7 +148,7 @@ pub struct Integrals {
     wi: Vec3,
     samples: u64,
     pdf: OnceLock<((Expected, Expected), u64)>,
-    eval: OnceLock<Estimate>,
+    eval: OnceLock<(Estimate, Estimate)>,
 }
 
 impl Integrals {
@@ -187,15 +187,27 @@ impl Integrals {
     /// ∫ eval dωo (the albedo) with its error bound and the evaluations it cost, on the same
     /// grid, to [`albedo_target`].
     pub fn albedo(&self, bsdf: &dyn Bsdf) -> Estimate {
+        let (u, l) = self.albedo_hemispheres(bsdf);
+        Estimate {
+            value: u.value + l.value,
+            error_bound: u.error_bound + l.error_bound,
+            evaluations: u.evaluations + l.evaluations,
+        }
+    }
+
+    /// ∫ eval dωo over each hemisphere (upper z > 0, lower z < 0), each with its error bound
+    /// and evaluations: the reflected and transmitted parts of [`Self::albedo`].
+    pub fn albedo_hemispheres(&self, bsdf: &dyn Bsdf) -> (Estimate, Estimate) {
         *self.eval.get_or_init(|| {
             let grid = HemisphereGrid::new(chi2::RESOLUTION).expect("R ≥ 1");
             let target = albedo_target(self.samples);
             let (u, l) = expected_sphere(&eval_at(bsdf, self.wi), grid, target);
-            Estimate {
-                value: u.total + l.total,
-                error_bound: u.error_bound + l.error_bound,
-                evaluations: u.evaluations + l.evaluations,
-            }
+            let side = |e: &Expected| Estimate {
+                value: e.total,
+                error_bound: e.error_bound,
+                evaluations: e.evaluations,
+            };
+            (side(&u), side(&l))
         })
     }
 }
