@@ -26,7 +26,8 @@
 //!    at most 2√λ), so λ ≤ 0.1 moves it by < 0.8 against a standard deviation √(2·dof) ≥ 20
 //!    for the grid's hundreds of bins; a summed 1/N asks 10–100× more of a kinked pdf where
 //!    it does not matter (measured: the reference GGX dielectric's five ci chi-squares
-//!    3.5e7 → see `mass_noncentrality`'s test).
+//!    3.55e7 → 6.2e6 pdf evaluations). Masses that end above the bound (the budget spent
+//!    first) make `bsdf.chi2` an error record, never a verdict.
 //! 3. **Sanity failures first** (no p-value): a sampled direction that is non-finite or not of
 //!    unit length, a non-finite or negative cell mass, a total mass above 1 by more than
 //!    [`MASS_TOLERANCE`] (a pdf of a sampler that cannot fail integrates to at most 1), samples
@@ -541,6 +542,7 @@ mod tests {
             mass,
             cell_bound: bound,
             evaluations: 0,
+            budget_hit: None,
         };
         // Exact masses: no noncentrality.
         assert_eq!(

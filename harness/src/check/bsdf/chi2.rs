@@ -4,7 +4,7 @@
 use super::{BsdfSubject, Incidence, Integrals, SOURCE};
 use crate::check::{applied, covers, Check, PlannedCheck, Profile};
 use crate::oracle::chi2::{Chi2Config, Verdict as Chi2Verdict};
-use crate::oracle::sphere_chi2::sphere_chi2_against;
+use crate::oracle::sphere_chi2::{sphere_chi2_against, MASS_BUDGET, MASS_NONCENTRALITY};
 use crate::record::{Measured, OracleValue, RecordData, Verdict};
 use crate::tolerance::STATISTICAL_ALPHA;
 use mfh_reference::geometry::Vec3;
@@ -99,6 +99,19 @@ pub fn plan<'a>(
                 } else {
                     Verdict::Fail
                 };
+                // Masses too uncertain to judge by: neither a pass nor a fail is earned.
+                let lambda = result.mass_noncentrality();
+                if !(lambda <= MASS_NONCENTRALITY) {
+                    r.verdict = Verdict::Error {
+                        message: format!(
+                            "expected masses unresolved within the budget of {MASS_BUDGET} \
+                             pdf evaluations a hemisphere: their error bounds could move the \
+                             statistic by up to {:.2} (noncentrality {lambda:.3} > \
+                             {MASS_NONCENTRALITY})",
+                            2.0 * lambda.sqrt() + lambda
+                        ),
+                    };
+                }
             }
             Ok(())
         })
