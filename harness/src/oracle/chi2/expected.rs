@@ -177,20 +177,7 @@ pub fn expected_mass_in_batch(
     }
     let f = in_angles(pdf);
     let (pieces, budget_hit) = integrate_rectangles_batch_budgeted(&f, &rectangles);
-    let mut at = 0;
-    let estimates: Vec<Estimate> = per_cell
-        .iter()
-        .map(|&n| {
-            let mut sum = Estimate::default();
-            for e in &pieces[at..at + n] {
-                sum.value += e.value;
-                sum.error_bound += e.error_bound;
-                sum.evaluations += e.evaluations;
-            }
-            at += n;
-            sum
-        })
-        .collect();
+    let estimates = sum_per_cell(&pieces, &per_cell);
     Expected {
         budget_hit,
         ..Expected::of_cells(&estimates)
@@ -267,22 +254,7 @@ pub fn expected_mass_global_until(
         per_cell.push(pieces);
     }
     let f = in_angles(pdf);
-    let cells = |pieces: &[Estimate]| {
-        let mut at = 0;
-        per_cell
-            .iter()
-            .map(|&n| {
-                let mut sum = Estimate::default();
-                for e in &pieces[at..at + n] {
-                    sum.value += e.value;
-                    sum.error_bound += e.error_bound;
-                    sum.evaluations += e.evaluations;
-                }
-                at += n;
-                sum
-            })
-            .collect::<Vec<Estimate>>()
-    };
+    let cells = |pieces: &[Estimate]| sum_per_cell(pieces, &per_cell);
     let result = crate::oracle::cubature::global::integrate_global_until(
         &f,
         &rectangles,
@@ -293,6 +265,25 @@ pub fn expected_mass_global_until(
     let mut e = Expected::of_cells(&cells(&result.estimates));
     e.evaluations = result.evaluations;
     (e, result.converged)
+}
+
+/// The estimates of the cells from those of their pieces (`per_cell[i]` consecutive pieces a
+/// cell, in cell order): values, bounds and evaluations summed.
+fn sum_per_cell(pieces: &[Estimate], per_cell: &[usize]) -> Vec<Estimate> {
+    let mut at = 0;
+    per_cell
+        .iter()
+        .map(|&n| {
+            let mut sum = Estimate::default();
+            for e in &pieces[at..at + n] {
+                sum.value += e.value;
+                sum.error_bound += e.error_bound;
+                sum.evaluations += e.evaluations;
+            }
+            at += n;
+            sum
+        })
+        .collect()
 }
 
 /// The cut points strictly inside `range`, with its ends.
