@@ -4,7 +4,11 @@
 
 pub mod artefacts;
 #[cfg(feature = "html")]
+pub mod bitmap;
+#[cfg(feature = "html")]
 pub mod bsdf_html;
+#[cfg(feature = "html")]
+pub mod colour;
 pub mod cost;
 #[cfg(feature = "html")]
 pub mod cost_html;

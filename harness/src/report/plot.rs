@@ -8,6 +8,8 @@
 //! coordinate type for every plot, and non-positive or non-finite values are left out (and
 //! counted in the caption) instead of breaking the scale.
 
+use super::bitmap::{cells_bitmap, Cells};
+pub use super::colour::{colour, ColourScale, INFINITE_COLOUR, NAN_COLOUR};
 use base64::Engine as _;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -428,81 +430,6 @@ pub fn panels_svg(panels: &[Panel<'_>], height: u32) -> Result<String, PlotError
     Ok(svg)
 }
 
-/// How heat-map values map to colours.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum ColourScale {
-    /// Linear from `min` (dark violet) to `max` (yellow), viridis-like.
-    Sequential {
-        /// The value drawn darkest.
-        min: f64,
-        /// The value drawn brightest.
-        max: f64,
-    },
-    /// Linear from −`limit` (blue) through 0 (white) to +`limit` (red), clipped beyond.
-    Diverging {
-        /// The magnitude drawn in the fullest colour.
-        limit: f64,
-    },
-}
-
-const VIRIDIS: [[f64; 3]; 9] = [
-    [68.0, 1.0, 84.0],
-    [71.0, 44.0, 122.0],
-    [59.0, 81.0, 139.0],
-    [44.0, 113.0, 142.0],
-    [33.0, 144.0, 141.0],
-    [39.0, 173.0, 129.0],
-    [92.0, 200.0, 99.0],
-    [170.0, 220.0, 50.0],
-    [253.0, 231.0, 37.0],
-];
-const BLUE: [f64; 3] = [33.0, 102.0, 172.0];
-const PALE: [f64; 3] = [247.0, 247.0, 247.0];
-const RED: [f64; 3] = [178.0, 24.0, 43.0];
-/// Cells with no samples and none expected (NaN).
-pub const NAN_COLOUR: RGBColor = RGBColor(150, 150, 150);
-/// Cells with samples where none are expected (±∞).
-pub const INFINITE_COLOUR: RGBColor = RGBColor(255, 0, 255);
-
-fn mix(a: [f64; 3], b: [f64; 3], t: f64) -> RGBColor {
-    let c = |i: usize| (a[i] + (b[i] - a[i]) * t).round().clamp(0.0, 255.0) as u8;
-    RGBColor(c(0), c(1), c(2))
-}
-
-/// The colour of a value under a scale (NaN grey, ±∞ magenta).
-pub fn colour(value: f64, scale: ColourScale) -> RGBColor {
-    if value.is_nan() {
-        return NAN_COLOUR;
-    }
-    if value.is_infinite() {
-        return INFINITE_COLOUR;
-    }
-    match scale {
-        ColourScale::Sequential { min, max } => {
-            let t = if max > min {
-                ((value - min) / (max - min)).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let x = t * (VIRIDIS.len() - 1) as f64;
-            let i = (x as usize).min(VIRIDIS.len() - 2);
-            mix(VIRIDIS[i], VIRIDIS[i + 1], x - i as f64)
-        }
-        ColourScale::Diverging { limit } => {
-            let t = if limit > 0.0 {
-                (value / limit).clamp(-1.0, 1.0)
-            } else {
-                0.0
-            };
-            if t < 0.0 {
-                mix(PALE, BLUE, -t)
-            } else {
-                mix(PALE, RED, t)
-            }
-        }
-    }
-}
-
 /// A heat map over the hemisphere's (φ, cos θ) grid: `rows` cos θ-rows (row 0 at the horizon,
 /// cos θ ∈ [z_i, z_{i+1}), by default z_i = i/R) × `columns` φ-columns over [0, 2π) (by default
 /// equal), row-major. Drawn with φ in degrees across and θ in degrees down, each cell where its
@@ -577,7 +504,16 @@ pub fn heat_map_svg(map: &HeatMap<'_>) -> Result<String, PlotError> {
              href=\"data:image/bmp;base64,{}\"/>",
             x1 - x0,
             y1 - y0,
-            base64::engine::general_purpose::STANDARD.encode(cells_bitmap(map))
+            base64::engine::general_purpose::STANDARD.encode(cells_bitmap(&Cells {
+                rows: map.rows,
+                columns: map.columns,
+                z_edges: map.z_edges,
+                phi_edges: map.phi_edges,
+                colour: &|cell| {
+                    let RGBColor(r, g, b) = colour(map.values[cell], map.scale);
+                    [r, g, b]
+                },
+            }))
         ));
         let (lo, hi) = match map.scale {
             ColourScale::Sequential { min, max } => (min, if max > min { max } else { min + 1.0 }),
@@ -625,72 +561,6 @@ pub fn heat_map_svg(map: &HeatMap<'_>) -> Result<String, PlotError> {
         svg.insert_str(at, &image);
     }
     Ok(svg)
-}
-
-/// Pixel rows of a heat map's bitmap: one per degree of θ (the cos θ-rows are uneven in θ).
-const BITMAP_ROWS: usize = 90;
-
-/// The heat map's cells as an uncompressed 24-bit BMP, one column per φ-column and one row per
-/// degree of θ (each pixel the colour of the cos θ-row its θ falls in). Hand-written because
-/// BMP needs only a 54-byte header and browsers display it: the dependency tree has no PNG
-/// encoder, and at 64 × 90 pixels (17 kB) the image is an eighth of the per-cell SVG.
-pub fn cells_bitmap(map: &HeatMap<'_>) -> Vec<u8> {
-    // Given edges: finer pixels (0.5° in θ, 2° in φ), each the cell its centre falls in
-    // (uneven columns only: equal φ-columns keep one pixel a column). At most 180 × 180 × 3 B
-    // = 97 kB, 173 kB once base64 in the SVG and again in report.html (whose images stay
-    // under 200 kB: tests/tests/html_report.rs).
-    let given_rows = map.z_edges.len() == map.rows + 1;
-    let given_columns = map.phi_edges.len() == map.columns + 1 && !equal_columns(map);
-    let w = if given_columns { 180 } else { map.columns };
-    let h = if given_rows {
-        2 * BITMAP_ROWS
-    } else {
-        BITMAP_ROWS
-    };
-    let stride = (3 * w).div_ceil(4) * 4;
-    let size = 54 + stride * h;
-    let mut b = Vec::with_capacity(size);
-    b.extend_from_slice(b"BM");
-    b.extend_from_slice(&(size as u32).to_le_bytes());
-    b.extend_from_slice(&[0; 4]);
-    b.extend_from_slice(&54u32.to_le_bytes());
-    b.extend_from_slice(&40u32.to_le_bytes());
-    b.extend_from_slice(&(w as i32).to_le_bytes());
-    b.extend_from_slice(&(h as i32).to_le_bytes()); // positive: rows stored bottom-up
-    b.extend_from_slice(&1u16.to_le_bytes());
-    b.extend_from_slice(&24u16.to_le_bytes());
-    b.extend_from_slice(&[0; 24]); // BI_RGB, no sizes, no palette
-    for k in (0..h).rev() {
-        let theta = ((k as f64 + 0.5) * 90.0 / h as f64).to_radians();
-        let row = if given_rows {
-            let z = theta.cos();
-            map.z_edges[1..map.rows].partition_point(|&e| e <= z)
-        } else {
-            ((theta.cos() * map.rows as f64) as usize).min(map.rows - 1)
-        };
-        let start = b.len();
-        for j in 0..w {
-            let column = if given_columns {
-                let phi = ((j as f64 + 0.5) * 360.0 / w as f64).to_radians();
-                map.phi_edges[1..map.columns].partition_point(|&e| e <= phi)
-            } else {
-                j
-            };
-            let RGBColor(r, g, bl) = colour(map.values[row * map.columns + column], map.scale);
-            b.extend_from_slice(&[bl, g, r]);
-        }
-        b.resize(start + stride, 0);
-    }
-    b
-}
-
-/// Whether the map's φ edges are the equal columns j·2π/columns (to 1e-12 rad).
-fn equal_columns(map: &HeatMap<'_>) -> bool {
-    let step = std::f64::consts::TAU / map.columns as f64;
-    map.phi_edges
-        .iter()
-        .enumerate()
-        .all(|(j, &e)| (e - j as f64 * step).abs() <= 1e-12)
 }
 
 /// The indices of the Pareto frontier of (time, error) points ([`crate::cost::frontier`]).
