@@ -181,7 +181,10 @@ impl SphereChi2Result {
     }
 }
 
-/// Draws `samples` directions through `sample` and bins them over the sphere (step 1).
+/// Draws `samples` directions through `sample` and bins them over the sphere (step 1): each
+/// block's directions split by hemisphere (the lower mirrored), each part binned by
+/// [`CellFinder::cells_of`] (the vectorized finder); a block with a direction outside the
+/// domain is binned again one by one for the errors (the same counts either way).
 pub fn observe_sphere(
     sample: &SphereSampler<'_>,
     grid: HemisphereGrid,
@@ -189,24 +192,45 @@ pub fn observe_sphere(
     seed: u64,
 ) -> SphereObserved {
     let finder = CellFinder::new(grid.clone());
-    // Each chunk's counts with its buffer of sampled directions (reused block to block).
     draw_chunks(
         samples,
         seed,
-        || (SphereObserved::zero(grid.cells()), Vec::new()),
-        |(obs, out), index, u| {
-            out.clear();
-            out.resize(u.len(), None);
-            sample(u, out);
-            for (k, wo) in out.iter().enumerate() {
+        || (SphereObserved::zero(grid.cells()), Buffers::default()),
+        |(obs, buf), index, u| {
+            buf.out.clear();
+            buf.out.resize(u.len(), None);
+            sample(u, &mut buf.out);
+            buf.upper.clear();
+            buf.lower.clear();
+            for w in &buf.out {
+                match *w {
+                    None => {}
+                    Some(w) if w[2] >= 0.0 => buf.upper.push(w),
+                    Some(w) => buf.lower.push([w[0], w[1], -w[2]]),
+                }
+            }
+            buf.cells.resize(buf.upper.len().max(buf.lower.len()), 0);
+            let upper = finder.cells_of(&buf.upper, &mut buf.cells[..buf.upper.len()]);
+            if upper {
+                for &c in &buf.cells[..buf.upper.len()] {
+                    obs.upper[c] += 1;
+                }
+            }
+            let lower = finder.cells_of(&buf.lower, &mut buf.cells[..buf.lower.len()]);
+            if lower {
+                for &c in &buf.cells[..buf.lower.len()] {
+                    obs.lower[c] += 1;
+                }
+            }
+            for (k, wo) in buf.out.iter().enumerate() {
                 let Some(w) = *wo else {
                     obs.failed += 1;
                     continue;
                 };
-                let (cells, mirrored) = if w[2] >= 0.0 {
-                    (&mut obs.upper, w)
-                } else {
-                    (&mut obs.lower, [w[0], w[1], -w[2]])
+                let (cells, mirrored) = match (w[2] >= 0.0, upper, lower) {
+                    (true, true, _) | (false, _, true) => continue,
+                    (true, false, _) => (&mut obs.upper, w),
+                    (false, _, false) => (&mut obs.lower, [w[0], w[1], -w[2]]),
                 };
                 match finder.cell_of(mirrored) {
                     Ok(c) => cells[c] += 1,
@@ -222,6 +246,16 @@ pub fn observe_sphere(
     )
     .into_iter()
     .fold(SphereObserved::zero(grid.cells()), |a, (b, _)| a.merge(b))
+}
+
+/// A chunk's buffers, reused block to block: the sampled directions, those of each
+/// hemisphere (the lower mirrored) and their cells.
+#[derive(Default)]
+struct Buffers {
+    out: Vec<Option<Vec3>>,
+    upper: Vec<Vec3>,
+    lower: Vec<Vec3>,
+    cells: Vec<usize>,
 }
 
 /// The u ∈ [0, 1)³ of `samples` samples from the streams of `seed` (three uniforms a sample,
@@ -242,11 +276,18 @@ pub fn draw_chunks<A: Send>(
             let mut acc = init();
             let (start, end) = (chunk * CHUNK, ((chunk + 1) * CHUNK).min(samples));
             let mut u = vec![[0.0; 3]; BLOCK];
+            // The block's uniforms in bulk: pairs are consecutive uniforms of the stream, so
+            // 3n/2 pairs read as n triples are the triples of 3n `uniform` calls (for an odd
+            // 3n the last block of a chunk draws one uniform more, which nothing reads).
+            let mut pairs = vec![[0.0; 2]; (3 * BLOCK).div_ceil(2)];
             let mut index = start;
             while index < end {
                 let n = BLOCK.min((end - index) as usize);
-                for v in &mut u[..n] {
-                    *v = [rng.uniform(), rng.uniform(), rng.uniform()];
+                let pairs = &mut pairs[..(3 * n).div_ceil(2)];
+                rng.fill_pairs(pairs);
+                let flat: &[f64] = bytemuck::cast_slice(pairs);
+                for (v, w) in u[..n].iter_mut().zip(flat.chunks_exact(3)) {
+                    *v = [w[0], w[1], w[2]];
                 }
                 block(&mut acc, index, &u[..n]);
                 index += n as u64;
@@ -531,6 +572,98 @@ mod tests {
                     "cell {i}: {m} vs {t} ± {bound}"
                 );
             }
+        }
+    }
+
+    /// The vectorized binning of `observe_sphere` counts what `CellFinder::cell_of` finds one
+    /// by one, on directions at the hard places (poles, φ = 0 and the column edges, the
+    /// horizon from both sides, row edges of a quantile grid) mixed with failed, non-finite
+    /// and non-unit ones, whatever the thread count.
+    #[test]
+    fn sphere_binning_counts_what_cell_of_finds() {
+        let grid = HemisphereGrid::with_edges(
+            vec![0.0, 0.1, 0.35, 0.5, 0.8, 0.97, 1.0],
+            Some(
+                (0..=12)
+                    .map(|j| j as f64 * std::f64::consts::TAU / 12.0)
+                    .collect(),
+            ),
+        )
+        .unwrap();
+        let z_edges = grid.z_edges();
+        // u[0] picks a kind of direction, u[1..] place it.
+        let direction = |u: [f64; 3]| -> Option<Vec3> {
+            let (phi, z) = (u[1] * std::f64::consts::TAU, 2.0 * u[2] - 1.0);
+            let edge_phi = (u[1] * 12.0).floor() * std::f64::consts::TAU / 12.0;
+            let edge_z = z_edges[(u[2] * 7.0) as usize % 7];
+            let at = |phi: f64, z: f64| {
+                let s = (1.0 - z * z).max(0.0).sqrt();
+                [s * phi.cos(), s * phi.sin(), z]
+            };
+            match (u[0] * 10.0) as u32 {
+                0 => None,
+                1 => Some([0.0, 0.0, if u[2] < 0.5 { 1.0 } else { -1.0 }]),
+                2 => Some(at(edge_phi, z)),
+                3 => Some(at(phi, if u[2] < 0.5 { edge_z } else { -edge_z })),
+                4 => Some(at(phi, if u[2] < 0.5 { 0.0 } else { -0.0 })),
+                5 if u[1] < 0.01 => Some([f64::NAN, 0.0, 1.0]),
+                6 if u[1] < 0.01 => Some([0.7, 0.7, 0.7]),
+                _ => Some(at(phi, z)),
+            }
+        };
+        let sampler = |u: &[[f64; 3]], out: &mut [Option<Vec3>]| {
+            for (o, &u) in out.iter_mut().zip(u) {
+                *o = direction(u);
+            }
+        };
+        let samples = 200_000;
+        let observed = observe_sphere(&sampler, grid.clone(), samples, 5);
+        // One by one, over the same uniforms.
+        let finder = CellFinder::new(grid.clone());
+        let mut want = SphereObserved::zero(grid.cells());
+        let blocks = draw_chunks(samples, 5, Vec::new, |acc, index, u| {
+            acc.extend(
+                u.iter()
+                    .enumerate()
+                    .map(|(k, &u)| (index + k as u64, direction(u))),
+            );
+        });
+        for (index, w) in blocks.into_iter().flatten() {
+            let Some(w) = w else {
+                want.failed += 1;
+                continue;
+            };
+            let (cells, m) = if w[2] >= 0.0 {
+                (&mut want.upper, w)
+            } else {
+                (&mut want.lower, [w[0], w[1], -w[2]])
+            };
+            match finder.cell_of(m) {
+                Ok(c) => cells[c] += 1,
+                Err(_) => {
+                    want.invalid += 1;
+                    want.first_invalid = want.first_invalid.or(Some((index, w)));
+                }
+            }
+        }
+        assert_eq!(observed.upper, want.upper);
+        assert_eq!(observed.lower, want.lower);
+        assert_eq!(
+            (observed.failed, observed.invalid),
+            (want.failed, want.invalid)
+        );
+        assert!(want.invalid > 100 && want.failed > 10_000, "{want:?}");
+        assert_eq!(
+            observed.first_invalid.map(|f| f.0),
+            want.first_invalid.map(|f| f.0)
+        );
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let again = pool.install(|| observe_sphere(&sampler, grid.clone(), samples, 5));
+            assert_eq!(again, observed, "{threads} threads");
         }
     }
 

@@ -147,13 +147,7 @@ pub fn run(plan: &BsdfChi2Plan) -> SphereChi2Result {
     let bsdf = plan.bsdf.as_ref();
     let wi = plan.wi;
     sphere_chi2(
-        &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| {
-            let mut samples = vec![None; u.len()];
-            bsdf.sample_batch(wi, u, &mut samples);
-            for (o, s) in out.iter_mut().zip(samples) {
-                *o = s.filter(|s| s.pdf > 0.0).map(|s| s.wo);
-            }
-        },
+        &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| bsdf.sample_wo_batch(wi, u, out),
         &|wo: &[Vec3], out: &mut [f64]| {
             let wis = vec![wi; wo.len()];
             bsdf.pdf_batch(&wis, wo, out);

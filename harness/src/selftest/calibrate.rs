@@ -301,11 +301,7 @@ pub fn calibrate_bsdf(
                 };
                 let r = sphere_chi2_against(
                     &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| {
-                        let mut s = vec![None; u.len()];
-                        bsdf.sample_batch(inc.wi, u, &mut s);
-                        for (o, s) in out.iter_mut().zip(s) {
-                            *o = s.filter(|s| s.pdf > 0.0).map(|s| s.wo);
-                        }
+                        bsdf.sample_wo_batch(inc.wi, u, out)
                     },
                     expected.clone(),
                     &config,

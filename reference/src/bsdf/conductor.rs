@@ -119,10 +119,31 @@ impl Bsdf for Conductor {
             return None;
         }
         let m = self.microfacet.sample_m(wi, [u[1], u[2]])?;
-        let wo = reflect(wi, m);
-        if !finite(wo) || !(wo[2] > 0.0) {
-            return None;
-        }
+        let wo = reflected(wi, m)?;
         BsdfSample::at(wo, self.evaluate(wi, wo))
     }
+
+    /// The directions of [`Bsdf::sample`] without its eval and pdf: the normals by the
+    /// model's batch sampler, then the reflection.
+    fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<Vec3>]) {
+        assert_eq!(
+            u.len(),
+            out.len(),
+            "sample_wo_batch: u and out differ in length"
+        );
+        if !finite(wi) || !(wi[2] > 0.0) {
+            return out.fill(None);
+        }
+        self.microfacet.sample_m_batch(wi, u, out);
+        for o in out.iter_mut() {
+            *o = o.and_then(|m| reflected(wi, m));
+        }
+    }
+}
+
+/// wi reflected about the sampled normal m, `None` unless finite and above the surface.
+#[inline]
+fn reflected(wi: Vec3, m: Vec3) -> Option<Vec3> {
+    let wo = reflect(wi, m);
+    (finite(wo) && wo[2] > 0.0).then_some(wo)
 }

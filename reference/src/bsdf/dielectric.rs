@@ -88,6 +88,23 @@ impl Dielectric {
         }
     }
 
+    /// The direction `sample` scatters wi into through the sampled normal m, the lobe chosen
+    /// by `u0` against the Fresnel reflectance at wi·m (§5.3): reflected (eq 39) or
+    /// refracted (eq 40); `None` unless finite, off the surface and on the chosen lobe's side.
+    #[inline]
+    fn scattered(&self, wi: Vec3, m: Vec3, u0: f64) -> Option<Vec3> {
+        let ci = wi[2];
+        let other = if ci > 0.0 { self.eta } else { 1.0 / self.eta };
+        let fr = fresnel::dielectric(dot(wi, m), other);
+        let reflected = u0 < fr.reflectance;
+        let wo = if reflected {
+            reflect(wi, m)
+        } else {
+            refract(wi, m, other, fr.cos_t)
+        };
+        (finite(wo) && (wo[2] * ci > 0.0) == reflected && wo[2] != 0.0).then_some(wo)
+    }
+
     /// eval and pdf together: the half vector, D, G, F and the Jacobian once.
     fn evaluate(&self, wi: Vec3, wo: Vec3) -> (f64, f64) {
         let (ci, co) = (wi[2], wo[2]);
@@ -193,23 +210,29 @@ impl Bsdf for Dielectric {
     }
 
     fn sample(&self, wi: Vec3, u: [f64; 3]) -> Option<BsdfSample> {
-        let ci = wi[2];
-        if !finite(wi) || ci == 0.0 {
+        if !finite(wi) || wi[2] == 0.0 {
             return None;
         }
         let m = self.microfacet.sample_m(wi, [u[1], u[2]])?;
-        let other = if ci > 0.0 { self.eta } else { 1.0 / self.eta };
-        let fr = fresnel::dielectric(dot(wi, m), other);
-        let reflected = u[0] < fr.reflectance;
-        let wo = if reflected {
-            reflect(wi, m)
-        } else {
-            refract(wi, m, other, fr.cos_t)
-        };
-        if !finite(wo) || (wo[2] * ci > 0.0) != reflected || wo[2] == 0.0 {
-            return None;
-        }
+        let wo = self.scattered(wi, m, u[0])?;
         BsdfSample::at(wo, self.evaluate(wi, wo))
+    }
+
+    /// The directions of [`Bsdf::sample`] without its eval and pdf: the normals by the
+    /// model's batch sampler, then the Fresnel choice and the reflection or refraction.
+    fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<Vec3>]) {
+        assert_eq!(
+            u.len(),
+            out.len(),
+            "sample_wo_batch: u and out differ in length"
+        );
+        if !finite(wi) || wi[2] == 0.0 {
+            return out.fill(None);
+        }
+        self.microfacet.sample_m_batch(wi, u, out);
+        for (o, u) in out.iter_mut().zip(u) {
+            *o = o.and_then(|m| self.scattered(wi, m, u[0]));
+        }
     }
 
     fn eta(&self) -> Option<f64> {

@@ -263,6 +263,47 @@ impl Microfacet {
         };
         (finite(m) && m[2] > 0.0 && dot(v, m) > 0.0).then_some(m)
     }
+
+    /// `out[k] = self.sample_m(wi, [u[k][1], u[k][2]])` for a block at one incidence (u's
+    /// first component, the lobe choice, is not used), through the model's batch sampler
+    /// ([`crate::model::NormalSampler::sample_wm_batch`],
+    /// [`crate::model::VisibleNormalSampler::sample_wm_visible_batch`]: the scalar sampler's
+    /// normals to the ulps each documents; the pseudo-VNIS one at a time).
+    pub fn sample_m_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<Vec3>]) {
+        assert_eq!(
+            u.len(),
+            out.len(),
+            "sample_m_batch: u and out differ in length"
+        );
+        let v = upper(wi);
+        if !(v[2] > 0.0) || !finite(v) {
+            out.fill(None);
+            return;
+        }
+        let pairs: Vec<[f64; 2]> = u.iter().map(|u| [u[1], u[2]]).collect();
+        let mut m = vec![[0.0; 3]; u.len()];
+        match self.sampling {
+            Sampling::Normals => match self.ndf.as_sampler() {
+                Some(s) => s.sample_wm_batch(&pairs, &mut m),
+                None => return out.fill(None),
+            },
+            Sampling::VisibleNormals => match self.ndf.as_visible_sampler() {
+                Some(s) => s.sample_wm_visible_batch(v, &pairs, &mut m),
+                None => return out.fill(None),
+            },
+            Sampling::PseudoVnis => match self.pseudo.as_ref() {
+                Some(p) => {
+                    for (m, &u) in m.iter_mut().zip(&pairs) {
+                        *m = p.sample_wm(v, u);
+                    }
+                }
+                None => return out.fill(None),
+            },
+        }
+        for (o, m) in out.iter_mut().zip(m) {
+            *o = (finite(m) && m[2] > 0.0 && dot(v, m) > 0.0).then_some(m);
+        }
+    }
 }
 
 /// The reflection half vector of Walter eq 13, h_r = sign(wi·n)(wi + wo)/|wi + wo| (on wi's

@@ -64,6 +64,8 @@ pub mod microfacet;
 pub mod spec;
 
 #[cfg(test)]
+mod direction_tests;
+#[cfg(test)]
 mod golden_tests;
 #[cfg(test)]
 mod tests;
@@ -225,6 +227,29 @@ pub trait Bsdf: Send + Sync {
             *o = self.sample(wi, u);
         }
     }
+
+    /// The directions alone of [`Bsdf::sample_batch`]: `out[k]` = the `wo` of
+    /// `self.sample(wi, u[k])`, `None` for a failed sample or one of pdf 0. A chi-square of the
+    /// sampled directions needs nothing else, so an implementation may skip the pdf and weight
+    /// of each sample here (the reference BSDFs do: their Fresnel, D, Λ and Jacobians are
+    /// most of a sample's cost), provided it returns the same directions (the reference
+    /// BSDFs' test: `reference/src/bsdf/tests.rs`). The default calls
+    /// [`Bsdf::sample_batch`] (one request of an external BSDF) and keeps the `wo`.
+    ///
+    /// # Panics
+    /// If `u` and `out` differ in length.
+    fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<Vec3>]) {
+        assert_eq!(
+            u.len(),
+            out.len(),
+            "sample_wo_batch: u and out differ in length"
+        );
+        let mut samples = vec![None; u.len()];
+        self.sample_batch(wi, u, &mut samples);
+        for (o, s) in out.iter_mut().zip(samples) {
+            *o = s.filter(|s: &BsdfSample| s.pdf > 0.0).map(|s| s.wo);
+        }
+    }
 }
 
 /// A reference to a BSDF is the BSDF (so `Arc<dyn Bsdf>`, `Box<T>` and `&T` audit as `T`).
@@ -257,6 +282,9 @@ macro_rules! delegate_bsdf {
             }
             fn sample_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<BsdfSample>]) {
                 (**self).sample_batch(wi, u, out)
+            }
+            fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<Vec3>]) {
+                (**self).sample_wo_batch(wi, u, out)
             }
         }
     )*};

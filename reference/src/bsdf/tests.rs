@@ -15,14 +15,14 @@ fn spec(text: &str) -> BsdfSpec {
     serde_json::from_str(text).unwrap_or_else(|e| panic!("{text}: {e}"))
 }
 
-fn build(text: &str) -> Arc<dyn Bsdf> {
+pub(super) fn build(text: &str) -> Arc<dyn Bsdf> {
     spec(text).build().unwrap_or_else(|e| panic!("{text}: {e}"))
 }
 
 /// The R3 low-discrepancy sequence (Roberts 2018: additive recurrence with the powers of
 /// 1/φ₃, φ₃ the real root of x⁴ = x + 1): deterministic u ∈ [0, 1)³ that fill the cube evenly,
 /// so that sample means converge about as 1/N.
-fn r3(k: usize) -> [f64; 3] {
+pub(super) fn r3(k: usize) -> [f64; 3] {
     const G: f64 = 1.220_744_084_605_759_5;
     let a = [1.0 / G, 1.0 / (G * G), 1.0 / (G * G * G)];
     a.map(|a| (0.5 + a * k as f64).fract())
@@ -48,7 +48,7 @@ fn index(eta: f64, w: Vec3) -> f64 {
 
 /// The configurations every consistency test runs: every sampling route, both masking forms,
 /// both transports, both BSDFs, several NDF families.
-const CONFIGS: &[&str] = &[
+pub(super) const CONFIGS: &[&str] = &[
     r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3},"masking":"height_correlated","sampling":"visible_normals"}"#,
     r#"{"bsdf":"dielectric","eta":0.6666666666666666,"ndf":{"family":"ggx","alpha_x":0.1,"alpha_y":0.5},"masking":"uncorrelated","sampling":"normals","transport":"importance"}"#,
     r#"{"bsdf":"dielectric","eta":1.33,"ndf":{"family":"beckmann","alpha_x":0.4,"alpha_y":0.2},"masking":"height_correlated","sampling":"visible_normals","transport":"importance"}"#,
@@ -63,7 +63,7 @@ const CONFIGS: &[&str] = &[
 
 /// Incidences: normal, oblique, grazing (cos θ = 1e-3), and for a dielectric the same from
 /// inside plus the critical angle ± 0.02 on the side where it exists.
-fn incidences(eta: Option<f64>) -> Vec<Vec3> {
+pub(super) fn incidences(eta: Option<f64>) -> Vec<Vec3> {
     let mut out = vec![
         [0.0, 0.0, 1.0],
         from_spherical(0.7, 0.4),

@@ -43,13 +43,7 @@ pub fn plan<'a>(
             };
             let (masses, spent) = shared.pdf_masses(bsdf);
             let result = sphere_chi2_against(
-                &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| {
-                    let mut samples = vec![None; u.len()];
-                    bsdf.sample_batch(wi, u, &mut samples);
-                    for (o, s) in out.iter_mut().zip(samples) {
-                        *o = s.filter(|s| s.pdf > 0.0).map(|s| s.wo);
-                    }
-                },
+                &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| bsdf.sample_wo_batch(wi, u, out),
                 masses.clone(),
                 &config,
             );
