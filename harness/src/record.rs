@@ -144,10 +144,12 @@ pub enum Measured {
     },
     /// A statistical test.
     PValue {
-        /// The p-value.
+        /// The p-value (of a chi-square: the test's, from its statistic split into the cos θ
+        /// marginal's smooth components and the rest, `oracle/chi2/components.rs`; so not
+        /// Q(dof/2, statistic/2) of the two fields below).
         #[serde(deserialize_with = "nullable_f64")]
         p: f64,
-        /// The test statistic.
+        /// The test statistic (of a chi-square: Pearson's, over the whole pooled table).
         #[serde(deserialize_with = "nullable_f64")]
         statistic: f64,
         /// Degrees of freedom (0 where the test has none, e.g. Kolmogorov–Smirnov).
@@ -276,9 +278,9 @@ pub enum RecordData {
         phi_edges: Vec<f64>,
     },
     /// The observed and expected counts of a BSDF's chi-square test over the whole sphere: each
-    /// hemisphere on the grid of [`RecordData::Chi2Table`] (the lower one mirrored through the
-    /// surface: its row 0 is at the horizon, its last row at −z), the expected counts those of
-    /// the successful samples.
+    /// hemisphere on a grid as [`RecordData::Chi2Table`]'s, with edges of its own (the lower
+    /// one mirrored through the surface: its row 0 is at the horizon, its last row at −z), the
+    /// expected counts those of the successful samples.
     SphereChi2Table {
         /// cos θ-rows R of each hemisphere.
         rows: usize,
@@ -298,6 +300,18 @@ pub enum RecordData {
         /// Expected counts per cell below the surface, mirrored.
         #[serde(deserialize_with = "crate::record_serde::nullable_f64_vec")]
         lower_expected: Vec<f64>,
+        /// The upper hemisphere's row edges z₀ = 0 < … < z_R = 1 (cos θ; empty: i/R).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        upper_z_edges: Vec<f64>,
+        /// The upper hemisphere's column edges φ₀ = 0 < … < φ_2R = 2π (empty: 2πj/2R).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        upper_phi_edges: Vec<f64>,
+        /// The lower hemisphere's row edges (mirrored cos θ, as `upper_z_edges`).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        lower_z_edges: Vec<f64>,
+        /// The lower hemisphere's column edges.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        lower_phi_edges: Vec<f64>,
     },
     /// A Kolmogorov–Smirnov marginal: the model's CDF and an empirical CDF at `x`.
     KsMarginal {

@@ -353,6 +353,7 @@ pub fn record(plan: &Chi2Plan, result: &Chi2Result, artefacts: &[String]) -> Val
         "statistic": finite_or_null(result.statistic),
         "dof": result.dof,
         "p_value": result.p_value,
+        "components": result.components,
         "alpha": result.alpha,
         "verdict": result.verdict,
         "reason": result.reason.as_ref().map(|r| r.to_string()),

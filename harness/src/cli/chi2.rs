@@ -238,6 +238,20 @@ fn run_external(
     )
 }
 
+/// The statistic's two parts as the text output prints them.
+fn parts_text(c: &crate::oracle::chi2::components::Components) -> String {
+    format!(
+        "cos θ marginal's smooth components χ² {:.4} (dof {}, p {:.3e}), rest χ² {:.4} (dof {}, \
+         p {:.3e}); p = 1 − (1 − min)²",
+        c.smooth.statistic,
+        c.smooth.dof,
+        c.smooth.p_value,
+        c.rest.statistic,
+        c.rest.dof,
+        c.rest.p_value
+    )
+}
+
 /// Writes the artefacts (with `--out`) and prints the result, text or JSON; the exit status.
 fn report(
     args: &Chi2Args,
@@ -276,6 +290,7 @@ fn report(
                 "model {spec_text}\n\
              grid {} φ × {} cos θ cells, {} samples, seed {}\n\
              statistic {:.4}, dof {}, p-value {:.6e}, pooled cells {}\n\
+             parts: {}\n\
              expected mass {:.12} (cubature error bound {:.2e} counts)\n\
              sampling+binning {:.3e} samples/s ({:.3} s), expected-count integration {:.3} s\n\
              verdict {} at α = {:e}{}\n{}\
@@ -288,6 +303,9 @@ fn report(
                 r.dof,
                 r.p_value,
                 r.pooled_cells,
+                r.components
+                    .as_ref()
+                    .map_or("none (one row)".to_string(), parts_text),
                 r.expected_mass,
                 r.expected_error_bound,
                 r.samples_per_second(),

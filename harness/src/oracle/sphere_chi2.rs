@@ -6,10 +6,14 @@
 //! 1. **Observed counts.** `samples` directions are drawn with u ∈ [0, 1)³ from the
 //!    counter-based stream of each fixed chunk of [`CHUNK`] sample indices (three uniforms a
 //!    sample, [`crate::random::Stream::uniform`]), handed to the sampler a block at a time, and
-//!    binned: a direction with z ≥ 0 into the upper [`HemisphereGrid`] (R z-rows × 2R
-//!    φ-columns), one with z < 0 into the same grid of the lower hemisphere mirrored through
-//!    the surface (cell of (x, y, −z)). A sample the sampler declares failed (`None`) is counted
-//!    apart. Counts are integers summed per chunk: identical whatever the thread count.
+//!    binned: a direction with z ≥ 0 into the upper hemisphere's [`HemisphereGrid`] (R
+//!    z-rows × 2R φ-columns), one with z < 0 into the lower hemisphere's, mirrored through the
+//!    surface (cell of (x, y, −z)). Each hemisphere's cells follow its lobe, as the NDF
+//!    chi-square's do ([`cells::layout`]): rows at the quantiles of the pdf's cos θ marginal
+//!    over that hemisphere, columns at its φ quantiles for the off-axis lobes a BSDF has (the
+//!    mirror and refracted directions), so that every cell expects about the same count.
+//!    A sample the sampler declares failed (`None`) is counted apart. Counts are integers
+//!    summed per chunk: identical whatever the thread count.
 //! 2. **Expected masses.** In each hemisphere the pdf's lobe is measured from the pdf alone
 //!    ([`crate::oracle::lobe`]: a reflection lobe about the mirror direction and a
 //!    transmission lobe about the refracted one are off-axis modes it finds), and every cell is
@@ -38,8 +42,12 @@
 //!    (`bsdf.sample_consistency` in the checks): folding it in here would let the cubature's
 //!    error in the total mass (up to 1e-4 relative, × 10⁶ samples = 100 counts) decide the test.
 //! 5. **Pooling and p-value** as the NDF chi-square ([`crate::oracle::chi2`]): cells expecting
-//!    fewer than [`crate::tolerance::MIN_EXPECTED`] samples are pooled, dof = bins − 1, p = Q(dof/2, χ²/2).
+//!    fewer than [`crate::tolerance::MIN_EXPECTED`] samples are pooled, dof = bins − 1; the
+//!    p-value combines the statistic's two parts ([`crate::oracle::chi2::components`]) on the
+//!    table of both hemispheres' rows ordered by cos θ from 1 to −1.
 
+use crate::oracle::chi2::cells::{self, Layout};
+use crate::oracle::chi2::components::{components, Components};
 use crate::oracle::chi2::{
     expected_mass_global_until, pooled_statistic, Chi2Config, Expected, Verdict,
 };
@@ -79,14 +87,6 @@ pub struct SphereObserved {
 }
 
 impl SphereObserved {
-    fn zero(cells: usize) -> Self {
-        Self {
-            upper: vec![0; cells],
-            lower: vec![0; cells],
-            ..Self::default()
-        }
-    }
-
     fn merge(mut self, other: Self) -> Self {
         for (a, b) in self.upper.iter_mut().zip(&other.upper) {
             *a += b;
@@ -114,12 +114,21 @@ impl SphereObserved {
 pub struct SphereChi2Result {
     /// R: each hemisphere has R z-rows × 2R φ-columns.
     pub resolution: usize,
+    /// The upper hemisphere's cells.
+    pub upper_grid: HemisphereGrid,
+    /// The lower hemisphere's cells (mirrored: row 0 at the horizon).
+    pub lower_grid: HemisphereGrid,
     /// The χ² statistic (NaN after a sanity failure).
     pub statistic: f64,
     /// Degrees of freedom (0 after a sanity failure).
     pub dof: usize,
-    /// Q(dof/2, χ²/2) (0 after a sanity failure).
+    /// The test's p-value (0 after a sanity failure): the combination of the two parts of
+    /// `components`, the rows ordered by cos θ over the whole sphere (upper rows from the
+    /// pole down, then the lower ones), as for the hemisphere's test
+    /// ([`crate::oracle::chi2::components`]).
     pub p_value: f64,
+    /// The statistic's two parts: the cos θ marginal's first smooth components and the rest.
+    pub components: Option<Components>,
     /// The level the verdict was taken at.
     pub alpha: f64,
     /// Pass or fail.
@@ -187,15 +196,23 @@ impl SphereChi2Result {
 /// domain is binned again one by one for the errors (the same counts either way).
 pub fn observe_sphere(
     sample: &SphereSampler<'_>,
-    grid: HemisphereGrid,
+    (upper_grid, lower_grid): (HemisphereGrid, HemisphereGrid),
     samples: u64,
     seed: u64,
 ) -> SphereObserved {
-    let finder = CellFinder::new(grid.clone());
+    let zero = || SphereObserved {
+        upper: vec![0; upper_grid.cells()],
+        lower: vec![0; lower_grid.cells()],
+        ..SphereObserved::default()
+    };
+    let (upper_finder, lower_finder) = (
+        CellFinder::new(upper_grid.clone()),
+        CellFinder::new(lower_grid.clone()),
+    );
     draw_chunks(
         samples,
         seed,
-        || (SphereObserved::zero(grid.cells()), Buffers::default()),
+        || (zero(), Buffers::default()),
         |(obs, buf), index, u| {
             buf.out.clear();
             buf.out.resize(u.len(), None);
@@ -210,13 +227,13 @@ pub fn observe_sphere(
                 }
             }
             buf.cells.resize(buf.upper.len().max(buf.lower.len()), 0);
-            let upper = finder.cells_of(&buf.upper, &mut buf.cells[..buf.upper.len()]);
+            let upper = upper_finder.cells_of(&buf.upper, &mut buf.cells[..buf.upper.len()]);
             if upper {
                 for &c in &buf.cells[..buf.upper.len()] {
                     obs.upper[c] += 1;
                 }
             }
-            let lower = finder.cells_of(&buf.lower, &mut buf.cells[..buf.lower.len()]);
+            let lower = lower_finder.cells_of(&buf.lower, &mut buf.cells[..buf.lower.len()]);
             if lower {
                 for &c in &buf.cells[..buf.lower.len()] {
                     obs.lower[c] += 1;
@@ -227,10 +244,10 @@ pub fn observe_sphere(
                     obs.failed += 1;
                     continue;
                 };
-                let (cells, mirrored) = match (w[2] >= 0.0, upper, lower) {
+                let (cells, finder, mirrored) = match (w[2] >= 0.0, upper, lower) {
                     (true, true, _) | (false, _, true) => continue,
-                    (true, false, _) => (&mut obs.upper, w),
-                    (false, _, false) => (&mut obs.lower, [w[0], w[1], -w[2]]),
+                    (true, false, _) => (&mut obs.upper, &upper_finder, w),
+                    (false, _, false) => (&mut obs.lower, &lower_finder, [w[0], w[1], -w[2]]),
                 };
                 match finder.cell_of(mirrored) {
                     Ok(c) => cells[c] += 1,
@@ -245,7 +262,7 @@ pub fn observe_sphere(
         },
     )
     .into_iter()
-    .fold(SphereObserved::zero(grid.cells()), |a, (b, _)| a.merge(b))
+    .fold(zero(), |a, (b, _)| a.merge(b))
 }
 
 /// A chunk's buffers, reused block to block: the sampled directions, those of each
@@ -342,14 +359,16 @@ pub fn mass_noncentrality(e: &Expected, samples: u64) -> f64 {
 
 /// The masses of the cells of one hemisphere (`lower`: mirrored) of the density `pdf` (step 2),
 /// by globally adaptive cubature to the summed error `target` within [`MASS_BUDGET`]
-/// evaluations ([`expected_mass_global_until`]), or until `enough` holds of the masses.
+/// evaluations ([`expected_mass_global_until`]), or until `enough` holds of the masses; the
+/// cells are `cells`'s (a given grid, or R rows and 2R columns placed at the quantiles of the
+/// hemisphere's marginals by [`cells::layout`]), returned with the masses.
 fn expected_hemisphere_until(
     pdf: &SpherePdf<'_>,
-    grid: HemisphereGrid,
+    cells: Cells,
     lower: bool,
     target: f64,
     enough: &dyn Fn(&Expected) -> bool,
-) -> Expected {
+) -> (HemisphereGrid, Expected) {
     let mirrored = |w: &[Vec3], out: &mut [f64]| {
         if lower {
             let m: Vec<Vec3> = w.iter().map(|v| [v[0], v[1], -v[2]]).collect();
@@ -359,25 +378,43 @@ fn expected_hemisphere_until(
         }
     };
     let lobe = lobe::measure_with_batch(&mirrored, &lobe::Options::default());
+    let (grid, placed) = match cells {
+        Cells::Given(grid) => (grid, 0),
+        Cells::FollowLobe(resolution) => {
+            cells::layout(&mirrored, &lobe, resolution, &[], Layout::FollowSteppedLobe)
+        }
+    };
     let (mut e, _converged) =
-        expected_mass_global_until(&mirrored, grid, &lobe, target, MASS_BUDGET, enough);
-    e.evaluations += lobe.evaluations;
-    e
+        expected_mass_global_until(&mirrored, grid.clone(), &lobe, target, MASS_BUDGET, enough);
+    e.evaluations += lobe.evaluations + placed;
+    (grid, e)
 }
 
-/// The masses of the cells of one hemisphere (`lower`: mirrored) of the density `pdf`, to the
-/// summed error `target` (within [`MASS_BUDGET`] evaluations).
+/// Where one hemisphere's cells are.
+#[derive(Debug, Clone)]
+pub enum Cells {
+    /// On this grid.
+    Given(HemisphereGrid),
+    /// R rows at the quantiles of the hemisphere's cos θ marginal and 2R columns (at its φ
+    /// quantiles for an off-axis or anisotropic lobe), as the hemisphere's chi-square places
+    /// them ([`cells::layout`], its marginals by a fixed rule: [`Layout::FollowSteppedLobe`]);
+    /// the equal-area grid of R where the hemisphere has no mass.
+    FollowLobe(usize),
+}
+
+/// The masses of the cells of one hemisphere (`lower`: mirrored) of the density `pdf` on
+/// `grid`, to the summed error `target` (within [`MASS_BUDGET`] evaluations).
 pub fn expected_hemisphere(
     pdf: &SpherePdf<'_>,
     grid: HemisphereGrid,
     lower: bool,
     target: f64,
 ) -> Expected {
-    expected_hemisphere_until(pdf, grid, lower, target, &|_| false)
+    expected_hemisphere_until(pdf, Cells::Given(grid), lower, target, &|_| false).1
 }
 
-/// The expected masses of both hemispheres (upper, lower) of `pdf` on `grid` (step 2), each to
-/// the summed error `target`.
+/// The expected masses of both hemispheres (upper, lower) of `pdf` on `grid`, each to the
+/// summed error `target`.
 pub fn expected_sphere(
     pdf: &SpherePdf<'_>,
     grid: HemisphereGrid,
@@ -389,55 +426,87 @@ pub fn expected_sphere(
     )
 }
 
-/// The expected masses of both hemispheres (upper, lower) of `pdf` on `grid` for a chi-square
-/// of `samples` samples (step 2): each refined until its [`mass_noncentrality`] is at most
-/// half of [`MASS_NONCENTRALITY`], or to the summed error [`mass_target`].
-pub fn chi2_masses(
-    pdf: &SpherePdf<'_>,
-    grid: HemisphereGrid,
-    samples: u64,
-) -> (Expected, Expected) {
-    let target = mass_target(samples);
-    let enough = |e: &Expected| mass_noncentrality(e, samples) <= 0.5 * MASS_NONCENTRALITY;
-    (
-        expected_hemisphere_until(pdf, grid.clone(), false, target, &enough),
-        expected_hemisphere_until(pdf, grid, true, target, &enough),
-    )
+/// The cells of both hemispheres of a whole-sphere chi-square and their expected masses.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SphereMasses {
+    /// The upper hemisphere's cells.
+    pub upper_grid: HemisphereGrid,
+    /// Their masses.
+    pub upper: Expected,
+    /// The lower hemisphere's cells (mirrored: row 0 at the horizon).
+    pub lower_grid: HemisphereGrid,
+    /// Their masses.
+    pub lower: Expected,
 }
 
-/// Tests `sample` against `pdf` over the sphere.
+/// The cells of both hemispheres of `pdf` at `resolution` (each following its hemisphere's
+/// lobe, [`Cells::FollowLobe`]) and their expected masses for a chi-square of `samples`
+/// samples (step 2): each refined until its [`mass_noncentrality`] is at most half of
+/// [`MASS_NONCENTRALITY`], or to the summed error [`mass_target`].
+pub fn chi2_masses(pdf: &SpherePdf<'_>, resolution: usize, samples: u64) -> SphereMasses {
+    chi2_masses_on(pdf, Cells::FollowLobe(resolution.max(1)), samples)
+}
+
+/// [`chi2_masses`] with both hemispheres' cells given by `cells` (e.g. the equal-area grid).
+pub fn chi2_masses_on(pdf: &SpherePdf<'_>, cells: Cells, samples: u64) -> SphereMasses {
+    let target = mass_target(samples);
+    let enough = |e: &Expected| mass_noncentrality(e, samples) <= 0.5 * MASS_NONCENTRALITY;
+    let (upper_grid, upper) = expected_hemisphere_until(pdf, cells.clone(), false, target, &enough);
+    let (lower_grid, lower) = expected_hemisphere_until(pdf, cells, true, target, &enough);
+    SphereMasses {
+        upper_grid,
+        upper,
+        lower_grid,
+        lower,
+    }
+}
+
+/// Tests `sample` against `pdf` over the sphere, on cells that follow each hemisphere's
+/// lobe.
 pub fn sphere_chi2(
     sample: &SphereSampler<'_>,
     pdf: &SpherePdf<'_>,
     config: &Chi2Config,
 ) -> SphereChi2Result {
-    let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
     let t = Instant::now();
-    let expected = chi2_masses(pdf, grid, config.samples);
+    let masses = chi2_masses(pdf, config.resolution, config.samples);
     let integration_seconds = t.elapsed().as_secs_f64();
-    let mut r = sphere_chi2_against(sample, expected, config);
+    let mut r = sphere_chi2_against(sample, masses, config);
     r.integration_seconds = integration_seconds;
     r
 }
 
-/// [`sphere_chi2`] against expected masses already integrated on the grid of
-/// `config.resolution` (by [`chi2_masses`]); `integration_seconds`
-/// of the result is 0.
+/// [`sphere_chi2`] against cells and expected masses already integrated (by
+/// [`chi2_masses`]); `integration_seconds` of the result is 0.
 pub fn sphere_chi2_against(
     sample: &SphereSampler<'_>,
-    (expected_upper, expected_lower): (Expected, Expected),
+    masses: SphereMasses,
     config: &Chi2Config,
 ) -> SphereChi2Result {
-    let grid = HemisphereGrid::new(config.resolution.max(1)).expect("resolution ≥ 1");
+    let SphereMasses {
+        upper_grid,
+        upper: expected_upper,
+        lower_grid,
+        lower: expected_lower,
+    } = masses;
     let t = Instant::now();
-    let observed = observe_sphere(sample, grid.clone(), config.samples, config.seed);
+    let observed = observe_sphere(
+        sample,
+        (upper_grid.clone(), lower_grid.clone()),
+        config.samples,
+        config.seed,
+    );
     let sampling_seconds = t.elapsed().as_secs_f64();
     let integration_seconds = 0.0;
+    let columns = upper_grid.columns();
     let mut result = SphereChi2Result {
-        resolution: grid.rows(),
+        resolution: upper_grid.rows(),
+        upper_grid,
+        lower_grid,
         statistic: f64::NAN,
         dof: 0,
         p_value: 0.0,
+        components: None,
         alpha: config.alpha,
         verdict: Verdict::Fail,
         reason: None,
@@ -471,9 +540,13 @@ pub fn sphere_chi2_against(
     result.sanity_failure = false;
     result.statistic = statistic;
     result.dof = bins - 1;
-    result.p_value =
-        statrs::function::gamma::checked_gamma_ur(0.5 * result.dof as f64, 0.5 * statistic)
-            .unwrap_or(f64::NAN);
+    let (table, expected) = along_cos_theta(&result, columns);
+    result.components = components(&table, &expected, columns);
+    result.p_value = match &result.components {
+        Some(c) => c.p_value,
+        None => statrs::function::gamma::checked_gamma_ur(0.5 * result.dof as f64, 0.5 * statistic)
+            .unwrap_or(f64::NAN),
+    };
     if result.p_value >= config.alpha {
         result.verdict = Verdict::Pass;
     } else {
@@ -483,6 +556,32 @@ pub fn sphere_chi2_against(
         ));
     }
     result
+}
+
+/// The observed and expected counts as one table of 2R rows ordered by cos θ from 1 to −1:
+/// the upper hemisphere's rows from the pole to the horizon, then the lower (mirrored)
+/// hemisphere's from the horizon to its pole.
+fn along_cos_theta(r: &SphereChi2Result, columns: usize) -> (Vec<u64>, Vec<f64>) {
+    let expected = r.expected_counts();
+    let (upper_e, lower_e) = expected.split_at(r.observed.upper.len());
+    let (mut table, mut counts) = (Vec::new(), Vec::new());
+    for (o, e) in r
+        .observed
+        .upper
+        .chunks(columns)
+        .zip(upper_e.chunks(columns))
+        .rev()
+        .chain(
+            r.observed
+                .lower
+                .chunks(columns)
+                .zip(lower_e.chunks(columns)),
+        )
+    {
+        table.extend_from_slice(o);
+        counts.extend_from_slice(e);
+    }
+    (table, counts)
 }
 
 /// The sanity failures of step 3, in order.
@@ -554,7 +653,9 @@ mod tests {
         let pdf = pdf_at(bsdf.as_ref(), wi);
         let grid = HemisphereGrid::new(16).unwrap();
         let samples = 1_000_000;
-        let (u, l) = chi2_masses(&pdf, grid.clone(), samples);
+        let SphereMasses {
+            upper: u, lower: l, ..
+        } = chi2_masses_on(&pdf, Cells::Given(grid.clone()), samples);
         let (tu, tl) = expected_sphere(&pdf, grid, mass_target(samples));
         let lambda = mass_noncentrality(&u, samples) + mass_noncentrality(&l, samples);
         assert!(lambda <= MASS_NONCENTRALITY, "λ = {lambda}");
@@ -617,10 +718,15 @@ mod tests {
             }
         };
         let samples = 200_000;
-        let observed = observe_sphere(&sampler, grid.clone(), samples, 5);
+        let grids = (grid.clone(), grid.clone());
+        let observed = observe_sphere(&sampler, grids.clone(), samples, 5);
         // One by one, over the same uniforms.
         let finder = CellFinder::new(grid.clone());
-        let mut want = SphereObserved::zero(grid.cells());
+        let mut want = SphereObserved {
+            upper: vec![0; grid.cells()],
+            lower: vec![0; grid.cells()],
+            ..SphereObserved::default()
+        };
         let blocks = draw_chunks(samples, 5, Vec::new, |acc, index, u| {
             acc.extend(
                 u.iter()
@@ -662,7 +768,7 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            let again = pool.install(|| observe_sphere(&sampler, grid.clone(), samples, 5));
+            let again = pool.install(|| observe_sphere(&sampler, grids.clone(), samples, 5));
             assert_eq!(again, observed, "{threads} threads");
         }
     }

@@ -125,23 +125,52 @@ pub fn file_names(data: &RecordData) -> &'static [&'static str] {
     }
 }
 
-/// The hemispheres of a sphere table: (file prefix, title suffix, observed, expected).
-pub fn hemispheres(data: &RecordData) -> Vec<(&'static str, &'static str, &[u64], &[f64])> {
+/// One hemisphere of a sphere table.
+pub struct Hemisphere<'a> {
+    /// The artefacts' file prefix (`upper`, `lower`).
+    pub prefix: &'static str,
+    /// The title suffix.
+    pub side: &'static str,
+    /// Observed counts per cell.
+    pub observed: &'a [u64],
+    /// Expected counts per cell.
+    pub expected: &'a [f64],
+    /// Its cells' cos θ edges (empty: equal).
+    pub z_edges: &'a [f64],
+    /// Its cells' φ edges (empty: equal).
+    pub phi_edges: &'a [f64],
+}
+
+/// The hemispheres of a sphere table, upper then lower (none for another kind of data).
+pub fn hemispheres(data: &RecordData) -> Vec<Hemisphere<'_>> {
     match data {
         RecordData::SphereChi2Table {
             upper_observed,
             upper_expected,
             lower_observed,
             lower_expected,
+            upper_z_edges,
+            upper_phi_edges,
+            lower_z_edges,
+            lower_phi_edges,
             ..
         } => vec![
-            ("upper", "above the surface", upper_observed, upper_expected),
-            (
-                "lower",
-                "below the surface (mirrored)",
-                lower_observed,
-                lower_expected,
-            ),
+            Hemisphere {
+                prefix: "upper",
+                side: "above the surface",
+                observed: upper_observed,
+                expected: upper_expected,
+                z_edges: upper_z_edges,
+                phi_edges: upper_phi_edges,
+            },
+            Hemisphere {
+                prefix: "lower",
+                side: "below the surface (mirrored)",
+                observed: lower_observed,
+                expected: lower_expected,
+                z_edges: lower_z_edges,
+                phi_edges: lower_phi_edges,
+            },
         ],
         _ => Vec::new(),
     }
@@ -353,30 +382,31 @@ pub fn write_record_data(
                     .find(|x| *x == n)
                     .unwrap_or("chi2.json")
             };
-            for (prefix, side, observed, expected) in hemispheres(data) {
+            for h in hemispheres(data) {
+                let edges = (h.z_edges, h.phi_edges);
                 for (name, text) in chi2_tables(
                     generated_by,
                     (*rows, *columns),
-                    (&[], &[]),
+                    edges,
                     *samples,
                     *seed,
-                    observed,
-                    expected,
+                    h.observed,
+                    h.expected,
                 ) {
-                    files.push((named(format!("{prefix}_{name}")), text));
+                    files.push((named(format!("{}_{name}", h.prefix)), text));
                 }
                 #[cfg(feature = "html")]
                 for (name, svg) in chi2_heat_maps(
-                    &format!("{title} · {side}"),
+                    &format!("{title} · {}", h.side),
                     (*rows, *columns),
-                    (&[], &[]),
-                    observed,
-                    expected,
+                    edges,
+                    h.observed,
+                    h.expected,
                 )? {
-                    files.push((named(format!("{prefix}_{name}")), svg));
+                    files.push((named(format!("{}_{name}", h.prefix)), svg));
                 }
                 #[cfg(not(feature = "html"))]
-                let _ = (title, side);
+                let _ = title;
             }
         }
         RecordData::KsMarginal { .. } => {

@@ -131,9 +131,9 @@ fn chi2_maps(r: &CheckRecord) -> Result<String, PlotError> {
     }
     let incidence = case_str(r, "incidence").unwrap_or("?").replace('_', " ");
     let mut h = String::new();
-    for ((_, side, observed, expected), what) in
-        sides.into_iter().zip(["reflection", "transmission"])
-    {
+    for (hemisphere, what) in sides.into_iter().zip(["reflection", "transmission"]) {
+        let (side, observed, expected) =
+            (hemisphere.side, hemisphere.observed, hemisphere.expected);
         let empty = observed.iter().all(|&o| o == 0) && expected.iter().all(|&e| e == 0.0);
         if empty {
             let _ = write!(
@@ -144,7 +144,8 @@ fn chi2_maps(r: &CheckRecord) -> Result<String, PlotError> {
             continue;
         }
         let title = format!("{incidence} · {what}, {side}");
-        let maps = chi2_heat_maps(&title, (*rows, *columns), (&[], &[]), observed, expected)?;
+        let edges = (hemisphere.z_edges, hemisphere.phi_edges);
+        let maps = chi2_heat_maps(&title, (*rows, *columns), edges, observed, expected)?;
         h.push_str("<div class=\"plots maps\">");
         for (name, svg) in &maps {
             h.push_str(&img(svg, &format!("bsdf.chi2 {incidence} {what} {name}")));

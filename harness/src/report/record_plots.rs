@@ -36,16 +36,16 @@ pub(crate) fn data_plots(r: &CheckRecord) -> Result<String, PlotError> {
         }
         Some(data @ RecordData::SphereChi2Table { rows, columns, .. }) => {
             let mut tags = String::new();
-            for (_, side, observed, expected) in super::artefacts::hemispheres(data) {
+            for h in super::artefacts::hemispheres(data) {
                 let maps = chi2_heat_maps(
-                    &format!("{title} · {side}"),
+                    &format!("{title} · {}", h.side),
                     (*rows, *columns),
-                    (&[], &[]),
-                    observed,
-                    expected,
+                    (h.z_edges, h.phi_edges),
+                    h.observed,
+                    h.expected,
                 )?;
                 for (name, svg) in &maps {
-                    tags.push_str(&img(svg, &format!("{} {side} {name}", r.check)));
+                    tags.push_str(&img(svg, &format!("{} {} {name}", r.check, h.side)));
                 }
             }
             Ok(tags)

@@ -158,18 +158,7 @@ pub fn run(plan: &BsdfChi2Plan) -> SphereChi2Result {
 
 /// The observed and expected counts of both hemispheres, as the `bsdf.chi2` records carry them.
 pub fn table(result: &SphereChi2Result) -> RecordData {
-    let expected = result.expected_counts();
-    let cells = result.observed.upper.len();
-    RecordData::SphereChi2Table {
-        rows: result.resolution,
-        columns: 2 * result.resolution,
-        samples: result.samples,
-        seed: result.seed,
-        upper_observed: result.observed.upper.clone(),
-        upper_expected: expected[..cells].to_vec(),
-        lower_observed: result.observed.lower.clone(),
-        lower_expected: expected[cells..].to_vec(),
-    }
+    crate::check::bsdf::chi2_table(result)
 }
 
 /// The record of a run as one JSON object (`mfh chi2 --bsdf … --json`).
@@ -180,6 +169,7 @@ pub fn record(plan: &BsdfChi2Plan, result: &SphereChi2Result, artefacts: &[Strin
         "statistic": finite_or_null(result.statistic),
         "dof": result.dof,
         "p_value": result.p_value,
+        "components": result.components,
         "alpha": result.alpha,
         "verdict": result.verdict,
         "reason": result.reason,

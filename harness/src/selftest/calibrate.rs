@@ -274,7 +274,6 @@ pub fn calibrate_bsdf(
     progress: Option<super::Progress<'_>>,
 ) -> Result<Vec<TestCalibration>, String> {
     use crate::check::bsdf::{incidences, pdf_at};
-    use crate::oracle::domain::HemisphereGrid;
     use crate::oracle::sphere_chi2::{chi2_masses, sphere_chi2_against};
     let spec: mfh_reference::bsdf::BsdfSpec =
         serde_json::from_str(BSDF_MODEL).map_err(|e| format!("calibration BSDF: {e}"))?;
@@ -282,14 +281,13 @@ pub fn calibrate_bsdf(
     let value = serde_json::to_value(&spec).unwrap_or(Value::Null);
     let samples = profile.chi2_samples();
     let resolution = crate::check::bsdf::CHI2_RESOLUTION;
-    let grid = HemisphereGrid::new(resolution).expect("R ≥ 1");
     let mut out = Vec::new();
     for inc in incidences(bsdf.as_ref())
         .into_iter()
         .filter(|i| matches!(i.name, "oblique" | "total_internal_reflection"))
     {
         let t = Instant::now();
-        let expected = chi2_masses(&pdf_at(bsdf.as_ref(), inc.wi), grid.clone(), samples);
+        let expected = chi2_masses(&pdf_at(bsdf.as_ref(), inc.wi), resolution, samples);
         let p: Vec<Option<f64>> = (0..runs)
             .into_par_iter()
             .map(|i| {

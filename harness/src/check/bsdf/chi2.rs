@@ -4,7 +4,9 @@
 use super::{BsdfSubject, Incidence, Integrals, SOURCE};
 use crate::check::{applied, covers, Check, PlannedCheck, Profile};
 use crate::oracle::chi2::{Chi2Config, Verdict as Chi2Verdict};
-use crate::oracle::sphere_chi2::{sphere_chi2_against, MASS_BUDGET, MASS_NONCENTRALITY};
+use crate::oracle::sphere_chi2::{
+    sphere_chi2_against, SphereChi2Result, MASS_BUDGET, MASS_NONCENTRALITY,
+};
 use crate::record::{Measured, OracleValue, RecordData, Verdict};
 use crate::tolerance::STATISTICAL_ALPHA;
 use mfh_reference::geometry::Vec3;
@@ -64,18 +66,7 @@ pub fn plan<'a>(
                     json!(result.mass_noncentrality()),
                 );
             }
-            let expected = result.expected_counts();
-            let cells = result.observed.upper.len();
-            r.data = Some(RecordData::SphereChi2Table {
-                rows: result.resolution,
-                columns: 2 * result.resolution,
-                samples,
-                seed: ctx.seed,
-                upper_observed: result.observed.upper.clone(),
-                upper_expected: expected[..cells].to_vec(),
-                lower_observed: result.observed.lower.clone(),
-                lower_expected: expected[cells..].to_vec(),
-            });
+            r.data = Some(table(&result));
             if result.sanity_failure {
                 r.verdict = Verdict::Fail;
                 if let Value::Object(case) = &mut r.case {
@@ -109,4 +100,25 @@ pub fn plan<'a>(
             }
             Ok(())
         })
+}
+
+/// The observed and expected counts of both hemispheres with their cells' edges, as the
+/// `bsdf.chi2` records (and `mfh chi2 --bsdf`) carry them.
+pub fn table(result: &SphereChi2Result) -> RecordData {
+    let expected = result.expected_counts();
+    let cells = result.observed.upper.len();
+    RecordData::SphereChi2Table {
+        rows: result.resolution,
+        columns: 2 * result.resolution,
+        samples: result.samples,
+        seed: result.seed,
+        upper_observed: result.observed.upper.clone(),
+        upper_expected: expected[..cells].to_vec(),
+        lower_observed: result.observed.lower.clone(),
+        lower_expected: expected[cells..].to_vec(),
+        upper_z_edges: result.upper_grid.z_edges(),
+        upper_phi_edges: result.upper_grid.phi_edges(),
+        lower_z_edges: result.lower_grid.z_edges(),
+        lower_phi_edges: result.lower_grid.phi_edges(),
+    }
 }

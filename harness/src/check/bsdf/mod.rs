@@ -25,12 +25,12 @@ mod reciprocity;
 mod stability;
 
 pub use against::plan_against;
-pub use chi2::RESOLUTION as CHI2_RESOLUTION;
+pub use chi2::{table as chi2_table, RESOLUTION as CHI2_RESOLUTION};
 
 use super::{PlannedCheck, Profile};
 use crate::oracle::chi2::Expected;
 use crate::oracle::domain::HemisphereGrid;
-use crate::oracle::sphere_chi2::{chi2_masses, draw_chunks, expected_sphere};
+use crate::oracle::sphere_chi2::{chi2_masses, draw_chunks, expected_sphere, SphereMasses};
 use crate::oracle::Estimate;
 use crate::subject::bsdf::BsdfSubject;
 use mfh_reference::bsdf::{Bsdf, BsdfSample};
@@ -147,7 +147,7 @@ pub fn fold_samples<A: Send>(
 pub struct Integrals {
     wi: Vec3,
     samples: u64,
-    pdf: OnceLock<((Expected, Expected), u64)>,
+    pdf: OnceLock<(SphereMasses, u64)>,
     eval: OnceLock<(Estimate, Estimate)>,
 }
 
@@ -162,13 +162,13 @@ impl Integrals {
         })
     }
 
-    /// The pdf's masses over the cells of both hemispheres (upper, lower) on the chi-square's
-    /// grid, to the accuracy its `samples` need ([`chi2_masses`]), and the evaluations they cost.
-    pub fn pdf_masses(&self, bsdf: &dyn Bsdf) -> (&(Expected, Expected), u64) {
+    /// The chi-square's cells of both hemispheres (following each hemisphere's lobe) and the
+    /// pdf's masses over them, to the accuracy its `samples` need ([`chi2_masses`]), and the
+    /// evaluations they cost.
+    pub fn pdf_masses(&self, bsdf: &dyn Bsdf) -> (&SphereMasses, u64) {
         let masses = self.pdf.get_or_init(|| {
-            let grid = HemisphereGrid::new(chi2::RESOLUTION).expect("R ≥ 1");
-            let e = chi2_masses(&pdf_at(bsdf, self.wi), grid, self.samples);
-            let spent = e.0.evaluations + e.1.evaluations;
+            let e = chi2_masses(&pdf_at(bsdf, self.wi), chi2::RESOLUTION, self.samples);
+            let spent = e.upper.evaluations + e.lower.evaluations;
             (e, spent)
         });
         (&masses.0, masses.1)
@@ -176,10 +176,10 @@ impl Integrals {
 
     /// ∫ pdf dωo with its error bound.
     pub fn pdf_mass(&self, bsdf: &dyn Bsdf) -> Estimate {
-        let ((upper, lower), spent) = self.pdf_masses(bsdf);
+        let (masses, spent) = self.pdf_masses(bsdf);
         Estimate {
-            value: upper.total + lower.total,
-            error_bound: upper.error_bound + lower.error_bound,
+            value: masses.upper.total + masses.lower.total,
+            error_bound: masses.upper.error_bound + masses.lower.error_bound,
             evaluations: spent,
         }
     }

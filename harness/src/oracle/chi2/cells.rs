@@ -42,6 +42,14 @@ pub enum Layout {
     /// an anisotropic or off-axis lobe.
     #[default]
     FollowLobe,
+    /// As [`Layout::FollowLobe`], the strips' masses by one G7/K15 product rule each, without
+    /// bisection: for densities with steps (a BSDF's pdf switches a lobe off where a half
+    /// vector crosses the horizon or total internal reflection begins), where the adaptive
+    /// rule bisects every strip a step crosses to its depth limit (measured: 7.5e7 pdf
+    /// evaluations for the transmission hemisphere of a GGX 0.3 dielectric at θi = 1 rad,
+    /// against 2.3e6 for its masses on the equal-area grid). The edges are rougher quantiles;
+    /// the masses over them are integrated to their bound all the same.
+    FollowSteppedLobe,
 }
 
 /// The grid of `resolution` rows (2 × `resolution` columns) for `layout`, with the pdf
@@ -66,7 +74,8 @@ pub fn layout(
     let mut evaluations = 0;
     // Rows: strips in θ, each over every azimuthal piece.
     let thetas = refine(&polar);
-    let (masses, spent) = strip_masses(&f, &thetas, &azimuth, false);
+    let bisect = layout == Layout::FollowLobe;
+    let (masses, spent) = strip_masses(&f, &thetas, &azimuth, false, bisect);
     evaluations += spent;
     // θ_k with mass (R − k)/R above it (θ < θ_k), k = 1 … R − 1; z_k = cos θ_k rises with k.
     let z = quantiles(&thetas, &masses, resolution).map(|theta| {
@@ -77,7 +86,7 @@ pub fn layout(
     });
     let phi = if lobe.anisotropy() >= ANISOTROPIC || lobe.mode.is_some() {
         let phis = refine(&azimuth);
-        let (masses, spent) = strip_masses(&f, &phis, &polar, true);
+        let (masses, spent) = strip_masses(&f, &phis, &polar, true, bisect);
         evaluations += spent;
         quantiles(&phis, &masses, 2 * resolution).map(|inner| {
             let mut phi = vec![0.0];
@@ -117,17 +126,26 @@ fn refine(cuts: &[f64]) -> Vec<f64> {
 }
 
 /// The masses of the strips between consecutive `edges` (θ edges over every φ piece between
-/// `across`; with `azimuthal`, φ edges over every θ piece), with the evaluations spent.
+/// `across`; with `azimuthal`, φ edges over every θ piece), with the evaluations spent; each
+/// piece bisected to the layout tolerances with `bisect`, else one product rule.
 fn strip_masses(
     f: &BatchFn2<'_>,
     edges: &[f64],
     across: &[f64],
     azimuthal: bool,
+    bisect: bool,
 ) -> (Vec<f64>, u64) {
     let pieces = (edges.len() - 1) * (across.len() - 1);
-    let tolerance = Tolerance {
-        absolute: LAYOUT_ABSOLUTE_TOLERANCE / pieces as f64,
-        relative: LAYOUT_RELATIVE_TOLERANCE,
+    let tolerance = if bisect {
+        Tolerance {
+            absolute: LAYOUT_ABSOLUTE_TOLERANCE / pieces as f64,
+            relative: LAYOUT_RELATIVE_TOLERANCE,
+        }
+    } else {
+        Tolerance {
+            absolute: f64::INFINITY,
+            relative: f64::INFINITY,
+        }
     };
     let mut rectangles = Vec::with_capacity(pieces);
     for e in edges.windows(2) {

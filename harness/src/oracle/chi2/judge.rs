@@ -1,6 +1,7 @@
 //! The verdict of the chi-square test from its observed and expected counts: the sanity
-//! failures first, then the pooled statistic and its p-value against α.
+//! failures first, then the pooled statistic, its two parts and their p-value against α.
 
+use super::components::components;
 use super::{Chi2Config, Chi2Result, Expected, Failure, Observed, OutsideDomain, Verdict};
 use crate::oracle::domain::{DomainError, HemisphereGrid};
 use crate::tolerance::{MASS_TOLERANCE, MIN_EXPECTED};
@@ -20,6 +21,7 @@ pub(super) fn judge(
         statistic: f64::NAN,
         dof: 0,
         p_value: 0.0,
+        components: None,
         alpha: config.alpha,
         pooled_cells: 0,
         samples: config.samples,
@@ -59,9 +61,12 @@ pub(super) fn judge(
     }
     result.statistic = statistic;
     result.dof = bins - 1;
-    result.p_value =
-        statrs::function::gamma::checked_gamma_ur(0.5 * result.dof as f64, 0.5 * statistic)
-            .unwrap_or(f64::NAN);
+    result.components = components(&result.observed, &result.expected, grid.columns());
+    result.p_value = match &result.components {
+        Some(c) => c.p_value,
+        None => statrs::function::gamma::checked_gamma_ur(0.5 * result.dof as f64, 0.5 * statistic)
+            .unwrap_or(f64::NAN),
+    };
     if result.p_value >= config.alpha {
         result.verdict = Verdict::Pass;
     } else {

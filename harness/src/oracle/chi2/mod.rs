@@ -23,8 +23,13 @@
 //!    bin's expected count is itself < [`MIN_EXPECTED`], it is merged into the regular bin of
 //!    least expected count (so a remainder of, say, 0.01 expected cannot dominate the
 //!    statistic). dof = bins − 1.
-//! 5. **p-value** Q(dof/2, χ²/2), the upper regularized incomplete gamma function (accurate in
-//!    the far tail, unlike 1 − CDF); the test rejects when p < α.
+//! 5. **p-value.** Pearson's statistic χ² over the pooled bins (reported with dof = bins − 1)
+//!    is split into two independent parts ([`components`]): the first smooth components of
+//!    the cos θ marginal, where a roughness or exponent error of the sampler lives, and the
+//!    rest of the table; each part's p-value is Q(dof/2, χ²/2), the upper regularized
+//!    incomplete gamma function (accurate in the far tail, unlike 1 − CDF), and the test's
+//!    p-value is the smaller, Šidák-corrected; the test rejects when p < α. (A table of one row
+//!    takes Q(dof/2, χ²/2) of the whole.)
 //!
 //! [`MASS_TOLERANCE`]: crate::tolerance::MASS_TOLERANCE
 //! [`MIN_EXPECTED`]: crate::tolerance::MIN_EXPECTED
@@ -35,6 +40,7 @@
 
 mod binning;
 pub mod cells;
+pub mod components;
 mod expected;
 mod judge;
 
@@ -172,8 +178,13 @@ pub struct Chi2Result {
     pub statistic: f64,
     /// Degrees of freedom: bins − 1 (0 after a sanity failure).
     pub dof: usize,
-    /// Q(dof/2, χ²/2) (0 after a sanity failure).
+    /// The test's p-value (0 after a sanity failure): the smaller p of the two parts, corrected,
+    /// of [`Chi2Result::components`] where the table has them, else Q(dof/2, χ²/2).
     pub p_value: f64,
+    /// The statistic in two independent parts: the cos θ marginal's first smooth components
+    /// and the rest of the table ([`components`]); `None` after a sanity failure or on a
+    /// table of one row.
+    pub components: Option<components::Components>,
     /// The level the verdict was taken at.
     pub alpha: f64,
     /// Cells pooled because their expected count was < [`MIN_EXPECTED`].
