@@ -209,11 +209,12 @@ pub fn observe_sphere(
         CellFinder::new(upper_grid.clone()),
         CellFinder::new(lower_grid.clone()),
     );
-    draw_chunks(
+    draw_chunks_with(
         samples,
         seed,
-        || (zero(), Buffers::default()),
-        |(obs, buf), index, u| {
+        zero,
+        Buffers::default,
+        |obs, buf, index, u| {
             buf.out.clear();
             buf.out.resize(u.len(), None);
             sample(u, &mut buf.out);
@@ -262,7 +263,7 @@ pub fn observe_sphere(
         },
     )
     .into_iter()
-    .fold(zero(), |a, (b, _)| a.merge(b))
+    .fold(zero(), SphereObserved::merge)
 }
 
 /// A chunk's buffers, reused block to block: the sampled directions, those of each
@@ -286,31 +287,51 @@ pub fn draw_chunks<A: Send>(
     init: impl Fn() -> A + Sync,
     block: impl Fn(&mut A, u64, &[[f64; 3]]) + Sync,
 ) -> Vec<A> {
+    draw_chunks_with(
+        samples,
+        seed,
+        init,
+        || (),
+        |acc, _, index, u| block(acc, index, u),
+    )
+}
+
+/// [`draw_chunks`] with a scratch value of `scratch()` handed to `block` beside the chunk's
+/// accumulator: one per rayon job, reused chunk to chunk (buffers allocated per chunk are
+/// pages the kernel maps and zeroes every time: 39 % of a BSDF chi-square's time before).
+/// Scratch must not carry results: the chunks it sees depend on the scheduling.
+pub fn draw_chunks_with<A: Send, B>(
+    samples: u64,
+    seed: u64,
+    init: impl Fn() -> A + Sync,
+    scratch: impl Fn() -> B + Sync,
+    block: impl Fn(&mut A, &mut B, u64, &[[f64; 3]]) + Sync,
+) -> Vec<A> {
     (0..samples.div_ceil(CHUNK))
         .into_par_iter()
-        .map(|chunk| {
-            let mut rng = stream(seed, chunk);
-            let mut acc = init();
-            let (start, end) = (chunk * CHUNK, ((chunk + 1) * CHUNK).min(samples));
-            let mut u = vec![[0.0; 3]; BLOCK];
-            // The block's uniforms in bulk: pairs are consecutive uniforms of the stream, so
-            // 3n/2 pairs read as n triples are the triples of 3n `uniform` calls (for an odd
-            // 3n the last block of a chunk draws one uniform more, which nothing reads).
-            let mut pairs = vec![[0.0; 2]; (3 * BLOCK).div_ceil(2)];
-            let mut index = start;
-            while index < end {
-                let n = BLOCK.min((end - index) as usize);
-                let pairs = &mut pairs[..(3 * n).div_ceil(2)];
-                rng.fill_pairs(pairs);
-                let flat: &[f64] = bytemuck::cast_slice(pairs);
-                for (v, w) in u[..n].iter_mut().zip(flat.chunks_exact(3)) {
-                    *v = [w[0], w[1], w[2]];
+        .map_init(
+            || (vec![[0.0; 2]; (3 * BLOCK).div_ceil(2)], scratch()),
+            |(pairs, scratch), chunk| {
+                let mut rng = stream(seed, chunk);
+                let mut acc = init();
+                let (start, end) = (chunk * CHUNK, ((chunk + 1) * CHUNK).min(samples));
+                // The block's uniforms in bulk: pairs are consecutive uniforms of the stream,
+                // so 3n/2 pairs read as n triples are the triples of 3n `uniform` calls (for
+                // an odd 3n the last block of a chunk draws one uniform more, which nothing
+                // reads); the triples are the pairs' memory, cast (no copy).
+                let mut index = start;
+                while index < end {
+                    let n = BLOCK.min((end - index) as usize);
+                    let pairs = &mut pairs[..(3 * n).div_ceil(2)];
+                    rng.fill_pairs(pairs);
+                    let flat: &[f64] = bytemuck::cast_slice(pairs);
+                    let u: &[[f64; 3]] = bytemuck::cast_slice(&flat[..3 * n]);
+                    block(&mut acc, scratch, index, u);
+                    index += n as u64;
                 }
-                block(&mut acc, index, &u[..n]);
-                index += n as u64;
-            }
-            acc
-        })
+                acc
+            },
+        )
         .collect()
 }
 

@@ -60,6 +60,7 @@ pub mod conductor;
 pub mod dielectric;
 pub mod error;
 pub mod fresnel;
+pub mod fresnel_block;
 pub mod microfacet;
 pub mod spec;
 
