@@ -441,7 +441,7 @@ pub fn plan<'a>(subject: &Arc<BsdfSubject<'a>>, why: &str) -> Vec<PlannedCheck<'
         if (k == 1 && eta.is_none()) || (k == 2 && !own.visible_normals) {
             continue;
         }
-        let (s, shared) = (subject.clone(), shared.clone());
+        let (s, own, shared) = (subject.clone(), own.clone(), shared.clone());
         let case = json!({
             "relation": relation,
             "eta": eta,
@@ -465,9 +465,8 @@ pub fn plan<'a>(subject: &Arc<BsdfSubject<'a>>, why: &str) -> Vec<PlannedCheck<'
                     "ndf_consistency",
                 )])
                 .run(move |r, _| {
-                    let own = s.own_ndf.as_ref().expect("planned with an NDF");
-                    let analysis = shared.get_or_init(|| analyse(s.bsdf.as_ref(), own));
-                    judge(r, analysis, own, relation, s.bsdf.eta().is_some());
+                    let analysis = shared.get_or_init(|| analyse(s.bsdf.as_ref(), &own));
+                    judge(r, analysis, &own, relation, s.bsdf.eta().is_some());
                     Ok(())
                 }),
         );
