@@ -11,7 +11,10 @@ Pure Python, no dependencies. Run by mfh:
 Options: --alpha A (isotropic GGX, default 0.3), --eta E (eta inside / eta outside, default
 1.5), --protocol 1|2 (default 2), --workers N (processes sharing large batches, default
 min(2, cores)), --defect refraction_jacobian (a classic bug, for the audit to
-find: the pdf of refracted directions without the Jacobian dwh/dwo).
+find: the pdf of refracted directions without the Jacobian dwh/dwo), --ndf ggx (also offer the
+GGX NDF it is built on, capabilities "d" and "lambda", and declare the BSDF's "masking" and
+"sampling" in describe: mfh then audits that NDF too and compares the BSDF with Walter's
+formulas built from it, bsdf.ndf_consistency, which the defect fails).
 
 Conventions (reference/src/bsdf/mod.rs): local frame, macro-normal +z pointing outside; wi and
 wo both point away from the surface, either hemisphere; eval = f(wi, wo) |wo_z|; pdf is the
@@ -41,6 +44,9 @@ A = float(ARGS.get("--alpha", 0.3))
 ETA = float(ARGS.get("--eta", 1.5))
 PROTOCOL = int(ARGS.get("--protocol", 2))
 DEFECT = ARGS.get("--defect")
+NDF = ARGS.get("--ndf")
+if NDF not in (None, "ggx"):
+    sys.exit("--ndf must be ggx")
 # Processes that share a large batch (default: one per core, at most 2).
 WORKERS = int(ARGS.get("--workers", min(2, os.cpu_count() or 1)))
 if DEFECT not in (None, "refraction_jacobian"):
@@ -69,6 +75,19 @@ def ggx_d(mx, my, mz):
     z2 = mz * mz
     s = 1.0 + (mx * mx + my * my) / (A2 * z2)
     return INV_PI_A2 / (z2 * z2 * s * s)
+
+
+def ndf_d(m):
+    """The NDF capability d: D(m), 0 below the horizon."""
+    return ggx_d(*m) if m[2] > 0.0 else 0.0
+
+
+def ndf_lambda(w):
+    """The NDF capability lambda: Lambda(w), with Lambda(-w) = -1 - Lambda(w) below."""
+    x, y, z = w
+    if z == 0.0:
+        return math.inf if x * x + y * y > 0.0 else 0.0
+    return lam(x, y, z) if z > 0.0 else -1.0 - lam(x, y, z)
 
 
 def fresnel(c, eta):
@@ -241,13 +260,19 @@ def bsdf_sample(wi, u):
 
 def main():
     name = "dielectric.py" + (" --defect " + DEFECT if DEFECT else "")
+    functions = {"bsdf_eval": bsdf_eval, "bsdf_pdf": bsdf_pdf, "bsdf_sample": bsdf_sample}
+    extra = {"eta": ETA, "transport": "radiance"}
+    if NDF:
+        name += " --ndf " + NDF
+        functions = dict({"d": ndf_d, "lambda": ndf_lambda}, **functions)
+        extra.update(masking="height_correlated", sampling="visible_normals")
     mfh_protocol.serve(
         name,
         {"ndf": {"family": "ggx", "alpha": A}, "eta": ETA, "masking": "height_correlated",
          "sampling": "visible_normals", "defect": DEFECT},
-        {"bsdf_eval": bsdf_eval, "bsdf_pdf": bsdf_pdf, "bsdf_sample": bsdf_sample},
+        functions,
         protocol=PROTOCOL,
-        extra={"eta": ETA, "transport": "radiance"},
+        extra=extra,
         workers=WORKERS,
     )
 

@@ -23,7 +23,7 @@ use crate::record::{CheckRecord, Verdict};
 use crate::run::DEFAULT_SEED;
 use crate::run::{run_plan, AuditOptions, AuditReport};
 use crate::scene::Sampling;
-use crate::subject::bsdf::BsdfSubject;
+use crate::subject::bsdf::{BsdfSubject, OwnNdf};
 use crate::subject::{Hints, Subject};
 use mfh_reference::bsdf::{Bsdf, BsdfSpec};
 use mfh_reference::{Masking, ModelSpec, Ndf};
@@ -38,6 +38,8 @@ pub struct Audit<'a> {
     model: Arc<dyn Ndf + 'a>,
     /// The BSDF under audit ([`Audit::of_bsdf`]); then `model` is unused.
     bsdf: Option<Arc<dyn Bsdf + 'a>>,
+    /// The NDF the BSDF is built on ([`Audit::ndf`]).
+    own_ndf: Option<Arc<dyn Ndf + 'a>>,
     name: String,
     hints: Hints,
     options: AuditOptions,
@@ -63,6 +65,7 @@ impl<'a> Audit<'a> {
         Self {
             model: Arc::new(model),
             bsdf: None,
+            own_ndf: None,
             name: std::any::type_name::<M>().to_string(),
             hints: Hints::default(),
             options: AuditOptions {
@@ -86,8 +89,9 @@ impl<'a> Audit<'a> {
     /// [`mfh_reference::bsdf`] for the conventions): the chi-square of its sampling over the
     /// whole sphere, the consistency of its sample weights, its failure rate, albedo, energy,
     /// reciprocity and stability at the hard cases; `.against` takes a reference BSDF spec
-    /// (`{"bsdf": "dielectric", "eta": 1.5, "ndf": {...}}`). The NDF options (masking,
-    /// sampling, slope moments, θ max, hints) do not apply.
+    /// (`{"bsdf": "dielectric", "eta": 1.5, "ndf": {...}}`); `.ndf` gives the NDF it is built
+    /// on, with which it is then compared (`bsdf.ndf_consistency`). The other NDF options
+    /// (slope moments, θ max, hints) do not apply.
     ///
     /// ```
     /// use mfh_harness::{Audit, Profile};
@@ -110,6 +114,19 @@ impl<'a> Audit<'a> {
         audit.bsdf = Some(Arc::new(bsdf));
         audit.name = std::any::type_name::<B>().to_string();
         audit
+    }
+
+    /// The NDF (with a Smith Λ) that the BSDF of [`Audit::of_bsdf`] is built on: the BSDF's
+    /// values are then compared with Walter 2007's eq 20 and 21 built from this NDF's D and Λ
+    /// (`bsdf.ndf_consistency`: the Fresnel factor they leave is a function of |wi·h| alone, in
+    /// [0, 1], and reflected and transmitted factors sum to 1). [`Audit::masking`] declares the
+    /// BSDF's G2 form (undeclared: the check finds the form that fits, and says which);
+    /// [`Audit::sampling`] with visible normals declares that the BSDF samples this NDF's
+    /// visible normals (choosing reflection with probability F where it transmits), which adds
+    /// its pdf to the comparison. The NDF itself is audited by [`Audit::of`].
+    pub fn ndf<N: Ndf + 'a>(mut self, ndf: &'a N) -> Self {
+        self.own_ndf = Some(Arc::new(ndf));
+        self
     }
 
     /// The capability traits the model's type implements (set by [`crate::audit!`], which has
@@ -154,14 +171,17 @@ impl<'a> Audit<'a> {
     }
 
     /// The G2 form the renderer uses (None: it does not mask; default: checked if the model
-    /// has Smith masking).
+    /// has Smith masking). For [`Audit::of_bsdf`] with [`Audit::ndf`]: the BSDF's G2 form
+    /// (None or default: not declared).
     pub fn masking(mut self, masking: Option<Masking>) -> Self {
         self.masking = Some(masking);
         self
     }
 
     /// How the renderer samples (None: it does not; default: normals if the model has a
-    /// sampler, visible normals too if it has a visible-normal sampler).
+    /// sampler, visible normals too if it has a visible-normal sampler). For
+    /// [`Audit::of_bsdf`] with [`Audit::ndf`]: visible normals declares that the BSDF samples
+    /// that NDF's visible normals (Walter §5.3's lobe choice by F where it transmits).
     pub fn sampling(mut self, sampling: Option<Sampling>) -> Self {
         self.sampling = Some(sampling);
         self
@@ -305,7 +325,12 @@ impl<'a> Audit<'a> {
 
     /// The plan of a BSDF audit.
     fn plan_bsdf(&self, bsdf: Arc<dyn Bsdf + 'a>) -> (Vec<PlannedCheck<'a>>, Vec<CheckRecord>) {
-        let subject = BsdfSubject::user(bsdf, &self.name);
+        let own_ndf = self.own_ndf.clone().map(|ndf| OwnNdf {
+            ndf,
+            masking: self.masking.flatten(),
+            visible_normals: self.sampling == Some(Some(Sampling::VisibleNormals)),
+        });
+        let subject = BsdfSubject::user(bsdf, &self.name, own_ndf);
         let why = format!("BSDF `{}`", self.name);
         let mut errors = Vec::new();
         if let Some(message) = &self.seed_error {

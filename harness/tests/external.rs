@@ -526,3 +526,68 @@ fn dropping_a_model_ends_its_childs_process_group() {
     let _ = std::fs::remove_file(&pid_file);
     assert!(!alive(pid), "the sleep {pid} outlived the dropped model");
 }
+
+/// A child that offers its BSDF and the NDF it is built on (`dielectric.py --ndf ggx`: `d`,
+/// `lambda`, and the BSDF's `masking` and `sampling` in `describe`) gets, in the plan
+/// `mfh audit-external` runs, the BSDF compared with Walter's formulas built from that NDF
+/// (`bsdf.ndf_consistency`: reflection, transmission, visible-normal pdf), besides the NDF's
+/// own checks; the example passes, and its refraction defect (the refracted pdf without its
+/// Jacobian) fails the pdf relation. Only those records are run here (seconds; the whole
+/// audit is the extensive tier's).
+#[test]
+fn a_child_with_bsdf_and_ndf_is_compared_with_its_own_ndf() {
+    use mfh_harness::check::{PlannedCheck, Profile, RunContext};
+    use mfh_harness::external::{plan, ExternalAudit};
+    let t = Instant::now();
+    for (args, failing) in [
+        ("--ndf ggx", vec![]),
+        (
+            "--ndf ggx --defect refraction_jacobian",
+            vec!["visible_normal_pdf"],
+        ),
+    ] {
+        let cmd = example("dielectric.py", &format!("{args} --workers 1"));
+        let model = start(&cmd, 30.0).unwrap();
+        let description = model.description().clone();
+        assert!(description.has_bsdf() && description.has_ndf() && description.visible_normals());
+        let request = ExternalAudit {
+            command: cmd.clone(),
+            profile: Profile::Ci,
+            seed: 1,
+            against: None,
+            timeout: Duration::from_secs(30),
+            out: None,
+            control: Default::default(),
+        };
+        let label = serde_json::json!({"name": cmd});
+        let (checks, errors) = plan(&model, &request, "dielectric.py", &label);
+        assert!(errors.iter().all(|e| !e.verdict.is_failure()), "{errors:?}");
+        let ids: Vec<&str> = checks.iter().map(|p| p.check.as_str()).collect();
+        // Both audited: the NDF's checks and the BSDF's, in one plan.
+        assert!(
+            ids.iter().any(|c| c.starts_with("normalization.")),
+            "{ids:?}"
+        );
+        assert!(ids.contains(&"bsdf.chi2"), "{ids:?}");
+        let ours: Vec<&PlannedCheck> = checks
+            .iter()
+            .filter(|p| p.check == "bsdf.ndf_consistency")
+            .collect();
+        assert_eq!(ours.len(), 3, "{ids:?}");
+        let mut failed = Vec::new();
+        for p in ours {
+            let r = (p.run)(&RunContext { seed: 1 });
+            let relation = r.case["relation"].as_str().unwrap().to_string();
+            assert_eq!(r.case["g2"]["masking"], "height_correlated");
+            assert_eq!(r.case["g2"]["declared"], true);
+            println!("{args}: {relation} {:?} {:?}", r.measured, r.verdict);
+            if r.verdict.is_failure() {
+                failed.push(relation);
+            }
+        }
+        assert_eq!(failed, failing, "{args}");
+        assert!(model.first_error().is_none());
+        model.shutdown();
+    }
+    println!("{:.1} s", t.elapsed().as_secs_f64());
+}

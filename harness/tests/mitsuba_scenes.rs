@@ -63,6 +63,7 @@ const BSDF_CHECKS: &[&str] = &[
     "bsdf.chi2",
     "bsdf.energy",
     "bsdf.failure_rate",
+    "bsdf.ndf_consistency",
     "bsdf.reciprocity",
     "bsdf.sample_consistency",
     "bsdf.stability",

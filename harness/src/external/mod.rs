@@ -45,7 +45,8 @@ pub struct ExternalAudit {
 
 /// Starts the child, audits it, shuts it down: the NDF checks if it offers an NDF (`d`), the
 /// BSDF checks ([`crate::check::bsdf::plan`], as [`Audit::of_bsdf`]) if it offers a BSDF, both
-/// in one plan; `against` goes to the side its spec is of ([`Against`]). A child that cannot be
+/// in one plan, and then, if the NDF has a Smith Λ, the BSDF against that NDF
+/// (`bsdf.ndf_consistency`, with the `masking` and `sampling` it declares); `against` goes to the side its spec is of ([`Against`]). A child that cannot be
 /// started or describe itself is an error (bad input); a protocol error during the audit is an
 /// `external.protocol` error record in the report (the audit fails).
 pub fn audit(request: &ExternalAudit) -> Result<AuditReport, ExternalError> {
@@ -98,9 +99,10 @@ pub fn audit(request: &ExternalAudit) -> Result<AuditReport, ExternalError> {
 }
 
 /// The checks of the child's NDF and of its BSDF, each planned as [`Audit::of`] and
-/// [`Audit::of_bsdf`] plan them, and the configuration errors (an `--against` spec that is
-/// invalid, or of a kind the child does not offer) as records that fail.
-fn plan<'a>(
+/// [`Audit::of_bsdf`] (with [`Audit::ndf`] when it offers both) plan them, and the
+/// configuration errors (an `--against` spec that is invalid, or of a kind the child does not
+/// offer) as records that fail. Public for tests that run part of an external audit.
+pub fn plan<'a>(
     model: &'a ExternalModel,
     request: &ExternalAudit,
     name: &str,
@@ -126,7 +128,15 @@ fn plan<'a>(
         errors.extend(e);
     }
     if description.has_bsdf() {
-        let (p, e) = configure(Audit::of_bsdf(model), |a| matches!(a, Against::Bsdf(_))).plan();
+        let mut audit = configure(Audit::of_bsdf(model), |a| matches!(a, Against::Bsdf(_)));
+        if description.has_ndf() && description.has("lambda") {
+            // Its own NDF: the BSDF is also compared with Walter's formulas built from it.
+            audit = audit.ndf(model).masking(description.masking());
+            if description.visible_normals() {
+                audit = audit.sampling(Some(crate::scene::Sampling::VisibleNormals));
+            }
+        }
+        let (p, e) = audit.plan();
         plan.extend(p);
         errors.extend(e);
     }

@@ -290,6 +290,15 @@ pub struct Description {
     /// checked by [`Description::validate`], read by [`Description::transport`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transport: Option<Value>,
+    /// The G2 form of a BSDF that also offers its NDF (`d`, `lambda`): `"uncorrelated"` or
+    /// `"height_correlated"` (absent: not declared); read by [`Description::masking`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub masking: Option<Value>,
+    /// How a BSDF that also offers its NDF samples: `"visible_normals"` (that NDF's visible
+    /// normals at wi⁺, reflection chosen with probability F where it transmits), or any other
+    /// name (not compared); read by [`Description::visible_normals`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampling: Option<Value>,
     /// The precision the implementation computes in, `"f64"` (absent: the default) or
     /// `"f32"`; checked by [`Description::validate`], read by [`Description::precision`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -329,6 +338,18 @@ impl Description {
             .unwrap_or_default()
     }
 
+    /// The BSDF's declared G2 form (None when absent; see [`Description::validate`]).
+    pub fn masking(&self) -> Option<Masking> {
+        self.masking
+            .as_ref()
+            .and_then(|m| serde_json::from_value(m.clone()).ok())
+    }
+
+    /// Whether the BSDF declares visible-normal sampling of its NDF.
+    pub fn visible_normals(&self) -> bool {
+        self.sampling.as_ref().and_then(Value::as_str) == Some("visible_normals")
+    }
+
     /// The BSDF's transport convention (radiance when absent or invalid: see
     /// [`Description::validate`]).
     pub fn transport(&self) -> Transport {
@@ -343,7 +364,8 @@ impl Description {
     /// three), or both; the other NDF capabilities need `d`, `g1`/`g2` need `lambda`, `pdf_wm`
     /// needs `sample_wm`, visible sampling needs `lambda`; `bsdf_pdf` and `bsdf_sample` need
     /// `bsdf_eval`; `eta`, when given, is a finite number in [0.1, 10] at least 5e-5 away from
-    /// 1; `transport`, when given, is `"importance"` or `"radiance"`.
+    /// 1; `transport`, when given, is `"importance"` or `"radiance"`; `masking`, when given,
+    /// is `"uncorrelated"` or `"height_correlated"`.
     pub fn validate(&self) -> Result<(), String> {
         if !VERSIONS.contains(&self.protocol) {
             return Err(format!(
@@ -408,6 +430,13 @@ impl Description {
             if !matches!(t.as_str(), Some("importance" | "radiance")) {
                 return Err(format!(
                     "\"transport\" is {t}; it must be \"importance\" or \"radiance\""
+                ));
+            }
+        }
+        if let Some(m) = &self.masking {
+            if self.masking().is_none() {
+                return Err(format!(
+                    "\"masking\" is {m}; it must be \"uncorrelated\" or \"height_correlated\""
                 ));
             }
         }
@@ -795,6 +824,8 @@ mod tests {
             parameters: Value::Null,
             eta: None,
             transport: None,
+            masking: None,
+            sampling: None,
             precision: None,
         };
         assert!(d(&["d", "lambda", "g2"], 1).validate().is_ok());
@@ -839,6 +870,8 @@ mod tests {
             parameters: Value::Null,
             eta,
             transport,
+            masking: None,
+            sampling: None,
             precision: None,
         };
         let bsdf = ["bsdf_eval", "bsdf_pdf", "bsdf_sample"];
@@ -850,6 +883,25 @@ mod tests {
         let both = d(&["d", "bsdf_eval", "bsdf_pdf", "bsdf_sample"], None, None);
         assert!(both.validate().is_ok() && both.has_bsdf() && both.has_ndf());
         assert_eq!((both.eta(), both.transport()), (None, Transport::Radiance));
+        // A BSDF with its NDF may declare its G2 form and visible-normal sampling.
+        assert_eq!((both.masking(), both.visible_normals()), (None, false));
+        let declared = Description {
+            masking: Some("uncorrelated".into()),
+            sampling: Some("visible_normals".into()),
+            ..both.clone()
+        };
+        assert!(declared.validate().is_ok());
+        assert_eq!(declared.masking(), Some(Masking::Uncorrelated));
+        assert!(declared.visible_normals());
+        for bad in [Value::from("smith"), Value::from(1)] {
+            let e = Description {
+                masking: Some(bad),
+                ..both.clone()
+            }
+            .validate()
+            .unwrap_err();
+            assert!(e.contains("\"masking\""), "{e}");
+        }
         let e = d(&["bsdf_pdf"], None, None).validate().unwrap_err();
         assert!(e.contains("bsdf_eval"), "{e}");
         let e = d(&["bsdf_eval", "bsdf_pdf"], None, None)

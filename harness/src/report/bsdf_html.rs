@@ -397,6 +397,17 @@ fn worst_table(records: &[&CheckRecord]) -> String {
                     .and_then(Value::as_f64)
                     .map_or("— (no transmission)".into(), fmt_num)
             ),
+            "bsdf.ndf_consistency" => format!(
+                "{}: {} direction pairs, G2 {} ({})",
+                case_str(r, "relation").unwrap_or("?"),
+                count(&r.case, "pairs"),
+                r.case["g2"]["masking"].as_str().unwrap_or("?"),
+                if r.case["g2"]["declared"] == true {
+                    "declared"
+                } else {
+                    "fitted"
+                }
+            ),
             _ => format!(
                 "{} against the reference",
                 case_str(r, "quantity").unwrap_or("?")
@@ -415,6 +426,8 @@ fn worst_table(records: &[&CheckRecord]) -> String {
                     ("f_wo_wi", "f(wo, wi)"),
                     ("value", "value"),
                     ("reference", "reference"),
+                    ("expected", "expected"),
+                    ("cos_wi_h", "|wi·h|"),
                 ] {
                     if let Some(x) = case_num(w, key) {
                         let _ = write!(p, ", {what} = {}", fmt_num(x));
@@ -522,14 +535,21 @@ pub(crate) fn bsdf_section(
         let worst: Vec<&CheckRecord> = rs
             .iter()
             .copied()
-            .filter(|r| r.check == "bsdf.reciprocity" || r.check == "bsdf.against")
+            .filter(|r| {
+                matches!(
+                    r.check.as_str(),
+                    "bsdf.reciprocity" | "bsdf.against" | "bsdf.ndf_consistency"
+                )
+            })
             .collect();
         if !worst.is_empty() {
             h.push_str(
                 "<h4>Reciprocity (bsdf.reciprocity)</h4>\n<p class=note>f(wi, wo) against \
                  f(wo, wi) with the transport's η² on a grid of direction pairs (normal, \
                  grazing and, for a transmitting BSDF, near-critical directions on both \
-                 sides); bsdf.against: the BSDF value by value against a reference.</p>\n",
+                 sides); bsdf.against: the BSDF value by value against a reference; \
+                 bsdf.ndf_consistency: the Fresnel factors (and a visible-normal pdf) left by \
+                 Walter's eq 20/21 with the BSDF's own NDF.</p>\n",
             );
             h.push_str(&worst_table(&worst));
             h.push('\n');

@@ -24,6 +24,21 @@ pub const BSDF_RECIPROCITY: Tolerance = Tolerance {
              1e-9 fails a lost η² (a factor η² ≥ 1.0002 off at the accepted η) by 2·10⁵×",
 };
 
+/// A BSDF against Walter's eq 20/21 built from the D and Λ of the NDF it offers: the Fresnel
+/// factors that remain must be a function of |wi·h| alone, in [0, 1], and sum to 1 across the
+/// lobes (`bsdf.ndf_consistency`).
+pub const BSDF_NDF_CONSISTENCY: Tolerance = Tolerance {
+    name: "bsdf_ndf_consistency",
+    value: 1e-9,
+    reason: "each side is a handful of f64 operations on the same D, Λ and half vector, \
+             evaluated by the BSDF and by the check from the NDF at directions 0.05 or more \
+             from the horizon and refracted cosines of 0.1 or more: the reference BSDFs \
+             measure ≤ 1e-14, a renderer's different algebra ~1e-13; 1e-9 leaves that room \
+             and fails a D or Λ that is not the NDF's (GGX α × 1.01: 4 %), a G2 of the other \
+             form (percents at α = 0.3) or a misplaced η² (≥ 0.02 % at the accepted η) by \
+             orders of magnitude",
+};
+
 /// A user's BSDF against the reference BSDF of the same spec.
 pub const BSDF_AGAINST_REFERENCE: Tolerance = Tolerance {
     name: "bsdf_against_reference",
