@@ -194,6 +194,20 @@ pub fn to_unit(x: u64) -> f64 {
     (high + low) * (1.0 / (1u64 << 53) as f64)
 }
 
+/// Every dispatch path of `pulp` this CPU can run — the baseline, and AVX2 + FMA (x86-64-v3)
+/// and AVX-512 (x86-64-v4) where it has them — for the tests that ask each path for the same
+/// bits.
+#[cfg(test)]
+pub(crate) fn every_arch() -> Vec<pulp::Arch> {
+    let mut paths = vec![pulp::Arch::Scalar];
+    #[cfg(target_arch = "x86_64")]
+    {
+        paths.extend(pulp::x86::V3::try_new().map(pulp::Arch::V3));
+        paths.extend(pulp::x86::V4::try_new().map(pulp::Arch::V4));
+    }
+    paths
+}
+
 /// SplitMix64's finalizer (Steele, Lea & Flood 2014): a bijective mix of 64 bits.
 #[inline]
 pub fn splitmix64(mut z: u64) -> u64 {
