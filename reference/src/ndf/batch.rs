@@ -1,5 +1,7 @@
 //! Batch forms of the reference normal samplers: GGX's visible-normal sampler
-//! ([`sample_visible_batch`]) and the elliptic normal samplers (GGX, Beckmann, Student), for
+//! ([`sample_visible_batch`]) and the elliptic normal samplers (Beckmann, Student; GGX's
+//! normal sampler has its own batch, within ulps, in `ndf/ggx_batch.rs`, on this module's
+//! block loop and sin/cos), for
 //! which this module writes the steps every one of them shares — (cos 2πu₀, sin 2πu₀) scaled
 //! by the axis scales, times the slope radius, and the normal of the slope — written as straight-line loops over fixed blocks that the compiler
 //! vectorizes (no branch, no call per element; SSE2 two-lane f64 on the baseline x86-64 target,
