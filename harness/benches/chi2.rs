@@ -1,6 +1,8 @@
-//! Criterion benchmark of the chi-square oracle's observed counts (issue 15's harness-overhead
-//! target: sampling + binning ≤ 1.15 × the bare sampler loop): samples/s of GGX α = 0.3 normal
-//! sampling binned into the 128 × 64-cell (φ × cos θ) grid by `observe_batch`, against the bare
+//! Criterion benchmark of the chi-square oracle's observed counts (issues 15 and 26's
+//! harness-overhead target: sampling + binning ≤ 1.15 × the bare sampler loop): samples/s of
+//! GGX α = 0.3 normal sampling binned by `observe_batch` into the 128 × 64 cells (φ × cos θ)
+//! that `mfh chi2 --resolution 64` bins into (rows at the lobe's cos θ quantiles,
+//! `oracle::chi2::cells`), against the bare
 //! loop — the same chunks, the same random streams drawn in the same blocks, the same sampler,
 //! no binning — for
 //!
@@ -14,7 +16,7 @@
 //! `cargo bench -p mfh-harness --bench chi2` (`-- --quick` for a fast pass).
 
 use criterion::{black_box, Criterion, Throughput};
-use mfh_harness::oracle::chi2::{observe_batch, CHUNK};
+use mfh_harness::oracle::chi2::{cells, observe_batch, CHUNK};
 use mfh_harness::oracle::domain::{CellFinder, HemisphereGrid};
 use mfh_harness::random::stream;
 use mfh_reference::geometry::Vec3;
@@ -64,10 +66,23 @@ fn bare(sampler: &dyn NormalSampler, samples: u64, seed: u64) -> f64 {
         .sum()
 }
 
+/// The cells `mfh chi2 --resolution 64` bins GGX α = 0.3 into: rows at its cos θ quantiles.
+fn lobe_grid(ggx: &Ggx) -> HemisphereGrid {
+    let lobe = mfh_harness::oracle::lobe::measure_density(&|m| ggx.pdf_wm(m));
+    let pdf = |m: &[Vec3], out: &mut [f64]| {
+        for (o, &m) in out.iter_mut().zip(m) {
+            *o = ggx.pdf_wm(m);
+        }
+    };
+    let (grid, _) = cells::layout(&pdf, &lobe, 64, &[], cells::Layout::FollowLobe);
+    assert!(!grid.is_equal_area(), "the lobe's rows");
+    grid
+}
+
 fn chi2_sampling(c: &mut Criterion) {
     let ggx = Ggx::new(0.3, 0.3).expect("valid roughness");
     let user = ScalarUser(ggx.clone());
-    let grid = HemisphereGrid::new(64).expect("resolution ≥ 1");
+    let grid = lobe_grid(&ggx);
     let threads = rayon::current_num_threads();
     let pools: Vec<(usize, rayon::ThreadPool)> = [1, threads]
         .into_iter()
@@ -82,6 +97,8 @@ fn chi2_sampling(c: &mut Criterion) {
     let mut group = c.benchmark_group("chi2_ggx_0.3");
     group.throughput(Throughput::Elements(SAMPLES));
     group.sample_size(10);
+    group.measurement_time(std::time::Duration::from_secs(3));
+    group.warm_up_time(std::time::Duration::from_secs(1));
     let samplers: [(&str, &dyn NormalSampler); 2] = [("vectorized", &ggx), ("scalar_user", &user)];
     for (name, sampler) in samplers {
         for (n, pool) in &pools {
@@ -109,7 +126,7 @@ fn chi2_sampling(c: &mut Criterion) {
 /// α = 0.3 (the blocks of the other stages made once, beforehand).
 fn chi2_stages(c: &mut Criterion) {
     let ggx = Ggx::new(0.3, 0.3).expect("valid roughness");
-    let finder = CellFinder::new(HemisphereGrid::new(64).expect("resolution ≥ 1"));
+    let finder = CellFinder::new(lobe_grid(&ggx));
     let mut rng = stream(1, 0);
     let (mut u, mut m, mut cells) = ([[0.0; 2]; BATCH], [[0.0; 3]; BATCH], [0usize; BATCH]);
     rng.fill_pairs(&mut u);
@@ -121,6 +138,8 @@ fn chi2_stages(c: &mut Criterion) {
     let mut counts = vec![0u64; finder.grid().cells()];
     let mut group = c.benchmark_group("chi2_stages");
     group.throughput(Throughput::Elements(BATCH as u64));
+    group.measurement_time(std::time::Duration::from_secs(2));
+    group.warm_up_time(std::time::Duration::from_millis(500));
     group.bench_function("uniforms", |b| b.iter(|| rng.fill_pairs(black_box(&mut u))));
     group.bench_function("ggx_sampler", |b| {
         b.iter(|| ggx.sample_wm_batch(black_box(&u), black_box(&mut m)))

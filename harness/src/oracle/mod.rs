@@ -5,6 +5,7 @@ pub mod chi2;
 pub mod cubature;
 pub mod domain;
 pub mod double_exponential;
+mod edge_table;
 pub mod gtr;
 pub mod ks;
 pub mod lobe;

@@ -10,11 +10,14 @@
 //! hoping that two seeded states do not overlap — and any position of a stream can be reached
 //! without drawing what precedes it ([`Stream::seek_pair`]).
 //!
-//! **Uniforms.** The i-th u64 of a stream (little-endian, 8 keystream bytes) gives the i-th
-//! uniform ([`to_unit`]: its top 53 bits times 2⁻⁵³, in [0, 1) on the grid k·2⁻⁵³); the i-th
-//! pair `u = [u₀, u₁]` is uniforms 2i and 2i + 1. Generating in blocks ([`Stream::fill_pairs`])
-//! and one at a time ([`uniform`]) give the same numbers (a test), so scalar and batch callers
-//! see the same samples.
+//! **Uniforms.** The i-th 32-bit word of a stream (ChaCha's words in order, as
+//! `rand_chacha`'s `next_u32` gives them) gives the i-th uniform ([`to_unit32`]: the word times
+//! 2⁻³², in [0, 1) on the grid k·2⁻³²); the i-th pair `u = [u₀, u₁]` is uniforms 2i and 2i + 1.
+//! 32 bits, not 53 (issue 26): the samplers' u needs no finer grid (the smallest u > 0 is
+//! 2.3e-10, far below any chi-square cell or KS step at 10⁹ samples), and a sample then costs
+//! 8 keystream bytes instead of 16. Generating in blocks ([`Stream::fill_pairs`]) and one at a
+//! time ([`Stream::uniform`], [`uniform`]) give the same numbers (a test), so scalar and batch
+//! callers see the same samples.
 //!
 //! **Chunking.** Callers split their samples into fixed chunks (e.g. 2¹⁶ for the chi-square
 //! test), one stream per chunk, and reduce per-chunk results in chunk order or by integer
@@ -37,10 +40,10 @@ pub struct Stream {
     /// Where the stream is (in ChaCha words) after a bulk fill, until the next draw moves
     /// `rng` there: consecutive bulk fills then never make `rand_chacha` refill its buffer.
     parked: Option<u128>,
+    /// The keystream words of the last bulk fill (kept to spare an allocation per fill).
+    words: Vec<u32>,
 }
 
-/// Pairs of uniforms per ChaCha block (64 bytes, 16 bytes a pair).
-const PAIRS_PER_BLOCK: usize = keystream::WORDS / 4;
 /// Whole blocks below which [`Stream::fill_pairs`] leaves the work to `rand_chacha` (moving
 /// it back to the stream's position after a bulk fill costs one 4-block refill).
 const MIN_BULK_BLOCKS: usize = 16;
@@ -50,13 +53,17 @@ impl Stream {
     pub fn new(seed: u64, id: u64) -> Self {
         let mut rng = ChaCha8Rng::from_seed(key_of(seed));
         rng.set_stream(id);
-        Self { rng, parked: None }
+        Self {
+            rng,
+            parked: None,
+            words: Vec::new(),
+        }
     }
 
-    /// The next uniform in [0, 1) (53 random bits).
+    /// The next uniform in [0, 1) (32 random bits).
     #[inline]
     pub fn uniform(&mut self) -> f64 {
-        to_unit(self.generator().next_u64())
+        to_unit32(self.generator().next_u32())
     }
 
     /// The next pair of uniforms.
@@ -67,73 +74,76 @@ impl Stream {
     }
 
     /// Fills `out` with the next `out.len()` pairs of uniforms: the same numbers as that many
-    /// calls of [`Stream::pair`]. The keystream is written straight into `out` (16 bytes per
-    /// pair, through `bytemuck`'s safe cast of `[f64; 2]` to bytes) and each 8-byte word
-    /// (little-endian, as [`Stream::pair`] reads it) is converted in place: no buffer to
-    /// clear or copy, a conversion loop the compiler vectorizes. The whole blocks of a large
-    /// request are computed 16 at once under AVX-512 or 8 at once under AVX2 ([`keystream`]:
-    /// the same words as `rand_chacha`'s), the pairs before the first and after the last
-    /// block boundary, and everything on a CPU without AVX2, by `rand_chacha`.
+    /// calls of [`Stream::pair`]. The keystream words go into the stream's own buffer (8
+    /// bytes a pair), then each word is converted ([`to_unit32`], written to vectorize) into
+    /// `out`. The whole blocks of a large request are computed 16 at once under AVX-512 or 8
+    /// at once under AVX2 ([`keystream`]: the same words as `rand_chacha`'s), the words before
+    /// the first and after the last block boundary, and everything on a CPU without AVX2, by
+    /// `rand_chacha`.
     pub fn fill_pairs(&mut self, out: &mut [[f64; 2]]) {
-        self.fill_keystream(out);
+        let mut words = std::mem::take(&mut self.words);
+        words.resize(2 * out.len(), 0);
+        self.fill_words(&mut words);
         /// The conversion as a `pulp::WithSimd` operation: under AVX2 or AVX-512 it goes 4 or
-        /// 8 lanes wide ([`to_unit`] is written to vectorize).
-        struct Convert<'a>(&'a mut [[f64; 2]]);
+        /// 8 lanes wide.
+        struct Convert<'a>(&'a [u32], &'a mut [[f64; 2]]);
         impl pulp::WithSimd for Convert<'_> {
             type Output = ();
             #[inline(always)]
             fn with_simd<S: pulp::Simd>(self, _simd: S) {
-                for u in self.0.iter_mut() {
-                    // to_bits returns the stored bytes as written (bit copies preserve every
-                    // pattern).
-                    *u = [
-                        to_unit(u64::from_le(u[0].to_bits())),
-                        to_unit(u64::from_le(u[1].to_bits())),
-                    ];
+                for (u, w) in self.1.iter_mut().zip(self.0.chunks_exact(2)) {
+                    *u = [to_unit32(w[0]), to_unit32(w[1])];
                 }
             }
         }
-        pulp::Arch::new().dispatch(Convert(out));
+        pulp::Arch::new().dispatch(Convert(&words, out));
+        self.words = words;
     }
 
     /// Moves to pair `index` of the stream (pair i is uniforms 2i and 2i + 1): the next pair
     /// drawn is the one the stream would give after `index` pairs from its start.
     pub fn seek_pair(&mut self, index: u64) {
-        // 4 ChaCha words (u32) per pair.
+        // 2 ChaCha words (u32) per pair.
         self.parked = None;
-        self.rng.set_word_pos(u128::from(index) * 4);
+        self.rng.set_word_pos(u128::from(index) * 2);
     }
 
-    /// The next `out.len()` pairs' keystream bytes, as stored in `out` (16 per pair).
-    fn fill_keystream(&mut self, out: &mut [[f64; 2]]) {
+    /// The next `out.len()` words of the keystream.
+    fn fill_words(&mut self, out: &mut [u32]) {
         let position = match self.parked {
             Some(words) => words,
             None => self.rng.get_word_pos(),
         };
-        // Words to the next block boundary, as pairs (4 words each); a stream left between
-        // two words of a pair (an odd number of `next_u32` calls) takes the plain path.
-        let to_boundary = (keystream::WORDS as u128 - position % keystream::WORDS as u128)
-            % keystream::WORDS as u128;
-        let head = (to_boundary / 4) as usize;
-        let bulk = out.len().saturating_sub(head) / PAIRS_PER_BLOCK;
+        let block_words = keystream::WORDS as u128;
+        let head = ((block_words - position % block_words) % block_words) as usize;
+        let bulk = out.len().saturating_sub(head) / keystream::WORDS;
         let fast = match keystream::Fast::detect() {
-            Some(fast) if position % 4 == 0 && bulk >= MIN_BULK_BLOCKS => fast,
+            Some(fast) if bulk >= MIN_BULK_BLOCKS => fast,
             _ => {
-                self.generator().fill_bytes(bytemuck::cast_slice_mut(out));
+                self.fill_words_plain(out);
                 return;
             }
         };
         let (first, rest) = out.split_at_mut(head);
-        let (middle, last) = rest.split_at_mut(bulk * PAIRS_PER_BLOCK);
-        if !first.is_empty() {
-            self.generator().fill_bytes(bytemuck::cast_slice_mut(first));
-        }
-        let block = ((position + to_boundary) / keystream::WORDS as u128) as u64;
+        let (middle, last) = rest.split_at_mut(bulk * keystream::WORDS);
+        self.fill_words_plain(first);
+        let block = ((position + head as u128) / block_words) as u64;
         let (key, id) = (self.rng.get_seed(), self.rng.get_stream());
+        // The words as values (x86-64 only, where the fast path exists).
         fast.blocks(&key, id, block, bytemuck::cast_slice_mut(middle));
-        self.parked = Some(position + to_boundary + (bulk * keystream::WORDS) as u128);
-        if !last.is_empty() {
-            self.generator().fill_bytes(bytemuck::cast_slice_mut(last));
+        self.parked = Some(position + head as u128 + (bulk * keystream::WORDS) as u128);
+        self.fill_words_plain(last);
+    }
+
+    /// The next `out.len()` words by `rand_chacha` (its bytes, read little-endian as
+    /// `next_u32` reads them).
+    fn fill_words_plain(&mut self, out: &mut [u32]) {
+        if out.is_empty() {
+            return;
+        }
+        self.generator().fill_bytes(bytemuck::cast_slice_mut(out));
+        for w in out.iter_mut() {
+            *w = u32::from_le(*w);
         }
     }
 
@@ -169,29 +179,35 @@ pub fn stream(seed: u64, chunk: u64) -> Stream {
     Stream::new(seed, chunk)
 }
 
-/// A uniform number in [0, 1) with 53 random bits, from the next u64 of `rng`.
+/// A uniform number in [0, 1) with 32 random bits, from the next u32 of `rng` (the stream's
+/// [`Stream::uniform`]).
 #[inline]
 pub fn uniform(rng: &mut impl RngCore) -> f64 {
-    to_unit(rng.next_u64())
+    to_unit32(rng.next_u32())
 }
 
-/// The top 53 bits of `x` times 2⁻⁵³: a uniform double in [0, 1) when `x` is uniform.
-///
-/// Written without a u64 → f64 conversion, so that the loop of [`Stream::fill_pairs`]
-/// vectorizes (x86 has no packed one below AVX-512, and the compiler converted one lane at a
-/// time): v = x >> 11 < 2⁵³ is split into its 32-bit halves, each made exactly into a double
-/// by writing it into the mantissa of 2⁵² (low half: 2⁵² + lo) or 2⁸⁴ (high half: 2⁸⁴ +
-/// hi·2³²) and subtracting that power; hi·2³² + lo = v < 2⁵³ is then exact, as is the product
-/// by 2⁻⁵³ (a power of 2), so the result is `(x >> 11) as f64 · 2⁻⁵³` bit for bit (the test
-/// `to_unit_is_the_top_53_bits_times_2_to_the_minus_53`).
+/// `x` times 2⁻³²: a uniform double in [0, 1) on the grid k·2⁻³² when `x` is uniform. Exact,
+/// and written without a u32 → f64 conversion (x86 has no packed unsigned one below AVX-512)
+/// so that the loop of [`Stream::fill_pairs`] vectorizes: x in the low mantissa bits of 2⁵²
+/// (2⁵² + x exactly), less 2⁵², times 2⁻³² (a power of 2).
 #[inline(always)]
-pub fn to_unit(x: u64) -> f64 {
-    const LOW: u64 = 0x4330_0000_0000_0000; // 2⁵²
-    const HIGH: u64 = 0x4530_0000_0000_0000; // 2⁸⁴
-    let v = x >> 11;
-    let low = f64::from_bits((v & 0xffff_ffff) | LOW) - f64::from_bits(LOW);
-    let high = f64::from_bits((v >> 32) | HIGH) - f64::from_bits(HIGH);
-    (high + low) * (1.0 / (1u64 << 53) as f64)
+pub fn to_unit32(x: u32) -> f64 {
+    const TWO_52: u64 = 0x4330_0000_0000_0000;
+    (f64::from_bits(TWO_52 | u64::from(x)) - f64::from_bits(TWO_52)) * (1.0 / (1u64 << 32) as f64)
+}
+
+/// Every dispatch path of `pulp` this CPU can run — the baseline, and AVX2 + FMA (x86-64-v3)
+/// and AVX-512 (x86-64-v4) where it has them — for the tests that ask each path for the same
+/// bits.
+#[cfg(test)]
+pub(crate) fn every_arch() -> Vec<pulp::Arch> {
+    let mut paths = vec![pulp::Arch::Scalar];
+    #[cfg(target_arch = "x86_64")]
+    {
+        paths.extend(pulp::x86::V3::try_new().map(pulp::Arch::V3));
+        paths.extend(pulp::x86::V4::try_new().map(pulp::Arch::V4));
+    }
+    paths
 }
 
 /// SplitMix64's finalizer (Steele, Lea & Flood 2014): a bijective mix of 64 bits.
@@ -268,8 +284,8 @@ mod tests {
             }
             let want: Vec<[f64; 2]> = (0..5000)
                 .map(|_| {
-                    let a = scalar.next_u64();
-                    [to_unit(a), to_unit(scalar.next_u64())]
+                    let a = scalar.next_u32();
+                    [to_unit32(a), to_unit32(scalar.next_u32())]
                 })
                 .collect();
             let mut got = vec![[0.0; 2]; 5000];
@@ -310,30 +326,37 @@ mod tests {
             "{var}"
         );
         assert!(values.iter().all(|&v| (0.0..1.0).contains(&v)));
-        assert_eq!(to_unit(u64::MAX), 1.0 - f64::EPSILON / 2.0);
-        assert_eq!(to_unit(0), 0.0);
+        assert_eq!(to_unit32(u32::MAX), 1.0 - 2f64.powi(-32));
+        assert_eq!(to_unit32(0), 0.0);
     }
 
     #[test]
-    fn to_unit_is_the_top_53_bits_times_2_to_the_minus_53() {
-        let direct = |v: u64| (v >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
-        let edges = [
-            0,
-            1,
-            (1 << 11) - 1,
-            1 << 11,
-            (1 << 43) - 1,
-            1 << 43,
-            u64::MAX,
-            u64::MAX - (1 << 11),
-        ];
+    fn to_unit32_is_the_word_times_2_to_the_minus_32() {
+        let direct = |v: u32| f64::from(v) / 4_294_967_296.0;
         let mut x = 0x0123_4567_89ab_cdefu64;
-        let random = (0..1_000_000u64).flat_map(|i| {
+        let random = (0..1_000_000u64).map(|i| {
             x = splitmix64(x ^ i);
-            [x, x >> (i % 64), x << (i % 64)]
+            x as u32
         });
-        for v in edges.into_iter().chain(random) {
-            assert_eq!(to_unit(v).to_bits(), direct(v).to_bits(), "x = {v:#x}");
+        for v in [0, 1, 2, u32::MAX - 1, u32::MAX, 1 << 31]
+            .into_iter()
+            .chain(random)
+        {
+            assert_eq!(to_unit32(v).to_bits(), direct(v).to_bits(), "x = {v:#x}");
+        }
+    }
+
+    /// The first words of the stream of (seed 0, chunk 0) as uniforms: the record of what
+    /// every seeded number of mfh is drawn from (ChaCha8 of the key `key_of(0)`, stream 0,
+    /// `rand_chacha`'s words), so that a change of generator or of the conversion fails here
+    /// first.
+    #[test]
+    fn the_first_uniforms_of_a_stream_are_its_first_words_over_2_to_the_32() {
+        let mut words = ChaCha8Rng::from_seed(key_of(0));
+        words.set_stream(0);
+        let mut s = stream(0, 0);
+        for _ in 0..8 {
+            assert_eq!(s.uniform(), f64::from(words.next_u32()) / 4_294_967_296.0);
         }
     }
 

@@ -5,6 +5,7 @@ mod batch;
 pub mod beckmann;
 pub mod blend;
 pub mod ggx;
+mod ggx_batch;
 mod ggx_visible;
 pub mod gtr;
 pub mod gtr_lambda;
@@ -23,6 +24,8 @@ pub use angular_profile::AngularProfile;
 pub use beckmann::Beckmann;
 pub use blend::Blend;
 pub use ggx::Ggx;
+/// How many ulps per component GGX's batch normal sampler may differ from `Ggx::sample_wm`.
+pub use ggx_batch::MAX_ULPS as GGX_BATCH_MAX_ULPS;
 pub use gtr::Gtr;
 pub use piecewise::PiecewiseLinear;
 pub use student::Student;

@@ -2,7 +2,8 @@
 //! KS and Monte Carlo checks draw through `sample_wm_batch` (and `sample_wm_visible_batch`),
 //! the Jacobian check and a renderer through the scalar methods: two code paths, each
 //! checked by different checks. The trait promises `batch[i] = scalar(u[i])` (to the ulps an
-//! override documents; the reference models: bit for bit), so this check draws the audit's own
+//! override documents; the reference models: GGX's normals within 8 ulps, the rest bit for
+//! bit), so this check draws the audit's own
 //! u — a seeded stream with the edge values 0 and 1 − 2⁻⁵³ in front — through both and
 //! compares them component by component in ulps, one record per sampler, reporting the worst
 //! index with its u and both vectors.
@@ -293,9 +294,11 @@ mod tests {
         assert_ne!(u, uniforms(8));
     }
 
-    /// The reference GGX (isotropic and anisotropic) agrees bit for bit, normal and visible.
+    /// The reference GGX (isotropic and anisotropic) agrees within its stated ulps for normals
+    /// (its batch inverts by reciprocal square roots) and bit for bit for visible normals, and
+    /// Beckmann bit for bit.
     #[test]
-    fn the_reference_ggx_agrees_bit_for_bit() {
+    fn the_reference_samplers_agree_within_their_stated_ulps() {
         for json in [
             r#"{"family":"ggx","alpha":0.3}"#,
             r#"{"family":"ggx","alpha_x":0.2,"alpha_y":0.5}"#,
@@ -306,7 +309,13 @@ mod tests {
             assert_eq!(rs.len(), 2, "{json}");
             for r in rs {
                 assert_eq!(r.verdict, Verdict::Pass, "{json} {r:?}");
-                assert_eq!(r.value, Some(0.0));
+                let ggx_normals = json.contains("ggx") && r.case["sampler"] == "sample_wm";
+                let bound = if ggx_normals {
+                    mfh_reference::ndf::GGX_BATCH_MAX_ULPS
+                } else {
+                    0.0
+                };
+                assert!(r.value.unwrap() <= bound, "{json} {r:?}");
                 assert_eq!(r.tolerance.unwrap().name, "batch_sampler_reference");
                 assert!(r.seed.is_some());
             }

@@ -208,6 +208,7 @@ fn chi2_counts_do_not_depend_on_thread_count() {
     let one = run(1);
     let two = run(2);
     assert_eq!(one, two);
+    assert_eq!(one, run(4));
     assert_eq!(one.counts.iter().sum::<u64>(), 5 * CHUNK + 123);
     assert_ne!(
         one,
@@ -264,9 +265,13 @@ fn chi2_batch_counts_are_the_scalar_counts_whatever_the_thread_count() {
                         )
                     })
             };
-            let (one, two) = (batch(1), batch(2));
+            let (one, two, four) = (batch(1), batch(2), batch(4));
+            // GGX's batch is within 8 ulps of its scalar sampler, not bit for bit
+            // (`ndf::ggx_batch`): a sample within ulps of a cell edge could change cells, which
+            // none of these seeded samples is.
             assert_eq!(one.counts, counts, "{json}");
             assert_eq!(one, two, "{json}");
+            assert_eq!(one, four, "{json}");
             assert_eq!(
                 one,
                 observe(&|u| s.sample_wm(u), grid.clone(), samples, 11),
