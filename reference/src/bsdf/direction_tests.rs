@@ -1,5 +1,5 @@
 //! `sample_wo_batch` of the reference BSDFs (the directions without the eval and pdf) returns
-//! the directions of `sample`, on every configuration and incidence of the consistency tests
+//! the directions of `sample` (to the ulps of the batch normal samplers), on every configuration and incidence of the consistency tests
 //! and at the hard cases (tiny and anisotropic roughness, grazing and near-critical
 //! incidence, u at the ends of [0, 1)).
 
@@ -37,7 +37,18 @@ fn sampled_directions_are_those_of_sample() {
             b.sample_wo_batch(wi, &u, &mut fast);
             for (k, (&u, fast)) in u.iter().zip(&fast).enumerate() {
                 let slow = scalar(b.as_ref(), wi, u);
-                assert_eq!(fast, &slow, "{text} wi {wi:?} sample {k} u {u:?}");
+                // The same directions, to the ulps a batch normal sampler may differ from its
+                // scalar form by (GGX's: 8 ulps a component, `ndf/ggx_batch.rs`), carried
+                // through a reflection or refraction: 1e-12 a component.
+                let close = match (fast, &slow) {
+                    (Some(a), Some(b)) => a.iter().zip(b).all(|(a, b)| (a - b).abs() <= 1e-12),
+                    (None, None) => true,
+                    _ => false,
+                };
+                assert!(
+                    close,
+                    "{text} wi {wi:?} sample {k} u {u:?}: {fast:?} vs {slow:?}"
+                );
                 compared += 1;
             }
         }
