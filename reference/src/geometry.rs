@@ -29,6 +29,23 @@ pub fn length(a: Vec3) -> f64 {
     dot(a, a).sqrt()
 }
 
+/// Cross product a × b.
+#[inline]
+pub fn cross(a: Vec3, b: Vec3) -> Vec3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// a / |a| (a must be non-zero), each component divided by the length.
+#[inline]
+pub fn normalize(a: Vec3) -> Vec3 {
+    let n = length(a);
+    [a[0] / n, a[1] / n, a[2] / n]
+}
+
 /// The microfacet normal of slope `(p, q)`: m = (p, q, 1)/√(1 + p² + q²), so that
 /// tan θ_m cos φ_m = p and tan θ_m sin φ_m = q. Infinite slopes give the horizon direction.
 #[inline]

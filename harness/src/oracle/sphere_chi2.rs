@@ -4,8 +4,9 @@
 //! Procedure:
 //!
 //! 1. **Observed counts.** `samples` directions are drawn with u ∈ [0, 1)³ from the
-//!    counter-based stream of each fixed chunk of [`CHUNK`] sample indices (three uniforms a
-//!    sample, [`crate::random::Stream::uniform`]), handed to the sampler a block at a time, and
+//!    counter-based stream of each fixed chunk of [`CHUNK`] sample indices (three consecutive
+//!    uniforms a sample, drawn in bulk by [`crate::random::Stream::fill_pairs`]), handed to the
+//!    sampler a block at a time ([`mfh_reference::bsdf::Bsdf::sample_wo_batch`]: the directions alone), and
 //!    binned: a direction with z ≥ 0 into the upper hemisphere's [`HemisphereGrid`] (R
 //!    z-rows × 2R φ-columns), one with z < 0 into the lower hemisphere's, mirrored through the
 //!    surface (cell of (x, y, −z)). Each hemisphere's cells follow its lobe, as the NDF
@@ -209,7 +210,7 @@ pub fn observe_sphere(
         CellFinder::new(upper_grid.clone()),
         CellFinder::new(lower_grid.clone()),
     );
-    draw_chunks_with(
+    draw_chunks(
         samples,
         seed,
         zero,
@@ -277,30 +278,16 @@ struct Buffers {
 }
 
 /// The u ∈ [0, 1)³ of `samples` samples from the streams of `seed` (three uniforms a sample,
-/// one stream per chunk of [`CHUNK`] samples), handed to `block(acc, first index, u)` a block
+/// one stream per chunk of [`CHUNK`] samples), handed to `block(acc, scratch, first index, u)` a block
 /// of at most 1024 at a time, the chunks in parallel, each folded into its own accumulator;
 /// the accumulators in chunk order (so a result folded from them does not depend on the
 /// thread count). The one sampling loop of the BSDF's chi-square and of the BSDF checks.
-pub fn draw_chunks<A: Send>(
-    samples: u64,
-    seed: u64,
-    init: impl Fn() -> A + Sync,
-    block: impl Fn(&mut A, u64, &[[f64; 3]]) + Sync,
-) -> Vec<A> {
-    draw_chunks_with(
-        samples,
-        seed,
-        init,
-        || (),
-        |acc, _, index, u| block(acc, index, u),
-    )
-}
-
-/// [`draw_chunks`] with a scratch value of `scratch()` handed to `block` beside the chunk's
-/// accumulator: one per rayon job, reused chunk to chunk (buffers allocated per chunk are
-/// pages the kernel maps and zeroes every time: 39 % of a BSDF chi-square's time before).
-/// Scratch must not carry results: the chunks it sees depend on the scheduling.
-pub fn draw_chunks_with<A: Send, B>(
+///
+/// `scratch()` is a value handed to `block` beside the chunk's accumulator, one per rayon job,
+/// reused chunk to chunk (buffers allocated per block or chunk are pages the kernel maps and
+/// zeroes every time: 39 % of a BSDF chi-square's time before); it must not carry results,
+/// since the chunks it sees depend on the scheduling.
+pub fn draw_chunks<A: Send, B>(
     samples: u64,
     seed: u64,
     init: impl Fn() -> A + Sync,
@@ -748,13 +735,19 @@ mod tests {
             lower: vec![0; grid.cells()],
             ..SphereObserved::default()
         };
-        let blocks = draw_chunks(samples, 5, Vec::new, |acc, index, u| {
-            acc.extend(
-                u.iter()
-                    .enumerate()
-                    .map(|(k, &u)| (index + k as u64, direction(u))),
-            );
-        });
+        let blocks = draw_chunks(
+            samples,
+            5,
+            Vec::new,
+            || (),
+            |acc, _, index, u| {
+                acc.extend(
+                    u.iter()
+                        .enumerate()
+                        .map(|(k, &u)| (index + k as u64, direction(u))),
+                );
+            },
+        );
         for (index, w) in blocks.into_iter().flatten() {
             let Some(w) = w else {
                 want.failed += 1;

@@ -234,7 +234,8 @@ pub trait Bsdf: Send + Sync {
     /// sampled directions needs nothing else, so an implementation may skip the pdf and weight
     /// of each sample here (the reference BSDFs do: their Fresnel, D, Λ and Jacobians are
     /// most of a sample's cost), provided it returns the same directions (the reference
-    /// BSDFs' test: `reference/src/bsdf/tests.rs`). The default calls
+    /// BSDFs do to the ulps their batch normal samplers document, within 1e-12 a component:
+    /// `reference/src/bsdf/direction_tests.rs`). The default calls
     /// [`Bsdf::sample_batch`] (one request of an external BSDF) and keeps the `wo`.
     ///
     /// # Panics

@@ -24,7 +24,7 @@
 use super::batch::{dispatch_blocks, sin_cos_turns_block, BlockKernel};
 use crate::geometry::Vec3;
 
-/// The most ulps a component of [`sample_ggx_batch`] differs from `Ggx::sample_wm`'s.
+/// The most ulps a component of `sample_ggx_batch` differs from `Ggx::sample_wm`'s.
 pub const MAX_ULPS: f64 = 8.0;
 
 /// `out[i]` = GGX's normal of `u[i]` (roughness αx = `sx`, αy = `sy`), within [`MAX_ULPS`] of

@@ -24,16 +24,8 @@ use crate::geometry::{dot, Vec3};
 /// How far from unit length (and from orthogonal) a given axis or frame may be.
 pub const UNIT_TOLERANCE: f64 = 1e-9;
 
-/// a × b.
 #[cfg(test)]
-#[inline]
-pub(crate) fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
+pub(crate) use crate::geometry::cross;
 
 /// s·a.
 #[inline]

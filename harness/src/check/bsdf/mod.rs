@@ -32,7 +32,7 @@ pub use chi2::{table as chi2_table, RESOLUTION as CHI2_RESOLUTION};
 use super::{PlannedCheck, Profile};
 use crate::oracle::chi2::Expected;
 use crate::oracle::domain::HemisphereGrid;
-use crate::oracle::sphere_chi2::{chi2_masses, draw_chunks_with, expected_sphere, SphereMasses};
+use crate::oracle::sphere_chi2::{chi2_masses, draw_chunks, expected_sphere, SphereMasses};
 use crate::oracle::Estimate;
 use crate::subject::bsdf::BsdfSubject;
 use mfh_reference::bsdf::{Bsdf, BsdfSample};
@@ -129,7 +129,7 @@ pub fn fold_samples<A: Send>(
     init: impl Fn() -> A + Sync,
     push: impl Fn(&mut A, u64, [f64; 3], Option<BsdfSample>) + Sync,
 ) -> Vec<A> {
-    draw_chunks_with(samples, seed, init, Vec::new, |acc, out, index, u| {
+    draw_chunks(samples, seed, init, Vec::new, |acc, out, index, u| {
         out.clear();
         out.resize(u.len(), None);
         bsdf.sample_batch(wi, u, out);

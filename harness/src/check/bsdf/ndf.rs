@@ -42,7 +42,7 @@ use crate::record::{CheckRecord, Measured, Verdict};
 use crate::subject::bsdf::OwnNdf;
 use crate::tolerance::BSDF_NDF_CONSISTENCY;
 use mfh_reference::bsdf::microfacet::{reflect, upper};
-use mfh_reference::geometry::{dot, Vec3};
+use mfh_reference::geometry::{cross, dot, from_spherical, normalize, Vec3};
 use mfh_reference::{Bsdf, Masking};
 use serde_json::{json, Value};
 use std::sync::{Arc, OnceLock};
@@ -129,12 +129,6 @@ impl Point {
     }
 }
 
-/// The direction at polar angle `theta`, azimuth `phi`.
-fn polar(theta: f64, phi: f64) -> Vec3 {
-    let s = theta.sin();
-    [s * phi.cos(), s * phi.sin(), theta.cos()]
-}
-
 /// The unit vector at angle `theta` from the unit vector `m`, turned by `psi` about it.
 fn about(m: Vec3, theta: f64, psi: f64) -> Vec3 {
     let t = if m[2].abs() < 0.9 {
@@ -151,19 +145,6 @@ fn about(m: Vec3, theta: f64, psi: f64) -> Vec3 {
     }))
 }
 
-fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn normalize(v: Vec3) -> Vec3 {
-    let n = dot(v, v).sqrt();
-    [v[0] / n, v[1] / n, v[2] / n]
-}
-
 fn neg(v: Vec3) -> Vec3 {
     [-v[0], -v[1], -v[2]]
 }
@@ -178,17 +159,17 @@ fn pairs(eta: Option<f64>) -> Vec<(Vec3, Vec3, Lobe, usize, bool)> {
             let group = si * THETA_D.len() + j;
             // The reference: wi at the normal (θ_d < π/4), else h = n.
             let (m, v) = if (2.0 * theta_d).cos() >= MIN_COS {
-                let m = polar(theta_d, PHI_REF);
+                let m = from_spherical(theta_d, PHI_REF);
                 (m, [0.0, 0.0, 1.0])
             } else {
-                ([0.0, 0.0, 1.0], polar(theta_d, PHI_REF))
+                ([0.0, 0.0, 1.0], from_spherical(theta_d, PHI_REF))
             };
             let at = |v: Vec3| if s > 0.0 { v } else { neg(v) };
             out.push((at(v), at(reflect(v, m)), Lobe::Reflection, group, true));
             let mut facets = vec![(m, v)];
             for &theta_h in &THETA_H {
                 for &phi_h in &PHI_H {
-                    let m = polar(theta_h, phi_h);
+                    let m = from_spherical(theta_h, phi_h);
                     for k in 0..PSI {
                         let psi = 0.2 + std::f64::consts::TAU * k as f64 / PSI as f64;
                         facets.push((m, about(m, theta_d, psi)));
