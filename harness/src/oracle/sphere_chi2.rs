@@ -216,36 +216,47 @@ pub fn observe_sphere(
         zero,
         Buffers::default,
         |obs, buf, index, u| {
+            let n = u.len();
             buf.out.clear();
-            buf.out.resize(u.len(), None);
+            buf.out.resize(n, None);
             sample(u, &mut buf.out);
-            buf.upper.clear();
-            buf.lower.clear();
+            // Each hemisphere's directions (the lower mirrored), without a branch per sample
+            // (reflection or refraction is a coin toss the predictor cannot learn): every
+            // direction is written to both lists' next slot, and the slot of its hemisphere
+            // advances. A NaN z counts as lower, where the finder flags it.
+            buf.upper.resize(n + 1, [0.0; 3]);
+            buf.lower.resize(n + 1, [0.0; 3]);
+            let (mut upper_n, mut lower_n, mut failed) = (0, 0, 0);
             for w in &buf.out {
-                match *w {
-                    None => {}
-                    Some(w) if w[2] >= 0.0 => buf.upper.push(w),
-                    Some(w) => buf.lower.push([w[0], w[1], -w[2]]),
-                }
+                let (w, some) = w.map_or(([0.0; 3], false), |w| (w, true));
+                let up = w[2] >= 0.0;
+                buf.upper[upper_n] = w;
+                buf.lower[lower_n] = [w[0], w[1], -w[2]];
+                upper_n += usize::from(some & up);
+                lower_n += usize::from(some & !up);
+                failed += u64::from(!some);
             }
-            buf.cells.resize(buf.upper.len().max(buf.lower.len()), 0);
-            let upper = upper_finder.cells_of(&buf.upper, &mut buf.cells[..buf.upper.len()]);
+            obs.failed += failed;
+            let (upper_w, lower_w) = (&buf.upper[..upper_n], &buf.lower[..lower_n]);
+            buf.cells.resize(upper_n.max(lower_n), 0);
+            let upper = upper_finder.cells_of(upper_w, &mut buf.cells[..upper_n]);
             if upper {
-                for &c in &buf.cells[..buf.upper.len()] {
+                for &c in &buf.cells[..upper_n] {
                     obs.upper[c] += 1;
                 }
             }
-            let lower = lower_finder.cells_of(&buf.lower, &mut buf.cells[..buf.lower.len()]);
+            let lower = lower_finder.cells_of(lower_w, &mut buf.cells[..lower_n]);
             if lower {
-                for &c in &buf.cells[..buf.lower.len()] {
+                for &c in &buf.cells[..lower_n] {
                     obs.lower[c] += 1;
                 }
             }
+            if upper && lower {
+                return;
+            }
+            // A hemisphere with a direction outside the domain: its directions one by one.
             for (k, wo) in buf.out.iter().enumerate() {
-                let Some(w) = *wo else {
-                    obs.failed += 1;
-                    continue;
-                };
+                let Some(w) = *wo else { continue };
                 let (cells, finder, mirrored) = match (w[2] >= 0.0, upper, lower) {
                     (true, true, _) | (false, _, true) => continue,
                     (true, false, _) => (&mut obs.upper, &upper_finder, w),
