@@ -2,9 +2,9 @@
 //! of relative index η = η_inside/η_outside, lit from either side, with total internal
 //! reflection.
 
-use super::microfacet::{reflect, reflection_half_vector, refract, Microfacet, SUB_BLOCK};
+use super::microfacet::{reflection_half_vector, Microfacet, SUB_BLOCK};
 use super::{finite, finite_or_zero, Bsdf, BsdfError, BsdfSample, Transport};
-use super::{fresnel, fresnel_block};
+use super::{fresnel, scatter_block};
 use crate::geometry::{dot, Vec3};
 
 /// The smallest and largest relative index accepted, and the least |η − 1|: at η = 1 the
@@ -95,7 +95,8 @@ impl Dielectric {
     fn scattered(&self, wi: Vec3, m: Vec3, u0: f64) -> Option<Vec3> {
         let other = self.other(wi);
         let fr = fresnel::dielectric(dot(wi, m), other);
-        self.scattered_with(wi, m, u0, other, (fr.reflectance, fr.cos_t))
+        let (wo, ok) = scatter_block::scatter_lane(wi, m, u0, other, (fr.reflectance, fr.cos_t));
+        ok.then_some(wo)
     }
 
     /// The index of the far side over wi's: η from outside, 1/η from inside.
@@ -106,25 +107,6 @@ impl Dielectric {
         } else {
             1.0 / self.eta
         }
-    }
-
-    /// [`Self::scattered`] with the Fresnel reflectance and refracted cosine at wi·m given.
-    #[inline]
-    fn scattered_with(
-        &self,
-        wi: Vec3,
-        m: Vec3,
-        u0: f64,
-        other: f64,
-        (reflectance, cos_t): (f64, f64),
-    ) -> Option<Vec3> {
-        let reflected = u0 < reflectance;
-        let wo = if reflected {
-            reflect(wi, m)
-        } else {
-            refract(wi, m, other, cos_t)
-        };
-        (finite(wo) && (wo[2] * wi[2] > 0.0) == reflected && wo[2] != 0.0).then_some(wo)
     }
 
     /// eval and pdf together: the half vector, D, G, F and the Jacobian once.
@@ -251,29 +233,13 @@ impl Bsdf for Dielectric {
         if !finite(wi) || wi[2] == 0.0 {
             return out.fill(None);
         }
-        self.microfacet.sample_m_batch(wi, u, out);
-        // The Fresnel terms of a sub-block at once (the vectorized form of the scalar's), in
-        // buffers on the stack.
+        // Sub-blocks on the stack: the normals and whether each is one, then the scatter.
+        let (mut m, mut ok) = ([[0.0; 3]; SUB_BLOCK], [false; SUB_BLOCK]);
         let other = self.other(wi);
-        let mut cos = [0.0; SUB_BLOCK];
-        let (mut reflectance, mut cos_t) = ([0.0; SUB_BLOCK], [0.0; SUB_BLOCK]);
         for (u, out) in u.chunks(SUB_BLOCK).zip(out.chunks_mut(SUB_BLOCK)) {
-            let n = u.len();
-            for (c, m) in cos.iter_mut().zip(out.iter()) {
-                *c = m.map_or(1.0, |m| dot(wi, m));
-            }
-            fresnel_block::dielectric_block(
-                &cos[..n],
-                other,
-                &mut reflectance[..n],
-                &mut cos_t[..n],
-            );
-            for (k, (o, u)) in out.iter_mut().zip(u).enumerate() {
-                *o = o.and_then(|m| {
-                    let fr = (reflectance[k], cos_t[k]);
-                    self.scattered_with(wi, m, u[0], other, fr)
-                });
-            }
+            let (m, ok) = (&mut m[..u.len()], &mut ok[..u.len()]);
+            self.microfacet.sample_m_sub_block(wi, u, m, ok);
+            scatter_block::scatter_block(wi, other, u, (m, ok), out);
         }
     }
 

@@ -61,7 +61,7 @@ fn dielectric_block_on(
 
 /// One element: `fresnel::dielectric`'s arithmetic in the same order, its branches as selects.
 #[inline(always)]
-fn lane(cos_i: f64, eta: f64, e2: f64, em1: f64) -> (f64, f64) {
+pub(super) fn lane(cos_i: f64, eta: f64, e2: f64, em1: f64) -> (f64, f64) {
     let c = if cos_i.abs() > 1.0 { 1.0 } else { cos_i.abs() };
     let g2 = em1 + c * c;
     // Under total internal reflection (g² ≤ 0) the values below are selected away.

@@ -275,41 +275,71 @@ impl Microfacet {
             out.len(),
             "sample_m_batch: u and out differ in length"
         );
-        let v = upper(wi);
-        if !(v[2] > 0.0) || !finite(v) {
-            out.fill(None);
-            return;
-        }
         // Sub-blocks on the stack: a heap buffer of a whole block (hundreds of kB) is mapped
         // and zeroed by the kernel at every call (measured: 39 % of a BSDF chi-square's time).
-        let (mut pairs, mut m) = ([[0.0; 2]; SUB_BLOCK], [[0.0; 3]; SUB_BLOCK]);
+        let (mut m, mut ok) = ([[0.0; 3]; SUB_BLOCK], [false; SUB_BLOCK]);
         for (u, out) in u.chunks(SUB_BLOCK).zip(out.chunks_mut(SUB_BLOCK)) {
             let n = u.len();
+            self.sample_m_sub_block(wi, u, &mut m[..n], &mut ok[..n]);
+            for ((o, &m), &ok) in out.iter_mut().zip(&m[..n]).zip(&ok[..n]) {
+                *o = ok.then_some(m);
+            }
+        }
+    }
+
+    /// [`Microfacet::sample_m_batch`] of at most [`SUB_BLOCK`] elements into `m[k]`, and
+    /// whether it is a sample into `ok[k]` (the form the BSDFs' batch samplers continue from).
+    ///
+    /// # Panics
+    /// If `u`, `m` and `ok` differ in length, or are longer than [`SUB_BLOCK`].
+    pub(crate) fn sample_m_sub_block(
+        &self,
+        wi: Vec3,
+        u: &[[f64; 3]],
+        m: &mut [Vec3],
+        ok: &mut [bool],
+    ) {
+        let n = u.len();
+        assert!(
+            n <= SUB_BLOCK && m.len() == n && ok.len() == n,
+            "sample_m_sub_block: u, m and ok differ in length or exceed a sub-block"
+        );
+        let v = upper(wi);
+        let sampled = (v[2] > 0.0 && finite(v)) && {
+            let mut pairs = [[0.0; 2]; SUB_BLOCK];
             for (p, u) in pairs.iter_mut().zip(u) {
                 *p = [u[1], u[2]];
             }
-            let (pairs, m) = (&pairs[..n], &mut m[..n]);
+            let pairs = &pairs[..n];
             match self.sampling {
-                Sampling::Normals => match self.ndf.as_sampler() {
-                    Some(s) => s.sample_wm_batch(pairs, m),
-                    None => return out.fill(None),
-                },
-                Sampling::VisibleNormals => match self.ndf.as_visible_sampler() {
-                    Some(s) => s.sample_wm_visible_batch(v, pairs, m),
-                    None => return out.fill(None),
-                },
-                Sampling::PseudoVnis => match self.pseudo.as_ref() {
-                    Some(p) => {
+                Sampling::Normals => self
+                    .ndf
+                    .as_sampler()
+                    .map(|s| s.sample_wm_batch(pairs, m))
+                    .is_some(),
+                Sampling::VisibleNormals => self
+                    .ndf
+                    .as_visible_sampler()
+                    .map(|s| s.sample_wm_visible_batch(v, pairs, m))
+                    .is_some(),
+                Sampling::PseudoVnis => self
+                    .pseudo
+                    .as_ref()
+                    .map(|p| {
                         for (m, &u) in m.iter_mut().zip(pairs) {
                             *m = p.sample_wm(v, u);
                         }
-                    }
-                    None => return out.fill(None),
-                },
+                    })
+                    .is_some(),
             }
-            for (o, &m) in out.iter_mut().zip(m.iter()) {
-                *o = (finite(m) && m[2] > 0.0 && dot(v, m) > 0.0).then_some(m);
-            }
+        };
+        if !sampled {
+            return ok.fill(false);
+        }
+        for (ok, m) in ok.iter_mut().zip(m.iter()) {
+            // `&`, not `&&`: no branch.
+            let finite = m[0].is_finite() & m[1].is_finite() & m[2].is_finite();
+            *ok = finite & (m[2] > 0.0) & (dot(v, *m) > 0.0);
         }
     }
 }

@@ -62,6 +62,7 @@ pub mod error;
 pub mod fresnel;
 pub mod fresnel_block;
 pub mod microfacet;
+mod scatter_block;
 pub mod spec;
 
 #[cfg(test)]
