@@ -12,7 +12,8 @@
 //!
 //! each on 1 thread and on every thread of the machine; and, in the group `chi2_stages`, each
 //! stage of the loop alone on 1 thread, per block of 256 samples (the uniforms, GGX's batch
-//! sampler, the cell finder, the counting), so that the loop's time can be apportioned. Run:
+//! sampler, GGX's batch visible-normal sampler at θi = 1 rad — the BSDF chi-square's — the
+//! cell finder, the counting), so that the loop's time can be apportioned. Run:
 //! `cargo bench -p mfh-harness --bench chi2` (`-- --quick` for a fast pass).
 
 use criterion::{black_box, Criterion, Throughput};
@@ -21,7 +22,7 @@ use mfh_harness::oracle::domain::{CellFinder, HemisphereGrid};
 use mfh_harness::random::stream;
 use mfh_reference::geometry::Vec3;
 use mfh_reference::ndf::Ggx;
-use mfh_reference::{Ndf, NormalSampler};
+use mfh_reference::{Ndf, NormalSampler, VisibleNormalSampler};
 use rayon::prelude::*;
 
 /// 2²² samples: 64 chunks, enough for two threads to share evenly.
@@ -143,6 +144,11 @@ fn chi2_stages(c: &mut Criterion) {
     group.bench_function("uniforms", |b| b.iter(|| rng.fill_pairs(black_box(&mut u))));
     group.bench_function("ggx_sampler", |b| {
         b.iter(|| ggx.sample_wm_batch(black_box(&u), black_box(&mut m)))
+    });
+    let wi = mfh_reference::geometry::from_spherical(1.0, 0.0);
+    let mut mv = [[0.0; 3]; BATCH];
+    group.bench_function("ggx_visible_sampler", |b| {
+        b.iter(|| ggx.sample_wm_visible_batch(black_box(wi), black_box(&u), black_box(&mut mv)))
     });
     group.bench_function("cell_finder", |b| {
         b.iter(|| finder.cells_of(black_box(&m), black_box(&mut cells)))

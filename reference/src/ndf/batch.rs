@@ -1,11 +1,12 @@
-//! Batch forms of the reference normal samplers: GGX's visible-normal sampler
-//! ([`sample_visible_batch`]) and the elliptic normal samplers (Beckmann, Student; GGX's
-//! normal sampler has its own batch, within ulps, in `ndf/ggx_batch.rs`, on this module's
-//! block loop and sin/cos), for
-//! which this module writes the steps every one of them shares — (cos 2πu₀, sin 2πu₀) scaled
-//! by the axis scales, times the slope radius, and the normal of the slope — written as straight-line loops over fixed blocks that the compiler
-//! vectorizes (no branch, no call per element; SSE2 two-lane f64 on the baseline x86-64 target,
-//! 4 or 8 lanes where the CPU has AVX2 or AVX-512, through `pulp`'s dispatch below).
+//! Batch forms of the reference normal samplers: the elliptic normal samplers (Beckmann,
+//! Student), for which this module writes the steps every one of them shares — (cos 2πu₀,
+//! sin 2πu₀) scaled by the axis scales, times the slope radius, and the normal of the slope —
+//! and the block loop, its dispatch and the block sin/cos that GGX's own batches
+//! (`ndf/ggx_batch.rs` for its normals, `ndf/ggx_visible_batch.rs` for its visible normals,
+//! each within ulps of its scalar sampler) share with them: straight-line loops over fixed
+//! blocks that the compiler vectorizes (no branch, no call per element; SSE2 two-lane f64 on
+//! the baseline x86-64 target, 4 or 8 lanes where the CPU has AVX2 or AVX-512, through
+//! `pulp`'s dispatch below).
 //!
 //! **Bit for bit.** Every step performs the same IEEE operations in the same order as the
 //! scalar path (`geometry::sin_cos_turns` with musl's `__sin`/`__cos` kernels as ported by the
@@ -18,7 +19,6 @@
 //! SIMD math crate would not round as the scalar `libm` kernels do.
 
 use crate::geometry::Vec3;
-use crate::ndf::ggx_visible::VisibleFrame;
 
 /// Elements per block: the temporaries live on the stack (5 × 64 doubles).
 const BLOCK: usize = 64;
@@ -207,37 +207,7 @@ impl<R: Fn(&[f64], &mut [f64])> BlockKernel for Elliptic<'_, R> {
     }
 }
 
-/// GGX's visible-normal block: (sin, cos) 2πu₁, then [`VisibleFrame::normal`] at √u₀.
-struct Visible<'a>(&'a VisibleFrame);
-
-impl BlockKernel for Visible<'_> {
-    #[inline(always)]
-    fn run(
-        &self,
-        u0: &[f64],
-        u1: &[f64],
-        x: &mut [f64],
-        y: &mut [f64],
-        z: &mut [f64],
-        fast: &mut [bool],
-    ) {
-        // (sin, cos) 2πu₁ into (y, z), then the normal over them.
-        sin_cos_turns_block(u1, y, z);
-        for ((((x, s), c), fast), (&u0, &u1)) in x
-            .iter_mut()
-            .zip(y.iter_mut())
-            .zip(z.iter_mut())
-            .zip(fast.iter_mut())
-            .zip(u0.iter().zip(u1))
-        {
-            let m = self.0.normal(u0.sqrt(), *s, *c);
-            (*x, *s, *c) = (m[0], m[1], m[2]);
-            *fast = (0.0..1.0).contains(&u1);
-        }
-    }
-}
-
-/// The block structure both batch samplers share: per block of [`BLOCK`] pairs, u split into
+/// The block structure every batch sampler shares: per block of [`BLOCK`] pairs, u split into
 /// its components, the [`BlockKernel`] (straight-line loops writing the normals' components
 /// and whether each element is on the fast path), the components interleaved into `out`, and the elements off the fast path recomputed by `scalar` (rare:
 /// one predictable test per block, then the flagged elements).
@@ -276,42 +246,6 @@ fn for_each_block(
             }
         }
     }
-}
-
-/// `out[i]` = GGX's visible normal (Heitz 2018, `Ggx::sample_wm_visible`) of `u[i]` in the
-/// incidence `frame`, as the scalar sampler computes it: √u₀ and the sine and cosine of 2πu₁
-/// in blocks, then [`VisibleFrame::normal`] (no branch) per element; `scalar` is the model's
-/// `sample_wm_visible` at the same incidence, for u₁ outside [0, 1) (the scalar path's
-/// general reduction). Dispatched like [`sample_elliptic_batch`]; the same bits on every path.
-///
-/// # Panics
-/// If `u` and `out` differ in length.
-pub(crate) fn sample_visible_batch(
-    frame: &VisibleFrame,
-    u: &[[f64; 2]],
-    out: &mut [Vec3],
-    scalar: impl Fn([f64; 2]) -> Vec3,
-) {
-    sample_visible_batch_on(pulp::Arch::new(), frame, u, out, scalar)
-}
-
-/// [`sample_visible_batch`] through the instruction set `arch`.
-#[inline(always)]
-fn sample_visible_batch_on<S: Fn([f64; 2]) -> Vec3>(
-    arch: pulp::Arch,
-    frame: &VisibleFrame,
-    u: &[[f64; 2]],
-    out: &mut [Vec3],
-    scalar: S,
-) {
-    dispatch_blocks(
-        arch,
-        "sample_wm_visible_batch",
-        u,
-        out,
-        &Visible(frame),
-        scalar,
-    )
 }
 
 #[cfg(test)]
@@ -417,59 +351,6 @@ mod tests {
                     "u = {u:?}: {a:?} {b:?} {want:?}"
                 );
             }
-        }
-    }
-
-    /// GGX's visible-normal sampler: the batch (dispatched and baseline paths, whole and odd
-    /// slices) is the scalar `sample_wm_visible` bit for bit, at normal, oblique and grazing
-    /// incidence, isotropic and anisotropic, and NaN outside the visible domain.
-    #[test]
-    fn visible_batch_is_the_scalar_visible_sampler_bit_for_bit() {
-        use crate::model::VisibleNormalSampler;
-        let u = arguments();
-        let incidences = [
-            [0.0, 0.0, 1.0],
-            crate::geometry::from_spherical(0.7, 0.4),
-            crate::geometry::from_spherical(1.5, 2.9),
-            crate::geometry::from_spherical(std::f64::consts::FRAC_PI_2 - 1e-6, -1.2),
-        ];
-        for (ax, ay) in [(0.3, 0.3), (0.02, 0.8), (1.7, 0.5)] {
-            let ggx = Ggx::new(ax, ay).unwrap();
-            for wi in incidences {
-                let frame = super::VisibleFrame::new(ax, ay, wi).expect("visible incidence");
-                let run = |arch: pulp::Arch, u: &[[f64; 2]]| {
-                    let mut out = vec![[0.0; 3]; u.len()];
-                    super::sample_visible_batch_on(arch, &frame, u, &mut out, |u| {
-                        ggx.sample_wm_visible(wi, u)
-                    });
-                    out
-                };
-                let (detected, baseline) =
-                    (run(pulp::Arch::new(), &u), run(pulp::Arch::Scalar, &u));
-                let mut trait_batch = vec![[0.0; 3]; u.len()];
-                ggx.sample_wm_visible_batch(wi, &u, &mut trait_batch);
-                let tail = run(pulp::Arch::new(), &u[1000..1037]);
-                for (i, &u) in u.iter().enumerate() {
-                    let want = ggx.sample_wm_visible(wi, u);
-                    assert!(
-                        same(detected[i], want)
-                            && same(baseline[i], want)
-                            && same(trait_batch[i], want),
-                        "α = ({ax}, {ay}), wi = {wi:?}, u = {u:?}: {:?} {:?} {want:?}",
-                        detected[i],
-                        baseline[i]
-                    );
-                    if (1000..1037).contains(&i) {
-                        assert!(same(tail[i - 1000], want), "u = {u:?}");
-                    }
-                }
-            }
-            let mut out = vec![[0.0; 3]; 3];
-            ggx.sample_wm_visible_batch([0.0, 0.6, -0.8], &u[..3], &mut out);
-            assert!(
-                out.iter().flatten().all(|v| v.is_nan()),
-                "below the horizon: {out:?}"
-            );
         }
     }
 

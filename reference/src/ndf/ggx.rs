@@ -147,8 +147,10 @@ impl VisibleNormalSampler for Ggx {
     }
 
     /// `sample_wm_visible` over a batch at one incidence, vectorized (the frame once, then
-    /// √u₀, the sine and cosine of 2πu₁ and the lift in straight-line blocks); bit for bit the
-    /// scalar result (`ndf::batch`).
+    /// √u₀, the sine and cosine of 2πu₁ and the lift in straight-line blocks, normalized by
+    /// one reciprocal instead of three divisions): within `ggx_visible_batch::MAX_ULPS` (2) of
+    /// the scalar result per component, the same bits on every dispatch path
+    /// (`ndf::ggx_visible_batch`).
     fn sample_wm_visible_batch(&self, wi: Vec3, u: &[[f64; 2]], out: &mut [Vec3]) {
         assert_eq!(
             u.len(),
@@ -156,7 +158,7 @@ impl VisibleNormalSampler for Ggx {
             "sample_wm_visible_batch: u and out differ in length"
         );
         match VisibleFrame::new(self.alpha_x, self.alpha_y, wi) {
-            Some(frame) => super::batch::sample_visible_batch(&frame, u, out, |u| {
+            Some(frame) => super::ggx_visible_batch::sample_visible_batch(&frame, u, out, |u| {
                 self.sample_wm_visible(wi, u)
             }),
             None => out.fill([f64::NAN; 3]),

@@ -1,7 +1,7 @@
 //! The incidence-dependent part of Heitz's GGX visible-normal sampler (Heitz 2018, "Sampling
 //! the GGX Distribution of Visible Normals", JCGT 7(4), Listing 1; see `Ggx`'s
 //! `sample_wm_visible`), shared by the scalar sampler (`ndf::ggx`) and the batch one
-//! (`ndf::batch`), so neither of the two needs the other's file.
+//! (`ndf::ggx_visible_batch`), so neither of the two needs the other's file.
 
 use crate::geometry::Vec3;
 use crate::model::visible_domain;
@@ -53,6 +53,13 @@ impl VisibleFrame {
     /// listing, without a branch (`max` and `sqrt` only), so that a loop over it vectorizes.
     #[inline(always)]
     pub(crate) fn normal(&self, r: f64, sp: f64, cp: f64) -> Vec3 {
+        normalize(self.unnormalized(r, sp, cp))
+    }
+
+    /// [`VisibleFrame::normal`] before its normalization: (αx N_h,x, αy N_h,y, max(0, N_h,z)),
+    /// which the batch sampler (`ndf::ggx_visible_batch`) normalizes its own way.
+    #[inline(always)]
+    pub(crate) fn unnormalized(&self, r: f64, sp: f64, cp: f64) -> Vec3 {
         let (vh, t1v, t2v, s) = (self.vh, self.t1, self.t2, self.s);
         let t1 = r * cp;
         let t2 = (1.0 - s) * (1.0 - t1 * t1).max(0.0).sqrt() + s * r * sp;
@@ -62,7 +69,7 @@ impl VisibleFrame {
             t1 * t1v[1] + t2 * t2v[1] + lift * vh[1],
             t1 * t1v[2] + t2 * t2v[2] + lift * vh[2],
         ];
-        normalize([self.alpha_x * nh[0], self.alpha_y * nh[1], nh[2].max(0.0)])
+        [self.alpha_x * nh[0], self.alpha_y * nh[1], nh[2].max(0.0)]
     }
 }
 

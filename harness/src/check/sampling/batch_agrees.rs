@@ -2,8 +2,8 @@
 //! KS and Monte Carlo checks draw through `sample_wm_batch` (and `sample_wm_visible_batch`),
 //! the Jacobian check and a renderer through the scalar methods: two code paths, each
 //! checked by different checks. The trait promises `batch[i] = scalar(u[i])` (to the ulps an
-//! override documents; the reference models: GGX's normals within 8 ulps, the rest bit for
-//! bit), so this check draws the audit's own
+//! override documents; the reference models: GGX's normals within 8 ulps, its visible normals
+//! within 2, the rest bit for bit), so this check draws the audit's own
 //! u — a seeded stream with the edge values 0 and 1 − 2⁻⁵³ in front — through both and
 //! compares them component by component in ulps, one record per sampler, reporting the worst
 //! index with its u and both vectors.
@@ -104,7 +104,8 @@ fn check(subject: &Subject, sampler: &str, case: serde_json::Value) -> Check {
         .seeded()
 }
 
-/// Bit for bit for mfh's reference models (what they promise); a few ulps for a user's.
+/// The reference models' stated ulps (GGX's batches; bit for bit for the others); a few ulps
+/// for a user's.
 fn tolerance(subject: &Subject) -> &'static Tolerance {
     if subject.reference.is_some() {
         &BATCH_SAMPLER_REFERENCE
@@ -295,8 +296,8 @@ mod tests {
     }
 
     /// The reference GGX (isotropic and anisotropic) agrees within its stated ulps for normals
-    /// (its batch inverts by reciprocal square roots) and bit for bit for visible normals, and
-    /// Beckmann bit for bit.
+    /// (its batch inverts by reciprocal square roots) and for visible normals (its batch
+    /// normalizes by one reciprocal), and Beckmann bit for bit.
     #[test]
     fn the_reference_samplers_agree_within_their_stated_ulps() {
         for json in [
@@ -309,11 +310,10 @@ mod tests {
             assert_eq!(rs.len(), 2, "{json}");
             for r in rs {
                 assert_eq!(r.verdict, Verdict::Pass, "{json} {r:?}");
-                let ggx_normals = json.contains("ggx") && r.case["sampler"] == "sample_wm";
-                let bound = if ggx_normals {
-                    mfh_reference::ndf::GGX_BATCH_MAX_ULPS
-                } else {
-                    0.0
+                let bound = match (json.contains("ggx"), r.case["sampler"].as_str()) {
+                    (true, Some("sample_wm")) => mfh_reference::ndf::GGX_BATCH_MAX_ULPS,
+                    (true, _) => mfh_reference::ndf::GGX_VISIBLE_BATCH_MAX_ULPS,
+                    (false, _) => 0.0,
                 };
                 assert!(r.value.unwrap() <= bound, "{json} {r:?}");
                 assert_eq!(r.tolerance.unwrap().name, "batch_sampler_reference");
@@ -338,7 +338,9 @@ mod tests {
             let at = r.case["worst_index"].as_u64().unwrap();
             assert_eq!(at % 1000, 0, "{r:?}");
             let x = |key: &str| r.case[key][0].as_f64().unwrap();
-            assert_eq!(x("batch"), -x("scalar"));
+            // The flipped component, to the wrapped reference GGX's stated ulps.
+            let flipped = ulps(x("batch"), -x("scalar"));
+            assert!(flipped <= BATCH_SAMPLER_REFERENCE.value, "{r:?}");
             assert!(r.case["worst_u"].is_array());
             assert!(r.value.unwrap() > 1e15);
             if r.case["sampler"] == "sample_wm_visible" {
