@@ -129,6 +129,19 @@ fn bsdf_stages(c: &mut Criterion) {
         Sampling::VisibleNormals,
     )
     .expect("GGX has Λ and a visible-normal sampler");
+    let ggx_model = Ggx::new(0.3, 0.3).expect("valid roughness");
+    let pairs3: Vec<[f64; 2]> = u.iter().map(|u| [u[1], u[2]]).collect();
+    let mut normals = vec![[0.0; 3]; BLOCK];
+    group.bench_function("ggx_visible_batch", |b| {
+        b.iter(|| {
+            mfh_reference::VisibleNormalSampler::sample_wm_visible_batch(
+                &ggx_model,
+                wi,
+                black_box(&pairs3),
+                black_box(&mut normals),
+            )
+        })
+    });
     group.bench_function("microfacet_sample_m_batch", |b| {
         b.iter(|| microfacet.sample_m_batch(wi, black_box(&u), black_box(&mut out)))
     });

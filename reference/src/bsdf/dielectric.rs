@@ -233,13 +233,15 @@ impl Bsdf for Dielectric {
         if !finite(wi) || wi[2] == 0.0 {
             return out.fill(None);
         }
-        // Sub-blocks on the stack: the normals and whether each is one, then the scatter.
-        let (mut m, mut ok) = ([[0.0; 3]; SUB_BLOCK], [false; SUB_BLOCK]);
+        // Sub-blocks on the stack: the normals, then their tests and the scatter in one pass.
+        let mut m = [[0.0; 3]; SUB_BLOCK];
         let other = self.other(wi);
         for (u, out) in u.chunks(SUB_BLOCK).zip(out.chunks_mut(SUB_BLOCK)) {
-            let (m, ok) = (&mut m[..u.len()], &mut ok[..u.len()]);
-            self.microfacet.sample_m_sub_block(wi, u, m, ok);
-            scatter_block::scatter_block(wi, other, u, (m, ok), out);
+            let m = &mut m[..u.len()];
+            match self.microfacet.sample_m_unchecked(wi, u, m) {
+                Some(v) => scatter_block::scatter_block((wi, v), other, u, m, out),
+                None => out.fill(None),
+            }
         }
     }
 

@@ -288,60 +288,74 @@ impl Microfacet {
     }
 
     /// [`Microfacet::sample_m_batch`] of at most [`SUB_BLOCK`] elements into `m[k]`, and
-    /// whether it is a sample into `ok[k]` (the form the BSDFs' batch samplers continue from).
+    /// whether it is a sample into `ok[k]`.
     ///
     /// # Panics
     /// If `u`, `m` and `ok` differ in length, or are longer than [`SUB_BLOCK`].
-    pub(crate) fn sample_m_sub_block(
+    fn sample_m_sub_block(&self, wi: Vec3, u: &[[f64; 3]], m: &mut [Vec3], ok: &mut [bool]) {
+        assert_eq!(
+            ok.len(),
+            m.len(),
+            "sample_m_sub_block: m and ok differ in length"
+        );
+        let Some(v) = self.sample_m_unchecked(wi, u, m) else {
+            return ok.fill(false);
+        };
+        for (ok, m) in ok.iter_mut().zip(m.iter()) {
+            *ok = normal_ok(v, *m);
+        }
+    }
+
+    /// The sampler's normals of at most [`SUB_BLOCK`] elements into `m`, before the test of
+    /// each ([`normal_ok`], which the caller makes): `Some(wi⁺)`, the incidence they are
+    /// sampled at, or `None` if nothing is sampled (wi⁺ at or below the horizon or not
+    /// finite, or no sampler of the kind asked), `m` then unspecified.
+    ///
+    /// # Panics
+    /// If `u` and `m` differ in length, or are longer than [`SUB_BLOCK`].
+    pub(crate) fn sample_m_unchecked(
         &self,
         wi: Vec3,
         u: &[[f64; 3]],
         m: &mut [Vec3],
-        ok: &mut [bool],
-    ) {
+    ) -> Option<Vec3> {
         let n = u.len();
         assert!(
-            n <= SUB_BLOCK && m.len() == n && ok.len() == n,
-            "sample_m_sub_block: u, m and ok differ in length or exceed a sub-block"
+            n <= SUB_BLOCK && m.len() == n,
+            "sample_m_unchecked: u and m differ in length or exceed a sub-block"
         );
         let v = upper(wi);
-        let sampled = (v[2] > 0.0 && finite(v)) && {
-            let mut pairs = [[0.0; 2]; SUB_BLOCK];
-            for (p, u) in pairs.iter_mut().zip(u) {
-                *p = [u[1], u[2]];
-            }
-            let pairs = &pairs[..n];
-            match self.sampling {
-                Sampling::Normals => self
-                    .ndf
-                    .as_sampler()
-                    .map(|s| s.sample_wm_batch(pairs, m))
-                    .is_some(),
-                Sampling::VisibleNormals => self
-                    .ndf
-                    .as_visible_sampler()
-                    .map(|s| s.sample_wm_visible_batch(v, pairs, m))
-                    .is_some(),
-                Sampling::PseudoVnis => self
-                    .pseudo
-                    .as_ref()
-                    .map(|p| {
-                        for (m, &u) in m.iter_mut().zip(pairs) {
-                            *m = p.sample_wm(v, u);
-                        }
-                    })
-                    .is_some(),
-            }
-        };
-        if !sampled {
-            return ok.fill(false);
+        if !(v[2] > 0.0) || !finite(v) {
+            return None;
         }
-        for (ok, m) in ok.iter_mut().zip(m.iter()) {
-            // `&`, not `&&`: no branch.
-            let finite = m[0].is_finite() & m[1].is_finite() & m[2].is_finite();
-            *ok = finite & (m[2] > 0.0) & (dot(v, *m) > 0.0);
+        let mut pairs = [[0.0; 2]; SUB_BLOCK];
+        for (p, u) in pairs.iter_mut().zip(u) {
+            *p = [u[1], u[2]];
         }
+        let pairs = &pairs[..n];
+        match self.sampling {
+            Sampling::Normals => self.ndf.as_sampler()?.sample_wm_batch(pairs, m),
+            Sampling::VisibleNormals => self
+                .ndf
+                .as_visible_sampler()?
+                .sample_wm_visible_batch(v, pairs, m),
+            Sampling::PseudoVnis => {
+                let p = self.pseudo.as_ref()?;
+                for (m, &u) in m.iter_mut().zip(pairs) {
+                    *m = p.sample_wm(v, u);
+                }
+            }
+        }
+        Some(v)
     }
+}
+
+/// Whether the normal `m` sampled at incidence `v` (= wi⁺) is a sample, as `sample_m` decides:
+/// finite, above the surface and facing v. Branch-free (`&`, not `&&`), for vector loops.
+#[inline(always)]
+pub(crate) fn normal_ok(v: Vec3, m: Vec3) -> bool {
+    let finite = m[0].is_finite() & m[1].is_finite() & m[2].is_finite();
+    finite & (m[2] > 0.0) & (dot(v, m) > 0.0)
 }
 
 /// The directions a batch method of the BSDFs handles at once on the stack.

@@ -9,7 +9,7 @@
 //! compares round as scalar ones (the test `the_block_is_the_scalar_on_every_path`).
 
 use super::fresnel_block::lane as fresnel_lane;
-use super::microfacet::{reflect, refract};
+use super::microfacet::{normal_ok, reflect, refract};
 use crate::geometry::{dot, Vec3};
 
 /// Elements per pass: the temporaries live on the stack (5 × 64 doubles).
@@ -37,61 +37,59 @@ pub(super) fn scatter_lane(
     (wo, ok)
 }
 
-/// `out[k]` = the dielectric's sampled direction of the normal `m[k]` (`None` where `ok[k]`
-/// is false: a failed normal) with the lobe choice `u[k][0]`, from `wi` into a far side of
-/// index `eta` over wi's: `Dielectric::scattered` bit for bit.
+/// `out[k]` = the dielectric's sampled direction of the normal `m[k]` sampled at `v` = wi⁺
+/// (`None` where [`normal_ok`] fails: a failed normal) with the lobe choice `u[k][0]`, from
+/// `wi` into a far side of index `eta` over wi's: `Dielectric::scattered` bit for bit.
 ///
 /// # Panics
-/// If `u`, `m`, `ok` and `out` differ in length.
+/// If `u`, `m` and `out` differ in length.
 pub(super) fn scatter_block(
-    wi: Vec3,
+    (wi, v): (Vec3, Vec3),
     eta: f64,
     u: &[[f64; 3]],
-    (m, ok): (&[Vec3], &[bool]),
+    m: &[Vec3],
     out: &mut [Option<Vec3>],
 ) {
-    scatter_block_on(pulp::Arch::new(), wi, eta, u, (m, ok), out)
+    scatter_block_on(pulp::Arch::new(), (wi, v), eta, u, m, out)
 }
 
 /// [`scatter_block`] through the instruction set `arch` (`pulp::Arch::Scalar`: baseline).
 fn scatter_block_on(
     arch: pulp::Arch,
-    wi: Vec3,
+    (wi, v): (Vec3, Vec3),
     eta: f64,
     u: &[[f64; 3]],
-    (m, ok): (&[Vec3], &[bool]),
+    m: &[Vec3],
     out: &mut [Option<Vec3>],
 ) {
     let n = u.len();
     assert!(
-        m.len() == n && ok.len() == n && out.len() == n,
-        "scatter_block: u, m, ok and out differ in length"
+        m.len() == n && out.len() == n,
+        "scatter_block: u, m and out differ in length"
     );
     /// The loop as a `pulp::WithSimd` operation (instantiated per instruction set).
     struct Op<'a> {
         wi: Vec3,
+        v: Vec3,
         eta: f64,
         u: &'a [[f64; 3]],
         m: &'a [Vec3],
-        ok: &'a [bool],
         out: &'a mut [Option<Vec3>],
     }
     impl pulp::WithSimd for Op<'_> {
         type Output = ();
         #[inline(always)]
         fn with_simd<S: pulp::Simd>(self, _simd: S) {
-            let (wi, eta) = (self.wi, self.eta);
+            let (wi, v, eta) = (self.wi, self.v, self.eta);
             // fresnel::dielectric's constants of η, as the block form takes them.
             let (e2, em1) = (eta * eta, (eta - 1.0) * (eta + 1.0));
             let (mut x, mut y, mut z) = ([0.0; PASS], [0.0; PASS], [0.0; PASS]);
             let (mut u0, mut some) = ([0.0; PASS], [false; PASS]);
             let passes = self.u.chunks(PASS).zip(self.m.chunks(PASS));
-            for ((u, m), (ok, out)) in
-                passes.zip(self.ok.chunks(PASS).zip(self.out.chunks_mut(PASS)))
-            {
+            for ((u, m), out) in passes.zip(self.out.chunks_mut(PASS)) {
                 let n = u.len();
-                for (k, ((u, m), &ok)) in u.iter().zip(m).zip(ok).enumerate() {
-                    (x[k], y[k], z[k], u0[k], some[k]) = (m[0], m[1], m[2], u[0], ok);
+                for (k, (u, m)) in u.iter().zip(m).enumerate() {
+                    (x[k], y[k], z[k], u0[k]) = (m[0], m[1], m[2], u[0]);
                 }
                 // Zipped slices of one length: no bounds checks, so the loop vectorizes.
                 for ((((x, y), z), some), &u0) in x[..n]
@@ -105,7 +103,7 @@ fn scatter_block_on(
                     let fresnel = fresnel_lane(dot(wi, m), eta, e2, em1);
                     let (wo, ok) = scatter_lane(wi, m, u0, eta, fresnel);
                     (*x, *y, *z) = (wo[0], wo[1], wo[2]);
-                    *some &= ok;
+                    *some = normal_ok(v, m) & ok;
                 }
                 for (k, o) in out.iter_mut().enumerate() {
                     *o = some[k].then_some([x[k], y[k], z[k]]);
@@ -115,10 +113,10 @@ fn scatter_block_on(
     }
     arch.dispatch(Op {
         wi,
+        v,
         eta,
         u,
         m,
-        ok,
         out,
     })
 }
@@ -127,6 +125,7 @@ fn scatter_block_on(
 mod tests {
     use super::*;
     use crate::bsdf::fresnel::dielectric;
+    use crate::bsdf::microfacet::upper;
     use crate::geometry::from_spherical;
 
     /// The scalar: `Dielectric::scattered`'s computation.
@@ -143,6 +142,7 @@ mod tests {
         for eta in [1.5, 1.0 / 1.5, 1.0001, 1.0 / 1.0001, 4.0, 0.25] {
             for theta in [0.0, 0.3, 1.0, 1.5, 1.57, 3.0, 2.2] {
                 let wi = from_spherical(theta, 0.7);
+                let v = upper(wi);
                 // Normals over the whole sphere (wi·m of either sign, grazing, total internal
                 // reflection), exact ones, failed samples and non-finite ones; u₀ at the ends.
                 let mut m: Vec<Option<Vec3>> = (0..2000)
@@ -166,16 +166,18 @@ mod tests {
                     .collect();
                 for arch in [pulp::Arch::new(), pulp::Arch::Scalar] {
                     for range in [0..m.len(), 5..72] {
+                        // A failed normal as the sampler may leave it: anything (zero here).
                         let normals: Vec<Vec3> = m[range.clone()]
                             .iter()
                             .map(|m| m.unwrap_or([0.0; 3]))
                             .collect();
-                        let ok: Vec<bool> = m[range.clone()].iter().map(Option::is_some).collect();
                         let mut out = vec![Some([9.0; 3]); range.len()];
                         let u = &u[range.clone()];
-                        scatter_block_on(arch, wi, eta, u, (&normals, &ok), &mut out);
+                        scatter_block_on(arch, (wi, v), eta, u, &normals, &mut out);
                         for (k, got) in range.clone().zip(&out) {
-                            let want = m[k].and_then(|m| scalar(wi, m, u[k - range.start][0], eta));
+                            let want = m[k]
+                                .filter(|&m| normal_ok(v, m))
+                                .and_then(|m| scalar(wi, m, u[k - range.start][0], eta));
                             let bits = |w: &Option<Vec3>| w.map(|w| w.map(f64::to_bits));
                             assert_eq!(bits(got), bits(&want), "η {eta}, θ {theta}, m {:?}", m[k]);
                         }
