@@ -2,7 +2,8 @@
 //! index n + ik (exact, or Schlick's approximation), one-sided (lit from outside only).
 
 use super::fresnel::{self, FresnelModel};
-use super::microfacet::{reflect, reflection_half_vector, Microfacet};
+use super::microfacet::{reflection_half_vector, Microfacet, SUB_BLOCK};
+use super::scatter_block;
 use super::{finite, finite_or_zero, Bsdf, BsdfError, BsdfSample};
 use crate::geometry::{dot, Vec3};
 
@@ -134,9 +135,15 @@ impl Bsdf for Conductor {
         if !finite(wi) || !(wi[2] > 0.0) {
             return out.fill(None);
         }
-        self.microfacet.sample_m_batch(wi, u, out);
-        for o in out.iter_mut() {
-            *o = o.and_then(|m| reflected(wi, m));
+        // Sub-blocks on the stack: the normals, then their tests and the reflection in one
+        // vectorized pass.
+        let mut m = [[0.0; 3]; SUB_BLOCK];
+        for (u, out) in u.chunks(SUB_BLOCK).zip(out.chunks_mut(SUB_BLOCK)) {
+            let m = &mut m[..u.len()];
+            match self.microfacet.sample_m_unchecked(wi, u, m) {
+                Some(v) => scatter_block::reflect_block((wi, v), m, out),
+                None => out.fill(None),
+            }
         }
     }
 }
@@ -144,6 +151,6 @@ impl Bsdf for Conductor {
 /// wi reflected about the sampled normal m, `None` unless finite and above the surface.
 #[inline]
 fn reflected(wi: Vec3, m: Vec3) -> Option<Vec3> {
-    let wo = reflect(wi, m);
-    (finite(wo) && wo[2] > 0.0).then_some(wo)
+    let (wo, ok) = scatter_block::reflect_lane(wi, m);
+    ok.then_some(wo)
 }

@@ -1,9 +1,10 @@
-//! The rough dielectric's sampled directions over a block of sampled microfacet normals
-//! (`Dielectric::sample_wo_batch`, the BSDF chi-square's hot loop): per element the Fresnel
+//! The reference BSDFs' sampled directions over a block of sampled microfacet normals
+//! (`sample_wo_batch`, the BSDF chi-square's hot loop). For the rough dielectric, per element the Fresnel
 //! reflectance at wi·m, the lobe choice by u₀, the reflected or refracted direction and its
 //! side test — [`scatter_lane`], which the scalar `Dielectric::scattered` calls too, so the two
 //! are one computation — as straight-line loops over a pass of [`PASS`] elements, both
-//! directions computed and one selected, so that they vectorize (8 or 4 lanes under AVX-512 or
+//! directions computed and one selected; for the conductor, the reflection and its side test
+//! ([`reflect_lane`], the scalar's too). The loops vectorize (8 or 4 lanes under AVX-512 or
 //! AVX2 through `pulp`'s safe runtime dispatch, 2 under baseline SSE2). The same bits on every
 //! path and as the scalar: Rust never contracts into FMA, and packed +, −, ×, ÷, √, min and
 //! compares round as scalar ones (the test `the_block_is_the_scalar_on_every_path`).
@@ -121,6 +122,71 @@ fn scatter_block_on(
     })
 }
 
+/// The direction the conductor's `sample` reflects wi into about the normal m (Walter eq 39),
+/// and whether it is a sample: finite and above the surface. No branch.
+#[inline(always)]
+pub(super) fn reflect_lane(wi: Vec3, m: Vec3) -> (Vec3, bool) {
+    let wo = reflect(wi, m);
+    let finite = wo[0].is_finite() & wo[1].is_finite() & wo[2].is_finite();
+    (wo, finite & (wo[2] > 0.0))
+}
+
+/// `out[k]` = the conductor's sampled direction of the normal `m[k]` sampled at `v` = wi⁺
+/// (`None` where [`normal_ok`] or [`reflect_lane`] fails), as its scalar `sample` makes it,
+/// bit for bit, in one vectorized pass.
+///
+/// # Panics
+/// If `m` and `out` differ in length.
+pub(super) fn reflect_block((wi, v): (Vec3, Vec3), m: &[Vec3], out: &mut [Option<Vec3>]) {
+    reflect_block_on(pulp::Arch::new(), (wi, v), m, out)
+}
+
+/// [`reflect_block`] through the instruction set `arch`.
+fn reflect_block_on(arch: pulp::Arch, (wi, v): (Vec3, Vec3), m: &[Vec3], out: &mut [Option<Vec3>]) {
+    assert_eq!(
+        m.len(),
+        out.len(),
+        "reflect_block: m and out differ in length"
+    );
+    /// The loop as a `pulp::WithSimd` operation (instantiated per instruction set).
+    struct Op<'a> {
+        wi: Vec3,
+        v: Vec3,
+        m: &'a [Vec3],
+        out: &'a mut [Option<Vec3>],
+    }
+    impl pulp::WithSimd for Op<'_> {
+        type Output = ();
+        #[inline(always)]
+        fn with_simd<S: pulp::Simd>(self, _simd: S) {
+            let (wi, v) = (self.wi, self.v);
+            let (mut x, mut y, mut z) = ([0.0; PASS], [0.0; PASS], [0.0; PASS]);
+            let mut some = [false; PASS];
+            for (m, out) in self.m.chunks(PASS).zip(self.out.chunks_mut(PASS)) {
+                let n = m.len();
+                for (k, m) in m.iter().enumerate() {
+                    (x[k], y[k], z[k]) = (m[0], m[1], m[2]);
+                }
+                for (((x, y), z), some) in x[..n]
+                    .iter_mut()
+                    .zip(&mut y[..n])
+                    .zip(&mut z[..n])
+                    .zip(&mut some[..n])
+                {
+                    let m = [*x, *y, *z];
+                    let (wo, ok) = reflect_lane(wi, m);
+                    (*x, *y, *z) = (wo[0], wo[1], wo[2]);
+                    *some = normal_ok(v, m) & ok;
+                }
+                for (k, o) in out.iter_mut().enumerate() {
+                    *o = some[k].then_some([x[k], y[k], z[k]]);
+                }
+            }
+        }
+    }
+    arch.dispatch(Op { wi, v, m, out })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -181,6 +247,36 @@ mod tests {
                             let bits = |w: &Option<Vec3>| w.map(|w| w.map(f64::to_bits));
                             assert_eq!(bits(got), bits(&want), "η {eta}, θ {theta}, m {:?}", m[k]);
                         }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_reflection_block_is_the_scalar_on_every_path() {
+        let weyl = |k: usize, a: f64| (k as f64 * a).fract();
+        for theta in [0.0, 0.3, 1.0, 1.5, 1.57] {
+            let wi = from_spherical(theta, 0.7);
+            let v = upper(wi);
+            let mut m: Vec<Vec3> = (0..2000)
+                .map(|k| {
+                    let (a, b) = (weyl(k, 0.618_033_988_7), weyl(k, 0.414_213_562_4));
+                    from_spherical(a * 3.2, b * 6.3)
+                })
+                .collect();
+            m.extend([[0.0, 0.0, 1.0], [f64::NAN, 0.0, 1.0], wi, [1.0, 0.0, 0.0]]);
+            for arch in [pulp::Arch::new(), pulp::Arch::Scalar] {
+                for range in [0..m.len(), 5..72] {
+                    let mut out = vec![Some([9.0; 3]); range.len()];
+                    reflect_block_on(arch, (wi, v), &m[range.clone()], &mut out);
+                    for (k, got) in range.clone().zip(&out) {
+                        let want = Some(m[k]).filter(|&m| normal_ok(v, m)).and_then(|m| {
+                            let (wo, ok) = reflect_lane(wi, m);
+                            ok.then_some(wo)
+                        });
+                        let bits = |w: &Option<Vec3>| w.map(|w| w.map(f64::to_bits));
+                        assert_eq!(bits(got), bits(&want), "θ {theta}, m {:?}", m[k]);
                     }
                 }
             }
