@@ -16,6 +16,7 @@
 
 use criterion::{black_box, Criterion, Throughput};
 use mfh_harness::oracle::chi2::{cells, observe_batch};
+use mfh_harness::oracle::domain::CellFinder;
 use mfh_harness::oracle::sphere_chi2::{chi2_masses, observe_sphere, SphereMasses};
 use mfh_harness::random::stream;
 use mfh_reference::bsdf::microfacet::{Microfacet, Sampling};
@@ -147,6 +148,20 @@ fn bsdf_stages(c: &mut Criterion) {
     });
     group.bench_function("dielectric_sample_wo_batch", |b| {
         b.iter(|| bsdf.sample_wo_batch(wi, black_box(&u), black_box(&mut out)))
+    });
+    // The transmission hemisphere's cell finder alone, on the block's transmitted directions
+    // (mirrored, as observe_sphere hands them).
+    let lower: Vec<Vec3> = sampled
+        .iter()
+        .flatten()
+        .filter(|w| w[2] < 0.0)
+        .map(|w| [w[0], w[1], -w[2]])
+        .collect();
+    let finder = CellFinder::new(grids.1.clone());
+    let mut cells = vec![0usize; lower.len()];
+    group.throughput(Throughput::Elements(lower.len() as u64));
+    group.bench_function("lower_cell_finder", |b| {
+        b.iter(|| finder.cells_of(black_box(&lower), black_box(&mut cells)))
     });
     // observe_sphere on this thread with a sampler that copies the block sampled above: the
     // split into hemispheres, the two cell finders and the counting (and the finders' tables,
