@@ -248,6 +248,37 @@ fn for_each_block(
     }
 }
 
+/// For the batch samplers' tests: the distance of two doubles in units in the last place (the
+/// count of doubles between them; 0 for two NaNs).
+#[cfg(test)]
+pub(super) fn ulps_apart(a: f64, b: f64) -> f64 {
+    if a.is_nan() && b.is_nan() {
+        return 0.0;
+    }
+    let key = |x: f64| {
+        let bits = x.to_bits() as i64;
+        if bits < 0 {
+            i64::MIN - bits
+        } else {
+            bits
+        }
+    };
+    (key(a) as i128 - key(b) as i128).unsigned_abs() as f64
+}
+
+/// For the batch samplers' tests: every dispatch path this CPU can run (the baseline, and
+/// x86-64-v3 and -v4 where it has them).
+#[cfg(test)]
+pub(super) fn dispatch_paths() -> Vec<pulp::Arch> {
+    let mut paths = vec![pulp::Arch::Scalar];
+    #[cfg(target_arch = "x86_64")]
+    {
+        paths.extend(pulp::x86::V3::try_new().map(pulp::Arch::V3));
+        paths.extend(pulp::x86::V4::try_new().map(pulp::Arch::V4));
+    }
+    paths
+}
+
 #[cfg(test)]
 mod tests {
     use crate::geometry::sin_cos_turns;

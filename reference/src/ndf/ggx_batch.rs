@@ -112,6 +112,7 @@ fn rsqrt(a: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::model::NormalSampler;
+    use crate::ndf::batch::{dispatch_paths, ulps_apart};
     use crate::ndf::Ggx;
 
     /// u₀ and u₁ on a stride through [0, 1), on the 32-bit grid's ends, the quadrant points,
@@ -140,21 +141,6 @@ mod tests {
         u
     }
 
-    fn ulps(a: f64, b: f64) -> f64 {
-        if a.is_nan() && b.is_nan() {
-            return 0.0;
-        }
-        let key = |x: f64| {
-            let bits = x.to_bits() as i64;
-            if bits < 0 {
-                i64::MIN - bits
-            } else {
-                bits
-            }
-        };
-        (key(a) as i128 - key(b) as i128).unsigned_abs() as f64
-    }
-
     #[test]
     fn within_max_ulps_of_the_scalar_sampler() {
         let u = arguments();
@@ -172,7 +158,7 @@ mod tests {
             for (&u, m) in u.iter().zip(&out) {
                 let want = ggx.sample_wm(u);
                 for k in 0..3 {
-                    let d = ulps(m[k], want[k]);
+                    let d = ulps_apart(m[k], want[k]);
                     worst = worst.max(d);
                     assert!(d <= MAX_ULPS, "α ({ax}, {ay}), u {u:?}: {m:?} vs {want:?}");
                 }
@@ -184,12 +170,7 @@ mod tests {
     #[test]
     fn every_path_gives_the_same_bits() {
         let u = arguments();
-        let mut paths = vec![pulp::Arch::Scalar];
-        #[cfg(target_arch = "x86_64")]
-        {
-            paths.extend(pulp::x86::V3::try_new().map(pulp::Arch::V3));
-            paths.extend(pulp::x86::V4::try_new().map(pulp::Arch::V4));
-        }
+        let paths = dispatch_paths();
         for (ax, ay) in [(0.3, 0.3), (0.02, 0.8)] {
             let ggx = Ggx::new(ax, ay).unwrap();
             let run = |arch: pulp::Arch, u: &[[f64; 2]]| {
