@@ -208,8 +208,8 @@ pub trait NormalSampler: Ndf {
     /// `out[i] = self.sample_wm(u[i])` for every i: the batch capability the chi-square oracle
     /// draws through (the default loops over [`NormalSampler::sample_wm`], so a model that
     /// implements only the scalar method needs nothing more). A vectorized override must agree
-    /// with `sample_wm` to the number of ulps it documents (the reference models: GGX's within
-    /// `ndf::GGX_BATCH_MAX_ULPS`, the others bit for bit).
+    /// with `sample_wm` to the number of ulps it documents (the reference models: bit for
+    /// bit).
     ///
     /// # Panics
     /// If `u` and `out` differ in length.

@@ -16,8 +16,8 @@ const HARD: &[&str] = &[
 ];
 
 /// The same directions, to the ulps a batch normal sampler may differ from its scalar form by
-/// (GGX's: 8 ulps a component for normals, `ndf/ggx_batch.rs`, 2 for visible normals,
-/// `ndf/ggx_visible_batch.rs`), carried through a reflection or refraction: 1e-12 a component.
+/// (GGX's visible normals: 2 ulps a component, `ndf/ggx_visible_batch.rs`; the others bit for
+/// bit), carried through a reflection or refraction: 1e-12 a component.
 fn close(a: &Option<Vec3>, b: &Option<Vec3>) -> bool {
     match (a, b) {
         (Some(a), Some(b)) => a.iter().zip(b).all(|(a, b)| (a - b).abs() <= 1e-12),

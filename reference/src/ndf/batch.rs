@@ -1,9 +1,8 @@
-//! Batch forms of the reference normal samplers: the elliptic normal samplers (Beckmann,
+//! Batch forms of the reference normal samplers: the elliptic normal samplers (GGX, Beckmann,
 //! Student), for which this module writes the steps every one of them shares — (cos 2πu₀,
 //! sin 2πu₀) scaled by the axis scales, times the slope radius, and the normal of the slope —
-//! and the block loop, its dispatch and the block sin/cos that GGX's own batches
-//! (`ndf/ggx_batch.rs` for its normals, `ndf/ggx_visible_batch.rs` for its visible normals,
-//! each within ulps of its scalar sampler) share with them: straight-line loops over fixed
+//! and the block loop, its dispatch and the block sin/cos that GGX's visible-normal batch
+//! (`ndf/ggx_visible_batch.rs`, within ulps of its scalar sampler) shares with them: straight-line loops over fixed
 //! blocks that the compiler vectorizes (no branch, no call per element; SSE2 two-lane f64 on
 //! the baseline x86-64 target, 4 or 8 lanes where the CPU has AVX2 or AVX-512, through
 //! `pulp`'s dispatch below).
@@ -388,8 +387,9 @@ mod tests {
     #[test]
     fn batch_samplers_agree_with_scalar_bit_for_bit() {
         let u = arguments();
-        // GGX's batch is its own, within ulps (`ndf::ggx_batch`).
         let samplers: Vec<(&str, Box<dyn NormalSampler>)> = vec![
+            ("ggx 0.3", Box::new(Ggx::new(0.3, 0.3).unwrap())),
+            ("ggx 0.02 0.8", Box::new(Ggx::new(0.02, 0.8).unwrap())),
             ("beckmann 0.3", Box::new(Beckmann::new(0.3, 0.3).unwrap())),
             (
                 "beckmann 0.1 0.5",

@@ -33,7 +33,8 @@
 //! The AVX2 and baseline paths are a little slower there (1.84 against 1.77 µs and 4.16
 //! against 4.08 µs, best of 30 in a timing loop): a Zen 4 divides four lanes cheaply.
 //!
-//! **Why not `ggx_batch`'s reciprocal square roots** (f32's 1/√a, two Newton steps in f64).
+//! **Why not reciprocal square roots by Newton steps** (f32's 1/√a, then two in f64; tried for
+//! GGX's normal batch in issue 26 and removed, `Ggx::sample_wm_batch`).
 //! In that timing loop on the AVX-512 path, normalizing by it took 1.40 µs a block against the
 //! exact form's 1.37 (this form: 1.23): the f32 start (conversions, `vsqrtps`, `vdivps`) and
 //! the Newton products cost more than an f64 √ and ÷ on that divider. And the other three

@@ -5,7 +5,6 @@ mod batch;
 pub mod beckmann;
 pub mod blend;
 pub mod ggx;
-mod ggx_batch;
 mod ggx_visible;
 mod ggx_visible_batch;
 pub mod gtr;
@@ -25,8 +24,6 @@ pub use angular_profile::AngularProfile;
 pub use beckmann::Beckmann;
 pub use blend::Blend;
 pub use ggx::Ggx;
-/// How many ulps per component GGX's batch normal sampler may differ from `Ggx::sample_wm`.
-pub use ggx_batch::MAX_ULPS as GGX_BATCH_MAX_ULPS;
 /// How many ulps per component GGX's batch visible-normal sampler may differ from
 /// `Ggx::sample_wm_visible`.
 pub use ggx_visible_batch::MAX_ULPS as GGX_VISIBLE_BATCH_MAX_ULPS;

@@ -266,9 +266,7 @@ fn chi2_batch_counts_are_the_scalar_counts_whatever_the_thread_count() {
                     })
             };
             let (one, two, four) = (batch(1), batch(2), batch(4));
-            // GGX's batch is within 8 ulps of its scalar sampler, not bit for bit
-            // (`ndf::ggx_batch`): a sample within ulps of a cell edge could change cells, which
-            // none of these seeded samples is.
+            // The reference batch samplers give their scalar samplers' normals bit for bit.
             assert_eq!(one.counts, counts, "{json}");
             assert_eq!(one, two, "{json}");
             assert_eq!(one, four, "{json}");
