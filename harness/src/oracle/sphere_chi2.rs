@@ -290,7 +290,7 @@ struct Buffers {
 
 /// The u ∈ [0, 1)³ of `samples` samples from the streams of `seed` (three uniforms a sample,
 /// one stream per chunk of [`CHUNK`] samples), handed to `block(acc, scratch, first index, u)` a block
-/// of at most 1024 at a time, the chunks in parallel, each folded into its own accumulator;
+/// of at most [`BLOCK`] (16 384) at a time, the chunks in parallel, each folded into its own accumulator;
 /// the accumulators in chunk order (so a result folded from them does not depend on the
 /// thread count). The one sampling loop of the BSDF's chi-square and of the BSDF checks.
 ///
