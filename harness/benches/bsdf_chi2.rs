@@ -18,10 +18,11 @@ use criterion::{black_box, Criterion, Throughput};
 use mfh_harness::oracle::chi2::{cells, observe_batch};
 use mfh_harness::oracle::domain::CellFinder;
 use mfh_harness::oracle::sphere_chi2::{chi2_masses, observe_sphere, SphereMasses};
+use mfh_harness::oracle::sphere_finder::SphereFinder;
 use mfh_harness::random::stream;
 use mfh_reference::bsdf::microfacet::{Microfacet, Sampling};
 use mfh_reference::bsdf::spec::BsdfSpec;
-use mfh_reference::bsdf::Bsdf;
+use mfh_reference::bsdf::{Bsdf, Directions};
 use mfh_reference::geometry::Vec3;
 use mfh_reference::model::Masking;
 use mfh_reference::ndf::Ggx;
@@ -79,7 +80,7 @@ fn bsdf_against_ndf(c: &mut Criterion) {
     group.bench_function("dielectric_ggx_0.3", |b| {
         b.iter(|| {
             black_box(observe_sphere(
-                &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| bsdf.sample_wo_batch(wi, u, out),
+                &|u: &[[f64; 3]], out: &mut Directions| bsdf.sample_wo_batch(wi, u, out),
                 grids.clone(),
                 SAMPLES,
                 1,
@@ -110,7 +111,7 @@ fn bsdf_stages(c: &mut Criterion) {
     rng.fill_pairs(&mut pairs);
     let flat: Vec<f64> = pairs.iter().flatten().copied().collect();
     let u: Vec<[f64; 3]> = flat.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
-    let mut out = vec![None; BLOCK];
+    let mut out = Directions::new(BLOCK);
     bsdf.sample_wo_batch(wi, &u, &mut out);
     let sampled = out.clone();
     let mut group = c.benchmark_group("bsdf_stages");
@@ -143,8 +144,9 @@ fn bsdf_stages(c: &mut Criterion) {
             )
         })
     });
+    let mut normals_out = vec![None; BLOCK];
     group.bench_function("microfacet_sample_m_batch", |b| {
-        b.iter(|| microfacet.sample_m_batch(wi, black_box(&u), black_box(&mut out)))
+        b.iter(|| microfacet.sample_m_batch(wi, black_box(&u), black_box(&mut normals_out)))
     });
     group.bench_function("dielectric_sample_wo_batch", |b| {
         b.iter(|| bsdf.sample_wo_batch(wi, black_box(&u), black_box(&mut out)))
@@ -163,6 +165,13 @@ fn bsdf_stages(c: &mut Criterion) {
     group.bench_function("lower_cell_finder", |b| {
         b.iter(|| finder.cells_of(black_box(&lower), black_box(&mut cells)))
     });
+    // Both hemispheres' finder on the whole block, as observe_sphere bins it.
+    let sphere = SphereFinder::new(grids.0.clone(), grids.1.clone());
+    let mut sphere_cells = vec![0usize; sampled.len()];
+    group.throughput(Throughput::Elements(sampled.len() as u64));
+    group.bench_function("sphere_cell_finder", |b| {
+        b.iter(|| sphere.cells_of(black_box(&sampled), black_box(&mut sphere_cells)))
+    });
     // observe_sphere on this thread with a sampler that copies the block sampled above: the
     // split into hemispheres, the two cell finders and the counting (and the finders' tables,
     // built once a run).
@@ -176,9 +185,15 @@ fn bsdf_stages(c: &mut Criterion) {
         b.iter(|| {
             pool.install(|| {
                 black_box(observe_sphere(
-                    &|_: &[[f64; 3]], out: &mut [Option<Vec3>]| {
-                        for out in out.chunks_mut(BLOCK) {
-                            out.copy_from_slice(&sampled[..out.len()]);
+                    &|_: &[[f64; 3]], out: &mut Directions| {
+                        let ([x, y, z], flags) = sampled.components();
+                        for c in out.as_mut().chunks(BLOCK) {
+                            let n = c.len();
+                            let [cx, cy, cz] = c.xyz;
+                            cx.copy_from_slice(&x[..n]);
+                            cy.copy_from_slice(&y[..n]);
+                            cz.copy_from_slice(&z[..n]);
+                            c.sampled.copy_from_slice(&flags[..n]);
                         }
                     },
                     grids.clone(),

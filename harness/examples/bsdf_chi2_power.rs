@@ -14,7 +14,7 @@
 use mfh_harness::oracle::chi2::Chi2Config;
 use mfh_harness::oracle::sphere_chi2::sphere_chi2;
 use mfh_harness::tolerance::STATISTICAL_ALPHA;
-use mfh_reference::bsdf::{Bsdf, BsdfSpec};
+use mfh_reference::bsdf::{Bsdf, BsdfSpec, Directions};
 use mfh_reference::geometry::Vec3;
 
 /// The distortions tried (relative errors).
@@ -65,9 +65,7 @@ fn main() {
                     alpha: level,
                 };
                 let r = sphere_chi2(
-                    &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| {
-                        distorted.sample_wo_batch(wi, u, out)
-                    },
+                    &|u: &[[f64; 3]], out: &mut Directions| distorted.sample_wo_batch(wi, u, out),
                     &|wo: &[Vec3], out: &mut [f64]| {
                         reference.pdf_batch(&vec![wi; wo.len()], wo, out)
                     },

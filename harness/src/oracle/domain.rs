@@ -537,35 +537,11 @@ impl CellFinder {
         inside
     }
 
-    /// The cells of a block from the fast pass's `found` (the cell as an exact f64, or −1
-    /// where the direction was not clear): converted, and the unclear ones found by
-    /// [`CellFinder::cell_of`]; whether every direction was in the domain.
+    /// The cells of a block from the fast pass's `found` (see [`finish_cells`]), the unclear
+    /// ones found by [`CellFinder::cell_of`].
     #[inline(always)]
     fn finish_block(&self, m: &[Vec3], found: &[f64], cells: &mut [usize]) -> bool {
-        // −1 or an integer in [0, 2³¹), converted exactly by adding 1.5·2⁵² (the sum's
-        // low mantissa bits are then the integer, two's complement for −1): integer lanes,
-        // where Rust's saturating `as` conversion (NaN → 0) is done lane by lane, which
-        // made this loop a quarter of the pass under AVX-512. −1 becomes usize::MAX.
-        const MAGIC: f64 = 6_755_399_441_055_744.0;
-        for (cell, &found) in cells.iter_mut().zip(found) {
-            *cell = ((found + MAGIC).to_bits() as i64 - MAGIC.to_bits() as i64) as usize;
-        }
-        if found.iter().fold(true, |all, &f| all & (f >= 0.0)) {
-            return true;
-        }
-        let mut inside = true;
-        for ((cell, &m), &found) in cells.iter_mut().zip(m).zip(found) {
-            if found < 0.0 {
-                *cell = match self.cell_of(m) {
-                    Ok(c) => c,
-                    Err(_) => {
-                        inside = false;
-                        0
-                    }
-                };
-            }
-        }
-        inside
+        finish_cells(found, cells, |k| self.cell_of(m[k]).ok())
     }
 
     /// [`CellFinder::cells_of`] by [`CellFinder::cell_of`] alone.
@@ -635,6 +611,39 @@ impl CellFinder {
     }
 }
 
+/// The cells of a block from a finder's fast pass: `found[k]` is the cell as an exact f64 (an
+/// integer in [0, 2³¹)), or −1 where the direction was not clear and `exact(k)` decides it
+/// (`None`: outside the domain). Returns whether every direction was in the domain (if not,
+/// the cells of those outside are unspecified).
+#[inline(always)]
+pub(crate) fn finish_cells(
+    found: &[f64],
+    cells: &mut [usize],
+    mut exact: impl FnMut(usize) -> Option<usize>,
+) -> bool {
+    // −1 or an integer in [0, 2³¹), converted exactly by adding 1.5·2⁵² (the sum's low
+    // mantissa bits are then the integer, two's complement for −1): integer lanes, where
+    // Rust's saturating `as` conversion (NaN → 0) is done lane by lane, which made this loop
+    // a quarter of the pass under AVX-512. −1 becomes usize::MAX.
+    const MAGIC: f64 = 6_755_399_441_055_744.0;
+    for (cell, &found) in cells.iter_mut().zip(found) {
+        *cell = ((found + MAGIC).to_bits() as i64 - MAGIC.to_bits() as i64) as usize;
+    }
+    if found.iter().fold(true, |all, &f| all & (f >= 0.0)) {
+        return true;
+    }
+    let mut inside = true;
+    for (k, (cell, &found)) in cells.iter_mut().zip(found).enumerate() {
+        if found < 0.0 {
+            *cell = exact(k).unwrap_or_else(|| {
+                inside = false;
+                0
+            });
+        }
+    }
+    inside
+}
+
 /// The column of an azimuth estimate φ̃ and whether it is clear (see
 /// [`CellFinder::cells_of_block_edges`]), a trait so that each finder's loop is compiled apart.
 trait ColumnFinder: Copy {
@@ -676,7 +685,7 @@ impl ColumnFinder for EdgeLookup<'_> {
 /// The interval `[low, high]` of squared lengths x² + y² + z² whose square root `validate`
 /// accepts (|√· − 1| ≤ [`UNIT_TOLERANCE`]), found by bisection over the bit patterns of positive
 /// doubles (ordered like their values).
-fn accepted_squared_lengths() -> [f64; 2] {
+pub(crate) fn accepted_squared_lengths() -> [f64; 2] {
     let accepted = |bits: u64| (f64::from_bits(bits).sqrt() - 1.0).abs() <= UNIT_TOLERANCE;
     // The last accepted pattern in (accepted `a`, rejected `r`) and the first, searching
     // between a rejected `r` below and an accepted `a` above.
@@ -703,22 +712,22 @@ fn accepted_squared_lengths() -> [f64; 2] {
 }
 
 /// Directions per pass of [`CellFinder::cells_of`] (its temporaries live on the stack).
-const FIND_BLOCK: usize = 64;
+pub(crate) const FIND_BLOCK: usize = 64;
 
 /// How far (radians) the azimuth estimate of [`CellFinder::cells_of`] must be from a column
 /// edge for the column to be taken from it: 10× the estimate's error bound (2.5e-7 rad,
 /// `azimuth_estimate_is_within_its_stated_error`), so that the exact side tests of
 /// [`CellFinder::cell_of`] would find the same column.
-const COLUMN_MARGIN: f64 = 2.5e-6;
+pub(crate) const COLUMN_MARGIN: f64 = 2.5e-6;
 
 /// How far z may be from every row edge of a grid with given edges for the row of z to be the
 /// row of z / |m| (|z / |m| − z| ≤ z·1e-6 / (1 − 1e-6) + 3 ulps within the unit tolerance).
-const ROW_MARGIN: f64 = 2e-6;
+pub(crate) const ROW_MARGIN: f64 = 2e-6;
 
 /// The least x² + y² for which [`CellFinder::cells_of`] takes the column from the estimate:
 /// nearer the pole (|(x, y)| < 1e-100), the side tests' products c·y − s·x may lose every
 /// digit to underflow, and `cell_of` decides.
-const POLE_CLEARANCE: f64 = 1e-200;
+pub(crate) const POLE_CLEARANCE: f64 = 1e-200;
 
 /// atan2(y, x) in [0, 2π) to within 2.5e-7 rad, (x, y) ≠ (0, 0) (NaN at (0, 0)): atan q on q =
 /// min/max ∈ [0, 1] by an odd polynomial of degree 13, q·P(q²) with the seven coefficients of
@@ -731,7 +740,7 @@ const POLE_CLEARANCE: f64 = 1e-200;
 /// transmitted directions there, whose lobe-following columns are a few mrad wide; ten
 /// coefficients (9e-10 rad) cost the NDF finder 13 % more time and gained nothing measurable.
 #[inline(always)]
-fn approximate_azimuth(x: f64, y: f64) -> f64 {
+pub(crate) fn approximate_azimuth(x: f64, y: f64) -> f64 {
     use std::f64::consts::{FRAC_PI_2, PI};
     const A: [f64; 7] = [
         0.999_996_111_470_625_5,

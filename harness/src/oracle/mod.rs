@@ -14,6 +14,7 @@ pub mod precise;
 pub mod quadrature;
 pub mod smith_lambda;
 pub mod sphere_chi2;
+pub mod sphere_finder;
 pub mod student_t;
 pub mod visible_moments;
 

@@ -52,10 +52,12 @@ use crate::oracle::chi2::components::{components, Components};
 use crate::oracle::chi2::{
     expected_mass_global_until, pooled_statistic, Chi2Config, Expected, Verdict,
 };
-use crate::oracle::domain::{CellFinder, HemisphereGrid};
+use crate::oracle::domain::HemisphereGrid;
 use crate::oracle::lobe;
+use crate::oracle::sphere_finder::SphereFinder;
 use crate::random::stream;
 use crate::tolerance::{MASS_TOLERANCE, MIN_EXPECTED};
+use mfh_reference::bsdf::Directions;
 use mfh_reference::geometry::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -66,9 +68,9 @@ pub const CHUNK: u64 = 1 << 16;
 /// large enough that an external BSDF answers one request per 16 384 samples.
 const BLOCK: usize = 1 << 14;
 
-/// A batch BSDF sampler at one incidence: writes the direction of `u[k]` (or `None`, a failed
-/// sample) into `out[k]`.
-pub type SphereSampler<'a> = dyn Fn(&[[f64; 3]], &mut [Option<Vec3>]) + Sync + 'a;
+/// A batch BSDF sampler at one incidence: writes the direction of `u[k]` (or a failed sample)
+/// into element k of `out` (as long as `u`).
+pub type SphereSampler<'a> = dyn Fn(&[[f64; 3]], &mut Directions) + Sync + 'a;
 /// A batch density over the sphere at one incidence: writes pdf(wo[k]) into `out[k]`.
 pub type SpherePdf<'a> = dyn Fn(&[Vec3], &mut [f64]) + Sync + 'a;
 
@@ -88,22 +90,6 @@ pub struct SphereObserved {
 }
 
 impl SphereObserved {
-    fn merge(mut self, other: Self) -> Self {
-        for (a, b) in self.upper.iter_mut().zip(&other.upper) {
-            *a += b;
-        }
-        for (a, b) in self.lower.iter_mut().zip(&other.lower) {
-            *a += b;
-        }
-        self.failed += other.failed;
-        self.invalid += other.invalid;
-        self.first_invalid = match (self.first_invalid, other.first_invalid) {
-            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
-            (a, b) => a.or(b),
-        };
-        self
-    }
-
     /// Successful samples (binned).
     pub fn binned(&self) -> u64 {
         self.upper.iter().chain(&self.lower).sum()
@@ -192,8 +178,8 @@ impl SphereChi2Result {
 }
 
 /// Draws `samples` directions through `sample` and bins them over the sphere (step 1): each
-/// block's directions split by hemisphere (the lower mirrored), each part binned by
-/// [`CellFinder::cells_of`] (the vectorized finder); a block with a direction outside the
+/// block's directions binned by [`SphereFinder::cells_of`] (both hemispheres in one vectorized
+/// pass, the failed samples into a cell of their own); a block with a direction outside the
 /// domain is binned again one by one for the errors (the same counts either way).
 pub fn observe_sphere(
     sample: &SphereSampler<'_>,
@@ -201,73 +187,38 @@ pub fn observe_sphere(
     samples: u64,
     seed: u64,
 ) -> SphereObserved {
-    let zero = || SphereObserved {
-        upper: vec![0; upper_grid.cells()],
-        lower: vec![0; lower_grid.cells()],
-        ..SphereObserved::default()
+    let finder = SphereFinder::new(upper_grid, lower_grid);
+    let failed_cell = finder.failed_cell();
+    let zero = || Tally {
+        counts: vec![0; failed_cell + 1],
+        ..Tally::default()
     };
-    let (upper_finder, lower_finder) = (
-        CellFinder::new(upper_grid.clone()),
-        CellFinder::new(lower_grid.clone()),
-    );
-    draw_chunks(
+    let tally = draw_chunks(
         samples,
         seed,
         zero,
         Buffers::default,
-        |obs, buf, index, u| {
+        |tally, buf, index, u| {
             let n = u.len();
-            buf.out.clear();
-            buf.out.resize(n, None);
+            // Failed samples until written (a sampler that skips an element fails it).
+            buf.out.resize(n);
+            buf.out.fail_all();
             sample(u, &mut buf.out);
-            // Each hemisphere's directions (the lower mirrored), without a branch per sample
-            // (reflection or refraction is a coin toss the predictor cannot learn): every
-            // direction is written to both lists' next slot, and the slot of its hemisphere
-            // advances. A NaN z counts as lower, where the finder flags it.
-            buf.upper.resize(n + 1, [0.0; 3]);
-            buf.lower.resize(n + 1, [0.0; 3]);
-            let (mut upper_n, mut lower_n, mut failed) = (0, 0, 0);
-            for w in &buf.out {
-                let (w, some) = w.map_or(([0.0; 3], false), |w| (w, true));
-                let up = w[2] >= 0.0;
-                buf.upper[upper_n] = w;
-                buf.lower[lower_n] = [w[0], w[1], -w[2]];
-                upper_n += usize::from(some & up);
-                lower_n += usize::from(some & !up);
-                failed += u64::from(!some);
-            }
-            obs.failed += failed;
-            let (upper_w, lower_w) = (&buf.upper[..upper_n], &buf.lower[..lower_n]);
-            buf.cells.resize(upper_n.max(lower_n), 0);
-            let upper = upper_finder.cells_of(upper_w, &mut buf.cells[..upper_n]);
-            if upper {
-                for &c in &buf.cells[..upper_n] {
-                    obs.upper[c] += 1;
+            buf.cells.resize(n, 0);
+            if finder.cells_of(&buf.out, &mut buf.cells) {
+                for &c in &buf.cells {
+                    tally.counts[c] += 1;
                 }
-            }
-            let lower = lower_finder.cells_of(lower_w, &mut buf.cells[..lower_n]);
-            if lower {
-                for &c in &buf.cells[..lower_n] {
-                    obs.lower[c] += 1;
-                }
-            }
-            if upper && lower {
                 return;
             }
-            // A hemisphere with a direction outside the domain: its directions one by one.
-            for (k, wo) in buf.out.iter().enumerate() {
-                let Some(w) = *wo else { continue };
-                let (cells, finder, mirrored) = match (w[2] >= 0.0, upper, lower) {
-                    (true, true, _) | (false, _, true) => continue,
-                    (true, false, _) => (&mut obs.upper, &upper_finder, w),
-                    (false, _, false) => (&mut obs.lower, &lower_finder, [w[0], w[1], -w[2]]),
-                };
-                match finder.cell_of(mirrored) {
-                    Ok(c) => cells[c] += 1,
+            // A direction outside the domain: the block one by one, for the errors.
+            for (k, w) in buf.out.iter().enumerate() {
+                match w.map_or(Ok(failed_cell), |w| finder.cell_of(w)) {
+                    Ok(c) => tally.counts[c] += 1,
                     Err(_) => {
-                        obs.invalid += 1;
-                        if obs.first_invalid.is_none() {
-                            obs.first_invalid = Some((index + k as u64, w));
+                        tally.invalid += 1;
+                        if tally.first_invalid.is_none() {
+                            tally.first_invalid = w.map(|w| (index + k as u64, w));
                         }
                     }
                 }
@@ -275,16 +226,44 @@ pub fn observe_sphere(
         },
     )
     .into_iter()
-    .fold(zero(), SphereObserved::merge)
+    .fold(zero(), Tally::merge);
+    let upper_cells = finder.upper().grid().cells();
+    SphereObserved {
+        upper: tally.counts[..upper_cells].to_vec(),
+        lower: tally.counts[upper_cells..failed_cell].to_vec(),
+        failed: tally.counts[failed_cell],
+        invalid: tally.invalid,
+        first_invalid: tally.first_invalid,
+    }
 }
 
-/// A chunk's buffers, reused block to block: the sampled directions, those of each
-/// hemisphere (the lower mirrored) and their cells.
+/// A chunk's counts: per cell of the [`SphereFinder`] (the failed samples' last), and the
+/// directions outside the domain.
+#[derive(Default)]
+struct Tally {
+    counts: Vec<u64>,
+    invalid: u64,
+    first_invalid: Option<(u64, Vec3)>,
+}
+
+impl Tally {
+    fn merge(mut self, other: Self) -> Self {
+        for (a, b) in self.counts.iter_mut().zip(&other.counts) {
+            *a += b;
+        }
+        self.invalid += other.invalid;
+        self.first_invalid = match (self.first_invalid, other.first_invalid) {
+            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
+            (a, b) => a.or(b),
+        };
+        self
+    }
+}
+
+/// A chunk's buffers, reused block to block: the sampled directions and their cells.
 #[derive(Default)]
 struct Buffers {
-    out: Vec<Option<Vec3>>,
-    upper: Vec<Vec3>,
-    lower: Vec<Vec3>,
+    out: Directions,
     cells: Vec<usize>,
 }
 
@@ -655,6 +634,7 @@ fn sanity(r: &SphereChi2Result) -> Option<String> {
 mod tests {
     use super::*;
     use crate::check::bsdf::pdf_at;
+    use crate::oracle::domain::CellFinder;
 
     /// The reference GGX dielectric at grazing incidence (cos θi = 0.05), whose pdf steps where
     /// half vectors cross the horizon: the masses for a chi-square of 10⁶ samples meet the
@@ -695,10 +675,10 @@ mod tests {
         }
     }
 
-    /// The vectorized binning of `observe_sphere` counts what `CellFinder::cell_of` finds one
-    /// by one, on directions at the hard places (poles, φ = 0 and the column edges, the
-    /// horizon from both sides, row edges of a quantile grid) mixed with failed, non-finite
-    /// and non-unit ones, whatever the thread count.
+    /// The vectorized binning of `observe_sphere` counts what each hemisphere's
+    /// `CellFinder::cell_of` finds one by one, on directions at the hard places (poles, φ = 0
+    /// and the column edges, the horizon from both sides, row edges of a quantile grid) mixed
+    /// with failed, non-finite and non-unit ones, whatever the thread count.
     #[test]
     fn sphere_binning_counts_what_cell_of_finds() {
         let grid = HemisphereGrid::with_edges(
@@ -731,19 +711,24 @@ mod tests {
                 _ => Some(at(phi, z)),
             }
         };
-        let sampler = |u: &[[f64; 3]], out: &mut [Option<Vec3>]| {
-            for (o, &u) in out.iter_mut().zip(u) {
-                *o = direction(u);
+        let sampler = |u: &[[f64; 3]], out: &mut Directions| {
+            for (k, &u) in u.iter().enumerate() {
+                out.set(k, direction(u));
             }
         };
         let samples = 200_000;
-        let grids = (grid.clone(), grid.clone());
+        // The lower hemisphere equal-area: the finder puts both grids' edges on one line.
+        let lower_grid = HemisphereGrid::new(6).unwrap();
+        let grids = (grid.clone(), lower_grid.clone());
         let observed = observe_sphere(&sampler, grids.clone(), samples, 5);
-        // One by one, over the same uniforms.
-        let finder = CellFinder::new(grid.clone());
+        // One by one, over the same uniforms, by each hemisphere's own finder.
+        let (upper_finder, lower_finder) = (
+            CellFinder::new(grid.clone()),
+            CellFinder::new(lower_grid.clone()),
+        );
         let mut want = SphereObserved {
             upper: vec![0; grid.cells()],
-            lower: vec![0; grid.cells()],
+            lower: vec![0; lower_grid.cells()],
             ..SphereObserved::default()
         };
         let blocks = draw_chunks(
@@ -764,10 +749,10 @@ mod tests {
                 want.failed += 1;
                 continue;
             };
-            let (cells, m) = if w[2] >= 0.0 {
-                (&mut want.upper, w)
+            let (cells, finder, m) = if w[2] >= 0.0 {
+                (&mut want.upper, &upper_finder, w)
             } else {
-                (&mut want.lower, [w[0], w[1], -w[2]])
+                (&mut want.lower, &lower_finder, [w[0], w[1], -w[2]])
             };
             match finder.cell_of(m) {
                 Ok(c) => cells[c] += 1,

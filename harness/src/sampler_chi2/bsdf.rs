@@ -10,7 +10,7 @@ use crate::oracle::chi2::Chi2Config;
 use crate::oracle::sphere_chi2::{sphere_chi2, SphereChi2Result};
 use crate::record::RecordData;
 use crate::tolerance::MIN_EXPECTED;
-use mfh_reference::bsdf::{Bsdf, BsdfSpec};
+use mfh_reference::bsdf::{Bsdf, BsdfSpec, Directions};
 use mfh_reference::geometry::{from_spherical, Vec3};
 use serde_json::{json, Value};
 use std::f64::consts::FRAC_PI_2;
@@ -147,7 +147,7 @@ pub fn run(plan: &BsdfChi2Plan) -> SphereChi2Result {
     let bsdf = plan.bsdf.as_ref();
     let wi = plan.wi;
     sphere_chi2(
-        &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| bsdf.sample_wo_batch(wi, u, out),
+        &|u: &[[f64; 3]], out: &mut Directions| bsdf.sample_wo_batch(wi, u, out),
         &|wo: &[Vec3], out: &mut [f64]| {
             let wis = vec![wi; wo.len()];
             bsdf.pdf_batch(&wis, wo, out);

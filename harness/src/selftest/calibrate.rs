@@ -11,6 +11,7 @@ use crate::oracle::ks::ks_p_value;
 use crate::oracle::ks::{ks_statistic, ks_test_lobe, KsConfig, Marginal};
 use crate::oracle::lobe;
 use crate::tolerance::CELL_RELATIVE_TOLERANCE;
+use mfh_reference::bsdf::Directions;
 use mfh_reference::family::FamilySpec;
 use mfh_reference::{ModelSpec, Vec3};
 use rayon::prelude::*;
@@ -298,9 +299,7 @@ pub fn calibrate_bsdf(
                     alpha: LEVELS[0],
                 };
                 let r = sphere_chi2_against(
-                    &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| {
-                        bsdf.sample_wo_batch(inc.wi, u, out)
-                    },
+                    &|u: &[[f64; 3]], out: &mut Directions| bsdf.sample_wo_batch(inc.wi, u, out),
                     expected.clone(),
                     &config,
                 );

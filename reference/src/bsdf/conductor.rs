@@ -4,7 +4,7 @@
 use super::fresnel::{self, FresnelModel};
 use super::microfacet::{reflection_half_vector, Microfacet, SUB_BLOCK};
 use super::scatter_block;
-use super::{finite, finite_or_zero, Bsdf, BsdfError, BsdfSample};
+use super::{finite, finite_or_zero, Bsdf, BsdfError, BsdfSample, Directions};
 use crate::geometry::{dot, Vec3};
 
 /// The largest n and k accepted (measured metals have n, k < 15 in the visible; the bound only
@@ -126,23 +126,23 @@ impl Bsdf for Conductor {
 
     /// The directions of [`Bsdf::sample`] without its eval and pdf: the normals by the
     /// model's batch sampler, then the reflection.
-    fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<Vec3>]) {
+    fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut Directions) {
         assert_eq!(
             u.len(),
             out.len(),
             "sample_wo_batch: u and out differ in length"
         );
         if !finite(wi) || !(wi[2] > 0.0) {
-            return out.fill(None);
+            return out.fail_all();
         }
         // Sub-blocks on the stack: the normals, then their tests and the reflection in one
         // vectorized pass.
         let mut m = [[0.0; 3]; SUB_BLOCK];
-        for (u, out) in u.chunks(SUB_BLOCK).zip(out.chunks_mut(SUB_BLOCK)) {
+        for (u, out) in u.chunks(SUB_BLOCK).zip(out.as_mut().chunks(SUB_BLOCK)) {
             let m = &mut m[..u.len()];
             match self.microfacet.sample_m_unchecked(wi, u, m) {
                 Some(v) => scatter_block::reflect_block((wi, v), m, out),
-                None => out.fill(None),
+                None => out.sampled.fill(false),
             }
         }
     }

@@ -3,7 +3,7 @@
 //! reflection.
 
 use super::microfacet::{reflection_half_vector, Microfacet, SUB_BLOCK};
-use super::{finite, finite_or_zero, Bsdf, BsdfError, BsdfSample, Transport};
+use super::{finite, finite_or_zero, Bsdf, BsdfError, BsdfSample, Directions, Transport};
 use super::{fresnel, scatter_block};
 use crate::geometry::{dot, Vec3};
 
@@ -224,23 +224,23 @@ impl Bsdf for Dielectric {
 
     /// The directions of [`Bsdf::sample`] without its eval and pdf: the normals by the
     /// model's batch sampler, then the Fresnel choice and the reflection or refraction.
-    fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<Vec3>]) {
+    fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut Directions) {
         assert_eq!(
             u.len(),
             out.len(),
             "sample_wo_batch: u and out differ in length"
         );
         if !finite(wi) || wi[2] == 0.0 {
-            return out.fill(None);
+            return out.fail_all();
         }
         // Sub-blocks on the stack: the normals, then their tests and the scatter in one pass.
         let mut m = [[0.0; 3]; SUB_BLOCK];
         let other = self.other(wi);
-        for (u, out) in u.chunks(SUB_BLOCK).zip(out.chunks_mut(SUB_BLOCK)) {
+        for (u, out) in u.chunks(SUB_BLOCK).zip(out.as_mut().chunks(SUB_BLOCK)) {
             let m = &mut m[..u.len()];
             match self.microfacet.sample_m_unchecked(wi, u, m) {
                 Some(v) => scatter_block::scatter_block((wi, v), other, u, m, out),
-                None => out.fill(None),
+                None => out.sampled.fill(false),
             }
         }
     }

@@ -31,6 +31,14 @@ fn scalar(b: &dyn Bsdf, wi: Vec3, u: [f64; 3]) -> Option<Vec3> {
     b.sample(wi, u).filter(|s| s.pdf > 0.0).map(|s| s.wo)
 }
 
+/// `sample_wo_batch` into directions that hold something else before (so every element must
+/// be written).
+fn wo_batch(b: &dyn Bsdf, wi: Vec3, u: &[[f64; 3]]) -> Vec<Option<Vec3>> {
+    let mut out = super::Directions::from_options(&vec![Some([9.0; 3]); u.len()]);
+    b.sample_wo_batch(wi, u, &mut out);
+    out.iter().collect()
+}
+
 #[test]
 fn sampled_directions_are_those_of_sample() {
     let ends = [0.0, 0.5, 1.0 - f64::EPSILON / 2.0];
@@ -44,8 +52,7 @@ fn sampled_directions_are_those_of_sample() {
                     u.extend(ends.map(|e| [a, c, e]));
                 }
             }
-            let mut fast = vec![None; u.len()];
-            b.sample_wo_batch(wi, &u, &mut fast);
+            let fast = wo_batch(b.as_ref(), wi, &u);
             for (k, (&u, fast)) in u.iter().zip(&fast).enumerate() {
                 let slow = scalar(b.as_ref(), wi, u);
                 assert!(
@@ -82,9 +89,7 @@ fn the_default_keeps_the_directions_of_sample_batch() {
     let plain = Plain(b.clone());
     let u: Vec<[f64; 3]> = (0..2000).map(r3).collect();
     for wi in incidences(b.eta()) {
-        let (mut a, mut c) = (vec![None; u.len()], vec![None; u.len()]);
-        b.sample_wo_batch(wi, &u, &mut a);
-        plain.sample_wo_batch(wi, &u, &mut c);
+        let (a, c) = (wo_batch(b.as_ref(), wi, &u), wo_batch(&plain, wi, &u));
         for (k, (a, c)) in a.iter().zip(&c).enumerate() {
             assert!(close(a, c), "wi {wi:?} sample {k}: {a:?} vs {c:?}");
         }

@@ -58,6 +58,7 @@
 
 pub mod conductor;
 pub mod dielectric;
+pub mod directions;
 pub mod error;
 pub mod fresnel;
 pub mod fresnel_block;
@@ -74,6 +75,7 @@ mod tests;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
+pub use directions::{Directions, DirectionsMut};
 pub use error::BsdfError;
 pub use fresnel::FresnelModel;
 pub use microfacet::{Microfacet, Sampling};
@@ -230,18 +232,18 @@ pub trait Bsdf: Send + Sync {
         }
     }
 
-    /// The directions alone of [`Bsdf::sample_batch`]: `out[k]` = the `wo` of
-    /// `self.sample(wi, u[k])`, `None` for a failed sample or one of pdf 0. A chi-square of the
-    /// sampled directions needs nothing else, so an implementation may skip the pdf and weight
-    /// of each sample here (the reference BSDFs do: their Fresnel, D, Λ and Jacobians are
-    /// most of a sample's cost), provided it returns the same directions (the reference
-    /// BSDFs do to the ulps their batch normal samplers document, within 1e-12 a component:
-    /// `reference/src/bsdf/direction_tests.rs`). The default calls
+    /// The directions alone of [`Bsdf::sample_batch`]: element k of `out` = the `wo` of
+    /// `self.sample(wi, u[k])`, a failed sample for a failed sample or one of pdf 0. A
+    /// chi-square of the sampled directions needs nothing else, so an implementation may skip
+    /// the pdf and weight of each sample here (the reference BSDFs do: their Fresnel, D, Λ and
+    /// Jacobians are most of a sample's cost), provided it returns the same directions (the
+    /// reference BSDFs do to the ulps their batch normal samplers document, within 1e-12 a
+    /// component: `reference/src/bsdf/direction_tests.rs`). The default calls
     /// [`Bsdf::sample_batch`] (one request of an external BSDF) and keeps the `wo`.
     ///
     /// # Panics
     /// If `u` and `out` differ in length.
-    fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<Vec3>]) {
+    fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut Directions) {
         assert_eq!(
             u.len(),
             out.len(),
@@ -249,8 +251,8 @@ pub trait Bsdf: Send + Sync {
         );
         let mut samples = vec![None; u.len()];
         self.sample_batch(wi, u, &mut samples);
-        for (o, s) in out.iter_mut().zip(samples) {
-            *o = s.filter(|s: &BsdfSample| s.pdf > 0.0).map(|s| s.wo);
+        for (k, s) in samples.into_iter().enumerate() {
+            out.set(k, s.filter(|s: &BsdfSample| s.pdf > 0.0).map(|s| s.wo));
         }
     }
 }
@@ -286,7 +288,7 @@ macro_rules! delegate_bsdf {
             fn sample_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<BsdfSample>]) {
                 (**self).sample_batch(wi, u, out)
             }
-            fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut [Option<Vec3>]) {
+            fn sample_wo_batch(&self, wi: Vec3, u: &[[f64; 3]], out: &mut Directions) {
                 (**self).sample_wo_batch(wi, u, out)
             }
         }

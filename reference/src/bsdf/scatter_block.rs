@@ -2,18 +2,20 @@
 //! (`sample_wo_batch`, the BSDF chi-square's hot loop). For the rough dielectric, per element the Fresnel
 //! reflectance at wi·m, the lobe choice by u₀, the reflected or refracted direction and its
 //! side test — [`scatter_lane`], which the scalar `Dielectric::scattered` calls too, so the two
-//! are one computation — as straight-line loops over a pass of [`PASS`] elements, both
+//! are one computation — as straight-line loops over the block's components, written in
+//! place into the output's x, y and z arrays ([`DirectionsMut`]), both
 //! directions computed and one selected; for the conductor, the reflection and its side test
 //! ([`reflect_lane`], the scalar's too). The loops vectorize (8 or 4 lanes under AVX-512 or
 //! AVX2 through `pulp`'s safe runtime dispatch, 2 under baseline SSE2). The same bits on every
 //! path and as the scalar: Rust never contracts into FMA, and packed +, −, ×, ÷, √, min and
 //! compares round as scalar ones (the test `the_block_is_the_scalar_on_every_path`).
 
+use super::directions::DirectionsMut;
 use super::fresnel_block::lane as fresnel_lane;
 use super::microfacet::{normal_ok, reflect, refract};
 use crate::geometry::{dot, Vec3};
 
-/// Elements per pass: the temporaries live on the stack (5 × 64 doubles).
+/// Elements per pass of the scatter (its lobe choices live on the stack).
 const PASS: usize = 64;
 
 /// The direction `Dielectric::scattered` makes of wi through the normal m with the lobe
@@ -39,8 +41,9 @@ pub(super) fn scatter_lane(
 }
 
 /// `out[k]` = the dielectric's sampled direction of the normal `m[k]` sampled at `v` = wi⁺
-/// (`None` where [`normal_ok`] fails: a failed normal) with the lobe choice `u[k][0]`, from
-/// `wi` into a far side of index `eta` over wi's: `Dielectric::scattered` bit for bit.
+/// (a failed sample where [`normal_ok`] fails: a failed normal) with the lobe choice
+/// `u[k][0]`, from `wi` into a far side of index `eta` over wi's: `Dielectric::scattered` bit
+/// for bit.
 ///
 /// # Panics
 /// If `u`, `m` and `out` differ in length.
@@ -49,7 +52,7 @@ pub(super) fn scatter_block(
     eta: f64,
     u: &[[f64; 3]],
     m: &[Vec3],
-    out: &mut [Option<Vec3>],
+    out: DirectionsMut<'_>,
 ) {
     scatter_block_on(pulp::Arch::new(), (wi, v), eta, u, m, out)
 }
@@ -61,7 +64,7 @@ fn scatter_block_on(
     eta: f64,
     u: &[[f64; 3]],
     m: &[Vec3],
-    out: &mut [Option<Vec3>],
+    out: DirectionsMut<'_>,
 ) {
     let n = u.len();
     assert!(
@@ -75,7 +78,7 @@ fn scatter_block_on(
         eta: f64,
         u: &'a [[f64; 3]],
         m: &'a [Vec3],
-        out: &'a mut [Option<Vec3>],
+        out: DirectionsMut<'a>,
     }
     impl pulp::WithSimd for Op<'_> {
         type Output = ();
@@ -84,30 +87,25 @@ fn scatter_block_on(
             let (wi, v, eta) = (self.wi, self.v, self.eta);
             // fresnel::dielectric's constants of η, as the block form takes them.
             let (e2, em1) = (eta * eta, (eta - 1.0) * (eta + 1.0));
-            let (mut x, mut y, mut z) = ([0.0; PASS], [0.0; PASS], [0.0; PASS]);
-            let (mut u0, mut some) = ([0.0; PASS], [false; PASS]);
-            let passes = self.u.chunks(PASS).zip(self.m.chunks(PASS));
-            for ((u, m), out) in passes.zip(self.out.chunks_mut(PASS)) {
-                let n = u.len();
-                for (k, (u, m)) in u.iter().zip(m).enumerate() {
-                    (x[k], y[k], z[k], u0[k]) = (m[0], m[1], m[2], u[0]);
+            let [x, y, z] = self.out.xyz;
+            split(self.m, [&mut *x, &mut *y, &mut *z]);
+            // The lobe choices apart, a pass at a time: read from the u triples in the loop,
+            // they kept it from vectorizing.
+            let mut u0 = [0.0; PASS];
+            let passes = (x.chunks_mut(PASS).zip(y.chunks_mut(PASS)))
+                .zip(z.chunks_mut(PASS).zip(self.out.sampled.chunks_mut(PASS)));
+            for (((x, y), (z, sampled)), u) in passes.zip(self.u.chunks(PASS)) {
+                for (u0, u) in u0.iter_mut().zip(u) {
+                    *u0 = u[0];
                 }
                 // Zipped slices of one length: no bounds checks, so the loop vectorizes.
-                for ((((x, y), z), some), &u0) in x[..n]
-                    .iter_mut()
-                    .zip(&mut y[..n])
-                    .zip(&mut z[..n])
-                    .zip(&mut some[..n])
-                    .zip(&u0[..n])
-                {
+                let lanes = x.iter_mut().zip(y.iter_mut()).zip(z.iter_mut());
+                for ((((x, y), z), sampled), &u0) in lanes.zip(sampled).zip(&u0[..u.len()]) {
                     let m = [*x, *y, *z];
                     let fresnel = fresnel_lane(dot(wi, m), eta, e2, em1);
                     let (wo, ok) = scatter_lane(wi, m, u0, eta, fresnel);
                     (*x, *y, *z) = (wo[0], wo[1], wo[2]);
-                    *some = normal_ok(v, m) & ok;
-                }
-                for (k, o) in out.iter_mut().enumerate() {
-                    *o = some[k].then_some([x[k], y[k], z[k]]);
+                    *sampled = normal_ok(v, m) & ok;
                 }
             }
         }
@@ -122,6 +120,14 @@ fn scatter_block_on(
     })
 }
 
+/// The components of `m` into `xyz` (as long), for the passes that load whole vectors.
+#[inline(always)]
+fn split(m: &[Vec3], [x, y, z]: [&mut [f64]; 3]) {
+    for (((m, x), y), z) in m.iter().zip(x).zip(y).zip(z) {
+        (*x, *y, *z) = (m[0], m[1], m[2]);
+    }
+}
+
 /// The direction the conductor's `sample` reflects wi into about the normal m (Walter eq 39),
 /// and whether it is a sample: finite and above the surface. No branch.
 #[inline(always)]
@@ -132,17 +138,17 @@ pub(super) fn reflect_lane(wi: Vec3, m: Vec3) -> (Vec3, bool) {
 }
 
 /// `out[k]` = the conductor's sampled direction of the normal `m[k]` sampled at `v` = wi⁺
-/// (`None` where [`normal_ok`] or [`reflect_lane`] fails), as its scalar `sample` makes it,
-/// bit for bit, in one vectorized pass.
+/// (a failed sample where [`normal_ok`] or [`reflect_lane`] fails), as its scalar `sample`
+/// makes it, bit for bit, in one vectorized pass.
 ///
 /// # Panics
 /// If `m` and `out` differ in length.
-pub(super) fn reflect_block((wi, v): (Vec3, Vec3), m: &[Vec3], out: &mut [Option<Vec3>]) {
+pub(super) fn reflect_block((wi, v): (Vec3, Vec3), m: &[Vec3], out: DirectionsMut<'_>) {
     reflect_block_on(pulp::Arch::new(), (wi, v), m, out)
 }
 
 /// [`reflect_block`] through the instruction set `arch`.
-fn reflect_block_on(arch: pulp::Arch, (wi, v): (Vec3, Vec3), m: &[Vec3], out: &mut [Option<Vec3>]) {
+fn reflect_block_on(arch: pulp::Arch, (wi, v): (Vec3, Vec3), m: &[Vec3], out: DirectionsMut<'_>) {
     assert_eq!(
         m.len(),
         out.len(),
@@ -153,34 +159,21 @@ fn reflect_block_on(arch: pulp::Arch, (wi, v): (Vec3, Vec3), m: &[Vec3], out: &m
         wi: Vec3,
         v: Vec3,
         m: &'a [Vec3],
-        out: &'a mut [Option<Vec3>],
+        out: DirectionsMut<'a>,
     }
     impl pulp::WithSimd for Op<'_> {
         type Output = ();
         #[inline(always)]
         fn with_simd<S: pulp::Simd>(self, _simd: S) {
             let (wi, v) = (self.wi, self.v);
-            let (mut x, mut y, mut z) = ([0.0; PASS], [0.0; PASS], [0.0; PASS]);
-            let mut some = [false; PASS];
-            for (m, out) in self.m.chunks(PASS).zip(self.out.chunks_mut(PASS)) {
-                let n = m.len();
-                for (k, m) in m.iter().enumerate() {
-                    (x[k], y[k], z[k]) = (m[0], m[1], m[2]);
-                }
-                for (((x, y), z), some) in x[..n]
-                    .iter_mut()
-                    .zip(&mut y[..n])
-                    .zip(&mut z[..n])
-                    .zip(&mut some[..n])
-                {
-                    let m = [*x, *y, *z];
-                    let (wo, ok) = reflect_lane(wi, m);
-                    (*x, *y, *z) = (wo[0], wo[1], wo[2]);
-                    *some = normal_ok(v, m) & ok;
-                }
-                for (k, o) in out.iter_mut().enumerate() {
-                    *o = some[k].then_some([x[k], y[k], z[k]]);
-                }
+            let [x, y, z] = self.out.xyz;
+            split(self.m, [&mut *x, &mut *y, &mut *z]);
+            let lanes = x.iter_mut().zip(y.iter_mut()).zip(z.iter_mut());
+            for (((x, y), z), sampled) in lanes.zip(self.out.sampled) {
+                let m = [*x, *y, *z];
+                let (wo, ok) = reflect_lane(wi, m);
+                (*x, *y, *z) = (wo[0], wo[1], wo[2]);
+                *sampled = normal_ok(v, m) & ok;
             }
         }
     }
@@ -190,6 +183,7 @@ fn reflect_block_on(arch: pulp::Arch, (wi, v): (Vec3, Vec3), m: &[Vec3], out: &m
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::directions::Directions;
     use crate::bsdf::fresnel::dielectric;
     use crate::bsdf::microfacet::upper;
     use crate::geometry::from_spherical;
@@ -237,15 +231,15 @@ mod tests {
                             .iter()
                             .map(|m| m.unwrap_or([0.0; 3]))
                             .collect();
-                        let mut out = vec![Some([9.0; 3]); range.len()];
+                        let mut out = Directions::from_options(&vec![Some([9.0; 3]); range.len()]);
                         let u = &u[range.clone()];
-                        scatter_block_on(arch, (wi, v), eta, u, &normals, &mut out);
-                        for (k, got) in range.clone().zip(&out) {
+                        scatter_block_on(arch, (wi, v), eta, u, &normals, out.as_mut());
+                        for (k, got) in range.clone().zip(out.iter()) {
                             let want = m[k]
                                 .filter(|&m| normal_ok(v, m))
                                 .and_then(|m| scalar(wi, m, u[k - range.start][0], eta));
                             let bits = |w: &Option<Vec3>| w.map(|w| w.map(f64::to_bits));
-                            assert_eq!(bits(got), bits(&want), "η {eta}, θ {theta}, m {:?}", m[k]);
+                            assert_eq!(bits(&got), bits(&want), "η {eta}, θ {theta}, m {:?}", m[k]);
                         }
                     }
                 }
@@ -268,15 +262,15 @@ mod tests {
             m.extend([[0.0, 0.0, 1.0], [f64::NAN, 0.0, 1.0], wi, [1.0, 0.0, 0.0]]);
             for arch in [pulp::Arch::new(), pulp::Arch::Scalar] {
                 for range in [0..m.len(), 5..72] {
-                    let mut out = vec![Some([9.0; 3]); range.len()];
-                    reflect_block_on(arch, (wi, v), &m[range.clone()], &mut out);
-                    for (k, got) in range.clone().zip(&out) {
+                    let mut out = Directions::from_options(&vec![Some([9.0; 3]); range.len()]);
+                    reflect_block_on(arch, (wi, v), &m[range.clone()], out.as_mut());
+                    for (k, got) in range.clone().zip(out.iter()) {
                         let want = Some(m[k]).filter(|&m| normal_ok(v, m)).and_then(|m| {
                             let (wo, ok) = reflect_lane(wi, m);
                             ok.then_some(wo)
                         });
                         let bits = |w: &Option<Vec3>| w.map(|w| w.map(f64::to_bits));
-                        assert_eq!(bits(got), bits(&want), "θ {theta}, m {:?}", m[k]);
+                        assert_eq!(bits(&got), bits(&want), "θ {theta}, m {:?}", m[k]);
                     }
                 }
             }

@@ -9,7 +9,7 @@ use crate::oracle::sphere_chi2::{
 };
 use crate::record::{Measured, OracleValue, RecordData, Verdict};
 use crate::tolerance::STATISTICAL_ALPHA;
-use mfh_reference::geometry::Vec3;
+use mfh_reference::bsdf::Directions;
 use serde_json::{json, Value};
 use std::sync::Arc;
 
@@ -45,7 +45,7 @@ pub fn plan<'a>(
             };
             let (masses, spent) = shared.pdf_masses(bsdf);
             let result = sphere_chi2_against(
-                &|u: &[[f64; 3]], out: &mut [Option<Vec3>]| bsdf.sample_wo_batch(wi, u, out),
+                &|u: &[[f64; 3]], out: &mut Directions| bsdf.sample_wo_batch(wi, u, out),
                 masses.clone(),
                 &config,
             );
