@@ -139,8 +139,8 @@ impl<'a> Audit<'a> {
 
     /// The precision the model computes in (default f64): a float32 implementation is judged
     /// with value tolerances budgeted in float32 ε (`tolerance::Tolerance::at`) and oracles
-    /// that stop at its rounding floor; statistical checks are unchanged. Not yet for
-    /// [`Audit::of_bsdf`] (an `audit.configuration` error).
+    /// that stop at its rounding floor; statistical checks are unchanged. For
+    /// [`Audit::of_bsdf`] too (the BSDF checks' `_f32` rows, `tolerance/bsdf.rs`).
     pub fn precision(mut self, precision: Precision) -> Self {
         self.precision = precision;
         self
@@ -306,20 +306,7 @@ impl<'a> Audit<'a> {
                 )),
             }
         }
-        // Every record carries the precision it was judged at (the declared one, or f32 when
-        // `audit.precision` found a float32 model declared f64): stamped by the runner, so
-        // that `Audit::run` and the external audit's own runner both see it.
-        for p in &mut plan {
-            let run = std::mem::replace(&mut p.run, Box::new(|_| unreachable_record()));
-            p.run = Box::new(move |ctx| {
-                let mut r = run(ctx);
-                r.precision = precision;
-                r
-            });
-        }
-        for e in &mut errors {
-            e.precision = precision;
-        }
+        stamp_precision(&mut plan, &mut errors, precision);
         (plan, errors)
     }
 
@@ -330,20 +317,25 @@ impl<'a> Audit<'a> {
             masking: self.masking.flatten(),
             visible_normals: self.sampling == Some(Some(Sampling::VisibleNormals)),
         });
-        let subject = BsdfSubject::user(bsdf, &self.name, own_ndf);
+        // What its answers say of its precision, as for a model (`audit.precision`).
+        let seen = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            precision_probe::probe_bsdf(bsdf.as_ref())
+        }))
+        .ok();
+        let precision = seen.map_or(self.precision, |seen| {
+            precision_probe::effective(self.precision, seen)
+        });
+        let subject = BsdfSubject::user(bsdf, &self.name, own_ndf, precision);
         let why = format!("BSDF `{}`", self.name);
         let mut errors = Vec::new();
         if let Some(message) = &self.seed_error {
             errors.push(config_error(&subject.label, message.clone()));
         }
-        if self.precision != Precision::F64 {
-            errors.push(config_error(
+        if let Some(seen) = seen {
+            errors.push(precision_probe::record(
                 &subject.label,
-                format!(
-                    "precision: {} is not supported for a BSDF audit yet (its tolerances are \
-                     budgeted for f64)",
-                    self.precision
-                ),
+                self.precision,
+                seen,
             ));
         }
         let mut plan = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
@@ -368,6 +360,7 @@ impl<'a> Audit<'a> {
                 )),
             }
         }
+        stamp_precision(&mut plan, &mut errors, precision);
         (plan, errors)
     }
 
@@ -393,6 +386,27 @@ impl<'a> Audit<'a> {
             (k, alpha),
             t.elapsed().as_secs_f64(),
         )
+    }
+}
+
+/// Every record carries the precision it was judged at (the declared one, or f32 when
+/// `audit.precision` found a float32 implementation declared f64): stamped by the runner, so
+/// that `Audit::run` and the external audit's own runner both see it.
+fn stamp_precision(
+    plan: &mut [PlannedCheck<'_>],
+    errors: &mut [CheckRecord],
+    precision: Precision,
+) {
+    for p in plan {
+        let run = std::mem::replace(&mut p.run, Box::new(|_| unreachable_record()));
+        p.run = Box::new(move |ctx| {
+            let mut r = run(ctx);
+            r.precision = precision;
+            r
+        });
+    }
+    for e in errors {
+        e.precision = precision;
     }
 }
 

@@ -6,7 +6,7 @@
 
 use crate::precision::Precision;
 use crate::record::{CheckRecord, Verdict};
-use mfh_reference::{Ndf, Vec3};
+use mfh_reference::{Bsdf, Ndf, Vec3};
 use serde_json::json;
 
 /// Directions probed: 512, spread over the upper hemisphere (z = (i + ½)/512, golden azimuths).
@@ -33,7 +33,8 @@ fn directions() -> Vec<Vec3> {
 /// What the probe saw: the non-trivial answers and how many of them are float32 values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Seen {
-    /// Distinct non-trivial answers (finite, non-zero, not an integer) of D, Λ and pdf_wm.
+    /// Distinct non-trivial answers (finite, non-zero, not an integer) of D, Λ and pdf_wm (of
+    /// a BSDF: eval and pdf).
     pub nontrivial: usize,
     /// Of them, exactly representable in float32.
     pub float32: usize,
@@ -62,6 +63,37 @@ pub fn probe(model: &dyn Ndf) -> Seen {
         s.pdf_wm_batch(&dirs, &mut answers);
         all.extend_from_slice(&answers);
     }
+    seen(all)
+}
+
+/// Evaluates a BSDF's eval and pdf (in batches) from three incidences — cos θi = 0.9 and 0.5
+/// from outside, and 0.7 from inside for a transmitting BSDF — towards the probe's directions
+/// and their mirror images below the surface.
+pub fn probe_bsdf(bsdf: &dyn Bsdf) -> Seen {
+    let up = directions();
+    let wo: Vec<Vec3> = up
+        .iter()
+        .copied()
+        .chain(up.iter().map(|w| [w[0], w[1], -w[2]]))
+        .collect();
+    let mut incidences: Vec<f64> = vec![0.9, 0.5];
+    if bsdf.eta().is_some() {
+        incidences.push(-0.7);
+    }
+    let mut answers = vec![0.0; wo.len()];
+    let mut all = Vec::with_capacity(2 * incidences.len() * wo.len());
+    for cos in incidences {
+        let wi = vec![[(1.0 - cos * cos).sqrt(), 0.0, cos]; wo.len()];
+        bsdf.eval_batch(&wi, &wo, &mut answers);
+        all.extend_from_slice(&answers);
+        bsdf.pdf_batch(&wi, &wo, &mut answers);
+        all.extend_from_slice(&answers);
+    }
+    seen(all)
+}
+
+/// What answers say: their distinct non-trivial values and how many are float32 values.
+fn seen(all: Vec<f64>) -> Seen {
     // Distinct values only: a constant (or dyadic) answer repeated says nothing.
     let mut nontrivial: Vec<f64> = all
         .into_iter()
@@ -167,5 +199,34 @@ mod tests {
             record(&json!({}), Precision::F64, seen).verdict,
             Verdict::Pass
         );
+    }
+
+    /// A BSDF whose answers are rounded to float32 is told from the f64 reference it rounds.
+    #[test]
+    fn a_float32_bsdf_is_told_from_an_f64_one() {
+        let spec: mfh_reference::bsdf::BsdfSpec = serde_json::from_str(
+            r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}"#,
+        )
+        .unwrap();
+        let exact = spec.build().unwrap();
+        struct Rounded(std::sync::Arc<dyn Bsdf>);
+        impl Bsdf for Rounded {
+            fn eval(&self, wi: Vec3, wo: Vec3) -> f64 {
+                f64::from(self.0.eval(wi, wo) as f32)
+            }
+            fn pdf(&self, wi: Vec3, wo: Vec3) -> f64 {
+                f64::from(self.0.pdf(wi, wo) as f32)
+            }
+            fn sample(&self, wi: Vec3, u: [f64; 3]) -> Option<mfh_reference::bsdf::BsdfSample> {
+                self.0.sample(wi, u)
+            }
+            fn eta(&self) -> Option<f64> {
+                self.0.eta()
+            }
+        }
+        let seen = probe_bsdf(&Rounded(exact.clone()));
+        assert!(seen.is_float32(), "{seen:?}");
+        let seen = probe_bsdf(exact.as_ref());
+        assert!(!seen.is_float32() && seen.nontrivial > 1000, "{seen:?}");
     }
 }

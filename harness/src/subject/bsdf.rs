@@ -2,6 +2,7 @@
 //! reference BSDFs and a renderer's own alike), the name records give it, its spec when it is
 //! a reference BSDF, and its own NDF when it offers one. Checks ask it for nothing else.
 
+use crate::precision::Precision;
 use mfh_reference::bsdf::{BsdfSpec, Sampling};
 use mfh_reference::{Bsdf, Masking, Ndf};
 use serde_json::{json, Value};
@@ -32,12 +33,16 @@ pub struct BsdfSubject<'a> {
     pub reference: Option<BsdfSpec>,
     /// The NDF the BSDF is built on, when it offers one.
     pub own_ndf: Option<OwnNdf<'a>>,
+    /// The arithmetic the BSDF computes in: its value tolerances are budgeted in that
+    /// format's ε (`tolerance::Tolerance::at`). f64 for the reference BSDFs.
+    pub precision: Precision,
 }
 
 impl std::fmt::Debug for BsdfSubject<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("BsdfSubject")
             .field("label", &self.label)
+            .field("precision", &self.precision)
             .finish()
     }
 }
@@ -60,18 +65,26 @@ impl BsdfSubject<'static> {
                 masking: Some(masking),
                 visible_normals: sampling == Sampling::VisibleNormals,
             }),
+            precision: Precision::F64,
         }))
     }
 }
 
 impl<'a> BsdfSubject<'a> {
-    /// A user's BSDF, named `name` in the records, built on `own_ndf` when it says so.
-    pub fn user(bsdf: Arc<dyn Bsdf + 'a>, name: &str, own_ndf: Option<OwnNdf<'a>>) -> Arc<Self> {
+    /// A user's BSDF computing in `precision`, named `name` in the records, built on
+    /// `own_ndf` when it says so.
+    pub fn user(
+        bsdf: Arc<dyn Bsdf + 'a>,
+        name: &str,
+        own_ndf: Option<OwnNdf<'a>>,
+        precision: Precision,
+    ) -> Arc<Self> {
         Arc::new(Self {
             bsdf,
             label: json!({ "name": name }),
             reference: None,
             own_ndf,
+            precision,
         })
     }
 

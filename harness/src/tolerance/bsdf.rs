@@ -79,3 +79,76 @@ pub const BSDF_STABILITY: Tolerance = Tolerance {
              non-finite pdf or weight): any one is a defect a renderer would ship, so the count \
              must be 0 (0.5 only makes the comparison strict)",
 };
+
+/// [`BSDF_SAMPLE_CONSISTENCY`] for a float32 BSDF.
+pub const BSDF_SAMPLE_CONSISTENCY_F32: Tolerance = Tolerance {
+    name: "bsdf_sample_consistency_f32",
+    value: 1e-3,
+    reason: "8400 ε₃₂: the sample's pdf comes from the sampled normal, pdf(wi, wo) from the half \
+             vector rebuilt from the float32 wo (ε₃₂/2 per component, times D's log-slope in \
+             the lobe's tail and the refraction half vector's 1/|η_i wi + η_o wo|) and a \
+             transmittance 1 − F that cancels near the critical angle; a float32 GGX \
+             dielectric after pbrt-v4 measures 1.6e-4 to 2.2e-4 (η 1.5, α 0.3, from inside, two \
+             seeds), 1.1e-4 at η 1.05, 1.0e-4 at α 0.1 (tests/float32_bsdf.rs), Mitsuba 3.9.1's \
+             roughdielectric 3.3e-4 (GGX α 0.3, η 1.5): 3× margin; fails a weight or \
+             pdf off by 0.1 % (a lost η² at |η − 1| ≥ 5e-4, a cosine, G1)",
+};
+
+/// [`BSDF_RECIPROCITY`] for a float32 BSDF.
+pub const BSDF_RECIPROCITY_F32: Tolerance = Tolerance {
+    name: "bsdf_reciprocity_f32",
+    value: 1e-3,
+    reason: "8400 ε₃₂: the two sides round their float32 half vectors, Jacobians and 1 − F \
+             differently, and 1 − F computed from the denser side cancels near its critical \
+             angle (condition 1/T); a float32 GGX dielectric after pbrt-v4 measures 1.2e-4 \
+             (η 1.5, α 0.1 and 0.3), 5.8e-5 at η 1.05, Mitsuba 3.9.1's roughdielectric 4.5e-4 \
+             (GGX α 0.3, η 1.5): 2.2× margin; fails a lost η² at \
+             |η − 1| ≥ 5e-4",
+};
+
+/// [`BSDF_NDF_CONSISTENCY`] for a float32 BSDF.
+pub const BSDF_NDF_CONSISTENCY_F32: Tolerance = Tolerance {
+    name: "bsdf_ndf_consistency_f32",
+    value: 1e-4,
+    reason: "840 ε₃₂: the BSDF's float32 D, G and Jacobian against the check's f64 algebra on \
+             the float32 NDF's D and Λ, at directions 0.05 or more from the horizon: a float32 \
+             GGX dielectric after pbrt-v4 measures 3.0e-6 (η 1.5), 7.4e-6 (η 1.05), a float32 \
+             conductor 1.1e-6: 13× margin; fails a D or Λ not the NDF's (α × 1.01: 4 %) or \
+             the other G2 form (percents) by orders of magnitude",
+};
+
+/// [`BSDF_AGAINST_REFERENCE`] for a float32 BSDF.
+pub const BSDF_AGAINST_REFERENCE_F32: Tolerance = Tolerance {
+    name: "bsdf_against_reference_f32",
+    value: 1e-3,
+    reason: "8400 ε₃₂: a float32 evaluation of Walter's formulas against the f64 reference: \
+             the inputs rounded to float32 (ε₃₂/2, times D's log-slope in the tail), and 1 − F \
+             cancelling near the critical angle; a float32 GGX dielectric after pbrt-v4 \
+             measures 1.2e-4 (η 1.5, α 0.1 and 0.3), a float32 conductor 6.8e-7, Mitsuba 3.9.1's \
+             roughdielectric 4.6e-4 and roughconductor 8.1e-7 (GGX α 0.3): 2.2× margin; \
+             fails a misplaced η² or G1 by orders of magnitude and a Schlick-for-exact Fresnel \
+             where it is more than 0.1 % off (percents at grazing microfacet incidence)",
+};
+
+/// [`BSDF_SAMPLE_DIRECTION`] for a float32 BSDF (radians).
+pub const BSDF_SAMPLE_DIRECTION_F32: Tolerance = Tolerance {
+    name: "bsdf_sample_direction_f32",
+    value: 1e-2,
+    reason: "radians: the same inversion in float32 (u given exactly, the top step 1 − 2⁻¹², \
+             check/bsdf/against.rs): the visible-normal map amplifies rounding by up to ~1/α² \
+             near its poles, ε₃₂/α² ≈ 3e-4 at α 0.02; a float32 GGX dielectric after pbrt-v4 \
+             measures 9e-6 rad (α 0.3, 0.1) and 1.4e-4 rad (α 0.02), a conductor ≤ 2.4e-6: \
+             70× margin at α 0.02; below α ≈ 0.004 rounding alone reaches the budget. Fails a \
+             swapped u, a mirrored azimuth or an inverted lobe choice (radians apart)",
+};
+
+/// [`BSDF_ENERGY`] for a float32 BSDF.
+pub const BSDF_ENERGY_F32: Tolerance = Tolerance {
+    name: "bsdf_energy_f32",
+    value: 1e-5,
+    reason: "84 ε₃₂: the integral of a float32 eval carries its systematic rounding where the \
+             lobe's mass lies (≤ 16 ε₃₂ for ~10 operations; the float32 GGX BSDFs of \
+             tests/float32_bsdf.rs measure ≤ 7e-7 against the reference in the lobe's bulk), \
+             on top of BSDF_ENERGY's cubature slack; a BSDF that gains energy (a lost Fresnel, \
+             a Jacobian off by η²) exceeds 1 by percents",
+};

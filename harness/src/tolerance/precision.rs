@@ -93,6 +93,15 @@ pub const F32_TABLE: &[(&str, Tolerance)] = &[
     ("pdf_jacobian", PDF_JACOBIAN_F32),
     ("against_reference", AGAINST_REFERENCE_F32),
     ("batch_sampler", BATCH_SAMPLER_F32),
+    (
+        "bsdf_sample_consistency",
+        super::BSDF_SAMPLE_CONSISTENCY_F32,
+    ),
+    ("bsdf_reciprocity", super::BSDF_RECIPROCITY_F32),
+    ("bsdf_ndf_consistency", super::BSDF_NDF_CONSISTENCY_F32),
+    ("bsdf_against_reference", super::BSDF_AGAINST_REFERENCE_F32),
+    ("bsdf_sample_direction", super::BSDF_SAMPLE_DIRECTION_F32),
+    ("bsdf_energy", super::BSDF_ENERGY_F32),
 ];
 
 /// The per-cell relative tolerance of the chi-square expected masses for a density computed

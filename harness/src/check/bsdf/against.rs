@@ -6,6 +6,7 @@
 use super::reciprocity::directions;
 use super::{incidences, BsdfSubject, SOURCE};
 use crate::check::{applied, covers, Check, PlannedCheck};
+use crate::precision::Precision;
 use crate::record::{Measured, Verdict};
 use crate::tolerance::{BSDF_AGAINST_REFERENCE, BSDF_SAMPLE_DIRECTION};
 use mfh_reference::bsdf::{Bsdf, BsdfSpec};
@@ -15,6 +16,20 @@ use std::sync::Arc;
 
 /// u values per coordinate of the sampled-direction comparison (interior and edges).
 const U_STEPS: [f64; 7] = [0.0, 0.05, 0.25, 0.5, 0.75, 0.95, 1.0 - f64::EPSILON / 2.0];
+
+/// [`U_STEPS`] as an implementation computing in `precision` receives them. A float32
+/// implementation gets each step rounded to float32 (exactly what the reference is sampled
+/// at too) and, for the top step, 1 − 2⁻¹² instead of 1 − 2⁻⁵³ (which rounds to 1.0): within
+/// 2⁻²⁴ of 1 the visible-normal disk point lies within √ε₃₂ of its rim, the microfacet within
+/// ~10⁻⁴ rad of the silhouette, and float32 rounding alone decides whether the sample
+/// succeeds at all (measured: a float32 GGX dielectric at α 0.02 refracts where the f64
+/// reference fails). At 1 − 2⁻¹² the rim is 2⁻⁶ away and the direction conditioned.
+fn u_steps(precision: Precision) -> [f64; 7] {
+    match precision {
+        Precision::F64 => U_STEPS,
+        _ => U_STEPS.map(|u| f64::from(u as f32).min(1.0 - 1.0 / 4096.0)),
+    }
+}
 
 /// Plans the comparison of `subject` with the reference BSDF `spec` (already validated).
 pub fn plan_against<'a>(
@@ -58,12 +73,12 @@ pub fn plan_against<'a>(
                     }
                     let ((worst, at), tolerance) = match quantity {
                         "sample" => (
-                            sample_discrepancy(user, reference.as_ref()),
-                            BSDF_SAMPLE_DIRECTION,
+                            sample_discrepancy(user, reference.as_ref(), s.precision),
+                            BSDF_SAMPLE_DIRECTION.at(s.precision),
                         ),
                         q => (
                             value_discrepancy(user, reference.as_ref(), q == "pdf"),
-                            BSDF_AGAINST_REFERENCE,
+                            BSDF_AGAINST_REFERENCE.at(s.precision),
                         ),
                     };
                     r.value = Some(worst);
@@ -114,12 +129,13 @@ fn value_discrepancy(user: &dyn Bsdf, reference: &dyn Bsdf, pdf: bool) -> (f64, 
 
 /// The worst angle between the user's and the reference's sampled directions for the same u
 /// (π where one fails and the other does not), and where.
-fn sample_discrepancy(user: &dyn Bsdf, reference: &dyn Bsdf) -> (f64, Value) {
+fn sample_discrepancy(user: &dyn Bsdf, reference: &dyn Bsdf, precision: Precision) -> (f64, Value) {
+    let steps = u_steps(precision);
     let (mut worst, mut at) = (0.0f64, Value::Null);
     for inc in incidences(reference) {
-        for &a in &U_STEPS {
-            for &b in &U_STEPS {
-                for &c in &U_STEPS {
+        for &a in &steps {
+            for &b in &steps {
+                for &c in &steps {
                     let u = [a, b, c];
                     let ok = |s: Option<mfh_reference::bsdf::BsdfSample>| {
                         s.filter(|s| s.pdf != 0.0).map(|s| s.wo)

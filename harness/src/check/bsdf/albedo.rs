@@ -183,9 +183,10 @@ pub fn plan<'a>(
                 });
                 let excess = (quad.value - 1.0).max(0.0);
                 r.measured = Some(Measured::Absolute { error: excess });
-                r.tolerance = Some(applied(&BSDF_ENERGY));
+                let tolerance = BSDF_ENERGY.at(s.precision);
+                r.tolerance = Some(applied(&tolerance));
                 r.verdict =
-                    if quad.value.is_finite() && excess <= BSDF_ENERGY.value + quad.error_bound {
+                    if quad.value.is_finite() && excess <= tolerance.value + quad.error_bound {
                         Verdict::Pass
                     } else {
                         Verdict::Fail

@@ -96,14 +96,15 @@ pub fn plan<'a>(
         r.cost.samples = n;
         r.value = Some(worst.error);
         r.measured = Some(Measured::Relative { error: worst.error });
-        r.tolerance = Some(applied(&BSDF_SAMPLE_CONSISTENCY));
+        let tolerance = BSDF_SAMPLE_CONSISTENCY.at(s.precision);
+        r.tolerance = Some(applied(&tolerance));
         if let (Value::Object(case), Some(at)) = (&mut r.case, worst.at) {
             case.insert("worst".into(), at);
             case.insert("failed_samples".into(), json!(worst.failed));
             case.insert("worst_pdf_error".into(), json!(worst.pdf_error));
             case.insert("worst_weight_error".into(), json!(worst.weight_error));
         }
-        r.verdict = if worst.error <= BSDF_SAMPLE_CONSISTENCY.value {
+        r.verdict = if worst.error <= tolerance.value {
             Verdict::Pass
         } else {
             Verdict::Fail

@@ -40,7 +40,7 @@ use super::BsdfSubject;
 use crate::check::{applied, covers, Check, PlannedCheck};
 use crate::record::{CheckRecord, Measured, Verdict};
 use crate::subject::bsdf::OwnNdf;
-use crate::tolerance::BSDF_NDF_CONSISTENCY;
+use crate::tolerance::{Tolerance, BSDF_NDF_CONSISTENCY};
 use mfh_reference::bsdf::microfacet::{reflect, upper};
 use mfh_reference::geometry::{cross, dot, from_spherical, normalize, Vec3};
 use mfh_reference::{Bsdf, Masking};
@@ -447,7 +447,9 @@ pub fn plan<'a>(subject: &Arc<BsdfSubject<'a>>, why: &str) -> Vec<PlannedCheck<'
                 )])
                 .run(move |r, _| {
                     let analysis = shared.get_or_init(|| analyse(s.bsdf.as_ref(), &own));
-                    judge(r, analysis, &own, relation, s.bsdf.eta().is_some());
+                    let transmits = s.bsdf.eta().is_some();
+                    let tolerance = BSDF_NDF_CONSISTENCY.at(s.precision);
+                    judge(r, analysis, (&own, tolerance), relation, transmits);
                     Ok(())
                 }),
         );
@@ -459,7 +461,7 @@ pub fn plan<'a>(subject: &Arc<BsdfSubject<'a>>, why: &str) -> Vec<PlannedCheck<'
 fn judge(
     r: &mut CheckRecord,
     analysis: &Result<Analysis, String>,
-    own: &OwnNdf<'_>,
+    (own, tolerance): (&OwnNdf<'_>, Tolerance),
     relation: &str,
     transmits: bool,
 ) {
@@ -487,7 +489,7 @@ fn judge(
         case.insert("pairs".into(), json!(worst.compared));
         case.insert("worst".into(), worst.at.clone());
     }
-    r.tolerance = Some(applied(&BSDF_NDF_CONSISTENCY));
+    r.tolerance = Some(applied(&tolerance));
     if worst.compared == 0 {
         r.verdict = Verdict::Error {
             message: format!(
@@ -499,7 +501,7 @@ fn judge(
     }
     r.value = Some(worst.error);
     r.measured = Some(Measured::Relative { error: worst.error });
-    r.verdict = if worst.error <= BSDF_NDF_CONSISTENCY.value {
+    r.verdict = if worst.error <= tolerance.value {
         Verdict::Pass
     } else {
         Verdict::Fail

@@ -4,6 +4,7 @@
 
 use super::*;
 use crate::check::RunContext;
+use crate::precision::Precision;
 use crate::record::CheckRecord;
 use crate::selftest::bsdf_mutant::{BsdfDefect, MutatedBsdf};
 use mfh_reference::bsdf::{BsdfSample, BsdfSpec, Dielectric, Microfacet, Sampling, Transport};
@@ -51,6 +52,7 @@ fn user<'a>(
             masking,
             visible_normals,
         }),
+        Precision::F64,
     )
 }
 
@@ -117,7 +119,11 @@ fn a_record_carries_its_worst_pair_and_form() {
 #[test]
 fn planned_from_the_capabilities() {
     let b = spec(REFERENCES[0]).build().unwrap();
-    assert!(plan(&BsdfSubject::user(b.clone(), "b", None), "t").is_empty());
+    assert!(plan(
+        &BsdfSubject::user(b.clone(), "b", None, Precision::F64),
+        "t"
+    )
+    .is_empty());
     struct DOnly;
     impl Ndf for DOnly {
         fn d(&self, _: Vec3) -> f64 {
@@ -374,8 +380,12 @@ fn audit_of_bsdf_with_ndf_plans_and_passes() {
     let b = spec(REFERENCES[0]).build().unwrap();
     let g = ggx(0.3);
     let ids = |audit: crate::Audit<'_>| -> usize {
-        let (plan, errors) = audit.plan();
-        assert!(errors.is_empty());
+        let (plan, records) = audit.plan();
+        // Only the passing `audit.precision` record of the probe.
+        assert!(
+            records.iter().all(|r| r.verdict == Verdict::Pass),
+            "{records:?}"
+        );
         plan.iter()
             .filter(|p| p.check == "bsdf.ndf_consistency")
             .count()

@@ -104,12 +104,13 @@ pub fn plan<'a>(subject: &Arc<BsdfSubject<'a>>, why: &str) -> PlannedCheck<'a> {
             r.cost.evaluations += 2 * pairs;
             r.value = Some(worst);
             r.measured = Some(Measured::Relative { error: worst });
-            r.tolerance = Some(applied(&BSDF_RECIPROCITY));
+            let tolerance = BSDF_RECIPROCITY.at(s.precision);
+            r.tolerance = Some(applied(&tolerance));
             if let Value::Object(case) = &mut r.case {
                 case.insert("pairs".into(), json!(pairs));
                 case.insert("worst".into(), at);
             }
-            r.verdict = if worst <= BSDF_RECIPROCITY.value {
+            r.verdict = if worst <= tolerance.value {
                 Verdict::Pass
             } else {
                 Verdict::Fail
