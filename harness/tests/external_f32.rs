@@ -666,6 +666,11 @@ const AGAINST: &str = r#"{"family":"ggx","alpha":0.3}"#;
 /// `mfh audit-external --cmd <cmd> --profile ci --against GGX 0.3`: (exit code, the checks
 /// whose records failed or erred, the report), printing the wall time and record counts.
 fn audit(cmd: &str, label: &str) -> (i32, Vec<String>, Value) {
+    audit_against(cmd, label, AGAINST)
+}
+
+/// [`audit`] against the reference spec `against`.
+fn audit_against(cmd: &str, label: &str, against: &str) -> (i32, Vec<String>, Value) {
     let out = std::env::temp_dir().join(format!("mfh-f32-{label}-{}", std::process::id()));
     let args = [
         "audit-external",
@@ -674,7 +679,7 @@ fn audit(cmd: &str, label: &str) -> (i32, Vec<String>, Value) {
         "--profile",
         "ci",
         "--against",
-        AGAINST,
+        against,
         "--json",
         "--out",
         out.to_str().unwrap(),
@@ -785,4 +790,44 @@ fn the_numpy_exponent_defect_fails_the_jacobian_check() {
             "{c} fails, but only the normal sampler is wrong"
         );
     }
+}
+
+const DIELECTRIC: &str = r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}"#;
+
+/// The float32 numpy rough dielectric (pbrt-v4's algebra) passes the ci audit with
+/// `"precision":"f32"`: every BSDF check, judged at its float32 row, against the reference.
+#[test]
+fn the_numpy_f32_dielectric_passes_the_ci_audit_at_f32() {
+    require_numpy();
+    let cmd = example("dielectric_f32_numpy.py", "");
+    let (code, failing, report) = audit_against(&cmd, "numpy-dielectric", DIELECTRIC);
+    assert_eq!(code, 0, "failing: {failing:?}");
+    let run = checks(&report);
+    for want in [
+        "bsdf.chi2",
+        "bsdf.sample_consistency",
+        "bsdf.albedo",
+        "bsdf.reciprocity",
+        "bsdf.against",
+        "bsdf.stability",
+    ] {
+        assert!(run.contains(&want), "{want} not run: {run:?}");
+    }
+    for r in report["records"].as_array().unwrap() {
+        assert_eq!(r["precision"], "f32", "{r}");
+    }
+}
+
+/// The refraction Jacobian with |wi·m| for |wo·m|, in pdf and sample alike: the sampled
+/// directions no longer follow pdf, and `bsdf.chi2` fails.
+#[test]
+fn the_numpy_f32_dielectric_jacobian_defect_fails_the_chi_square() {
+    require_numpy();
+    let cmd = example("dielectric_f32_numpy.py", "--defect jacobian_wi");
+    let (code, failing, _) = audit_against(&cmd, "numpy-dielectric-defect", DIELECTRIC);
+    assert_eq!(code, 1);
+    assert!(
+        failing.iter().any(|c| c == "bsdf.chi2"),
+        "failing: {failing:?}"
+    );
 }

@@ -27,6 +27,8 @@ enum Defect {
     JacobianWithWi,
     /// Radiance transport without its 1/η′² (in eval and sample alike).
     NoEtaSquared,
+    /// The pdf `sample` returns 0.2 % high (pdf itself right).
+    SamplePdf,
 }
 
 fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
@@ -245,6 +247,11 @@ impl Bsdf for Glass32 {
             return None;
         }
         let weight = f * o[2].abs() / pdf;
+        let pdf = if self.defect == Defect::SamplePdf {
+            pdf * 1.002
+        } else {
+            pdf
+        };
         Some(BsdfSample {
             wo: v64(o),
             pdf: f64::from(pdf),
@@ -478,4 +485,19 @@ fn float32_bsdfs_at_tiny_roughness_pass() {
     let report = audit(&m, &m.facets.0, metal, Precision::F32);
     print_worst("float32 conductor, α = 0.001", &report);
     assert!(report.passed(), "{:#?}", failing(&report));
+}
+
+/// A sample pdf 0.2 % high is not excused by the consistency check's conditioning allowance
+/// (which only the samples near the critical angle and the horizon use): it fails.
+#[test]
+fn a_float32_sample_pdf_two_permille_high_fails_consistency() {
+    let b = Glass32::new(1.5, 0.3, Defect::SamplePdf);
+    let report = audit(&b, &b.facets.0, GLASS, Precision::F32);
+    let failed = failing(&report);
+    assert!(
+        failed
+            .iter()
+            .any(|f| f.starts_with("bsdf.sample_consistency")),
+        "{failed:#?}"
+    );
 }
