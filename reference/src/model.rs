@@ -243,7 +243,7 @@ pub trait NormalSampler: Ndf {
 
 /// Importance sampling of the normals visible from a direction `wi`: the distribution of
 /// visible normals of Heitz & d'Eon 2014 ("Importance Sampling Microfacet-Based BSDFs using the
-/// Distribution of Visible Normals", CGF 33(4), eq 2; seed 001 §7 cites it as [9]):
+/// Distribution of Visible Normals", CGF 33(4), eq 2; seed 001 §7 cites it as \[9\]):
 ///
 /// ```text
 /// D_wi(m) = G1(wi) ⟨wi·m⟩⁺ D(m) / cos θi,   G1(wi) = 1/(1 + Λ(wi)),   ∫ D_wi(m) dm = 1

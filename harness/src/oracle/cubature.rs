@@ -147,7 +147,7 @@ pub fn integrate_rectangle(
     e
 }
 
-/// A batch integrand over rectangles: writes f(x[i], y[i]) into out[i] for each `[x, y]`.
+/// A batch integrand over rectangles: writes f(x\[i\], y\[i\]) into out\[i\] for each `[x, y]`.
 pub type BatchFn2<'a> = dyn Fn(&[[f64; 2]], &mut [f64]) + 'a;
 
 /// The most rectangles whose rules are evaluated in one call of a batch integrand (225 nodes

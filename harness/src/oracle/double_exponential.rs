@@ -9,7 +9,7 @@
 //! `quadrature::double_exponential::integrate` (the test below compares them on many
 //! integrands and tolerances); only the grouping of the evaluations differs.
 
-/// A batch integrand: writes f(x[i]) into out[i] for every i.
+/// A batch integrand: writes f(x\[i\]) into out\[i\] for every i.
 pub type BatchFn<'a> = dyn Fn(&[f64], &mut [f64]) + 'a;
 
 /// The levels of the rule: (weight, abscissa) pairs on [−1, 1], positive abscissas only; each
@@ -167,7 +167,7 @@ fn xs_of(tx: &[(usize, f64)], xs: &mut Vec<f64>) {
     xs.extend(tx.iter().map(|&(_, x)| x));
 }
 
-/// A batch integrand of several integrals at once: `f(points, out)` writes f_tag(x) into out[i]
+/// A batch integrand of several integrals at once: `f(points, out)` writes f_tag(x) into out\[i\]
 /// for each `(tag, x)` of `points`.
 pub type TaggedBatchFn<'a> = dyn FnMut(&[(usize, f64)], &mut [f64]) + 'a;
 

@@ -144,7 +144,7 @@ pub fn measure_with(p: &(dyn Fn(Vec3) -> f64 + Sync), options: &Options<'_>) -> 
     survey(p, THETA_MIN, FRAC_PI_2, THETA_STEPS, options.seeds)
 }
 
-/// [`measure_with`] for a batch density (`p(m, out)` writes p(m[i]) into out[i]): the survey
+/// [`measure_with`] for a batch density (`p(m, out)` writes p(m\[i\]) into out\[i\]): the survey
 /// grids are evaluated first in one call each, then the measurement runs on those values (the
 /// mode search, a few hundred points, one point per call) — the same lobe bit for bit, while
 /// an external model pays a few hundred round trips rather than a few thousand.

@@ -74,7 +74,7 @@ where
     finish(parts, samples)
 }
 
-/// [`estimate`] for a batch integrand (`f(u, out)` writes f(u[i]) into out[i]): each chunk's
+/// [`estimate`] for a batch integrand (`f(u, out)` writes f(u\[i\]) into out\[i\]): each chunk's
 /// uniforms are drawn as [`estimate`] draws them and handed to `f` in one call, then pushed in
 /// order, so the estimate is the scalar form's bit for bit (an external model pays one round
 /// trip per chunk of [`CHUNK`] samples, not per sample).

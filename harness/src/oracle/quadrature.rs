@@ -128,7 +128,7 @@ fn scalar_batch<'f>(f: &'f dyn Fn(f64) -> f64) -> impl Fn(&[f64], &mut [f64]) + 
     }
 }
 
-/// [`integrate_pieces`] for a batch integrand (`f(x, out)` writes f(x[i]) into out[i]): the
+/// [`integrate_pieces`] for a batch integrand (`f(x, out)` writes f(x\[i\]) into out\[i\]): the
 /// same nodes and arithmetic, so the same result bit for bit, but each step of the rule
 /// evaluates its nodes in one call ([`integrate_pieces_many`]).
 pub fn integrate_pieces_batch(f: &BatchFn<'_>, points: &[f64], accuracy: Accuracy) -> Estimate {
@@ -529,7 +529,7 @@ fn width_cuts(width: f64, theta_max: f64) -> (Vec<f64>, [f64; 5]) {
     (polar_cuts, [0.0, 0.25 * tau, 0.5 * tau, 0.75 * tau, tau])
 }
 
-/// A batch integrand over a cap: writes f(θ[i], φ[i]) into out[i] for each `[θ, φ]`.
+/// A batch integrand over a cap: writes f(θ\[i\], φ\[i\]) into out\[i\] for each `[θ, φ]`.
 pub type PolarBatchFn<'a> = dyn Fn(&[[f64; 2]], &mut [f64]) + 'a;
 
 /// What a cap quadrature integrates.
@@ -681,8 +681,8 @@ pub fn integrate_hemisphere_lobe(
     integrate_hemisphere_lobe_batch(&scalar_directions(f), lobe, cuts, accuracy)
 }
 
-/// [`integrate_hemisphere_lobe`] for a batch integrand (`f(m, out)` writes f(m[i]) into
-/// out[i]): the same value bit for bit, with the nodes of each step in one call.
+/// [`integrate_hemisphere_lobe`] for a batch integrand (`f(m, out)` writes f(m\[i\]) into
+/// out\[i\]): the same value bit for bit, with the nodes of each step in one call.
 pub fn integrate_hemisphere_lobe_batch(
     f: &dyn Fn(&[Vec3], &mut [f64]),
     lobe: &Lobe,
@@ -700,7 +700,7 @@ pub fn integrate_hemisphere_lobe_batch(
     )
 }
 
-/// [`integrate_hemisphere`] for a batch integrand (`f(m, out)` writes f(m[i]) into out[i]):
+/// [`integrate_hemisphere`] for a batch integrand (`f(m, out)` writes f(m\[i\]) into out\[i\]):
 /// the same value bit for bit, with the nodes of each step in one call.
 pub fn integrate_hemisphere_batch(
     f: &dyn Fn(&[Vec3], &mut [f64]),

@@ -71,7 +71,7 @@ const BLOCK: usize = 1 << 14;
 /// A batch BSDF sampler at one incidence: writes the direction of `u[k]` (or a failed sample)
 /// into element k of `out` (as long as `u`).
 pub type SphereSampler<'a> = dyn Fn(&[[f64; 3]], &mut Directions) + Sync + 'a;
-/// A batch density over the sphere at one incidence: writes pdf(wo[k]) into `out[k]`.
+/// A batch density over the sphere at one incidence: writes pdf(wo\[k\]) into `out[k]`.
 pub type SpherePdf<'a> = dyn Fn(&[Vec3], &mut [f64]) + Sync + 'a;
 
 /// The observed counts over the sphere.

@@ -1,6 +1,6 @@
 //! Reference microfacet BSDFs: a rough conductor (reflection only) and a rough dielectric
 //! (reflection and refraction) after Walter, Marschner, Li & Torrance 2007, "Microfacet models
-//! for refraction through rough surfaces" (EGSR 2007; seed 001 cites it as [13]; "Walter" below),
+//! for refraction through rough surfaces" (EGSR 2007; seed 001 cites it as \[13\]; "Walter" below),
 //! built on any NDF that has a Smith Λ, and the [`Bsdf`] capability a renderer's own BSDF
 //! implements to be audited the same way.
 //!

@@ -148,7 +148,7 @@ impl NormalSampler for Beckmann {
 impl VisibleNormalSampler for Beckmann {
     /// Heitz & d'Eon 2014, "Importance Sampling Microfacet-Based BSDFs using the Distribution of
     /// Visible Normals", CGF 33(4), §4 and supplement (not one of the five source documents;
-    /// seed 001 §7 cites it as [9]), with the visible-slope cdf inverted numerically as in Jakob
+    /// seed 001 §7 cites it as \[9\]), with the visible-slope cdf inverted numerically as in Jakob
     /// 2014, "An Improved Visible Normal Sampling Routine for the Beckmann Distribution":
     /// stretch `wi` to unit roughness, at polar angle θ and azimuth φ; draw the slope x̃ along
     /// the incidence plane from the visible-slope density and ỹ across it from the Gaussian

@@ -550,7 +550,7 @@ impl Ndf for PiecewiseLinear {
 }
 
 impl NormalSampler for PiecewiseLinear {
-    /// φ by Algorithm 1 from u[0], θ given φ by Algorithm 2 from u[1] (seed 000 §2).
+    /// φ by Algorithm 1 from `u[0]`, θ given φ by Algorithm 2 from `u[1]` (seed 000 §2).
     fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
         let phi = self.sample_phi(u[0]);
         let theta = self.sample_theta(u[1], phi);

@@ -74,7 +74,7 @@ fn gk15(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
     (k * h, ((k - g) * h).abs())
 }
 
-/// ∫ f over [breaks[0], breaks[last]] with the integrand smooth between consecutive break
+/// ∫ f over `[breaks[0], breaks[last]]` with the integrand smooth between consecutive break
 /// points (which must be non-decreasing; empty intervals are skipped). Stops when the error
 /// estimate is ≤ max(rel·|I|, abs) or after `MAX_INTERVALS` intervals.
 pub fn integrate(f: &dyn Fn(f64) -> f64, breaks: &[f64], rel: f64, abs: f64) -> Estimate {

@@ -72,7 +72,7 @@ where
 }
 
 /// Draws `samples` normals with the batch sampler `sample` (`sample(u, m)` sets `m[i]` to the
-/// normal of `u[i]`, e.g. [`NormalSampler::sample_wm_batch`]) and bins them into `grid`, in
+/// normal of `u[i]`, e.g. [`NormalSampler::sample_wm_batch`](mfh_reference::NormalSampler::sample_wm_batch)) and bins them into `grid`, in
 /// parallel: per chunk of [`CHUNK`] samples, its stream's uniforms in blocks of [`BATCH`]
 /// pairs ([`crate::random::Stream::fill_pairs`]) → the batch sampler → the block's cells
 /// ([`CellFinder::cells_of`]) → the thread's histogram; the threads' histograms are summed

@@ -149,7 +149,7 @@ fn cell_pieces(
 
 /// [`expected_mass_in`] for a batch density, to the per-cell (relative, absolute) tolerances
 /// (`expected_mass_in` takes [`CELL_ABSOLUTE_TOLERANCE`]): the pieces of every cell are integrated together
-/// ([`integrate_rectangles_batch`], the density evaluated in parallel chunks of 16 384 points),
+/// ([`integrate_rectangles_batch`](crate::oracle::cubature::integrate_rectangles_batch), the density evaluated in parallel chunks of 16 384 points),
 /// so an external model pays a round trip per chunk, not per node. The same masses bit for bit.
 pub fn expected_mass_in_batch(
     pdf: &BatchPdf<'_>,

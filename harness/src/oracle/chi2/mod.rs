@@ -163,10 +163,10 @@ pub enum Failure {
     },
 }
 
-/// A batch sampler: writes the normal of u[i] into m[i].
+/// A batch sampler: writes the normal of u\[i\] into m\[i\].
 pub type BatchSampler<'a> = dyn Fn(&[[f64; 2]], &mut [Vec3]) + Sync + 'a;
 
-/// A batch density: writes pdf(m[i]) into out[i].
+/// A batch density: writes pdf(m\[i\]) into out\[i\].
 pub type BatchPdf<'a> = dyn Fn(&[Vec3], &mut [f64]) + Sync + 'a;
 
 /// The result of a chi-square test.
@@ -187,7 +187,7 @@ pub struct Chi2Result {
     pub components: Option<components::Components>,
     /// The level the verdict was taken at.
     pub alpha: f64,
-    /// Cells pooled because their expected count was < [`MIN_EXPECTED`].
+    /// Cells pooled because their expected count was < [`MIN_EXPECTED`](crate::tolerance::MIN_EXPECTED).
     pub pooled_cells: usize,
     /// Samples drawn.
     pub samples: u64,
@@ -233,7 +233,7 @@ where
 }
 
 /// [`chi2_test`] with the expected counts integrated to the per-cell relative tolerance
-/// `cell_relative` (e.g. [`KINKED_CELL_RELATIVE_TOLERANCE`]) about a given lobe (e.g. measured
+/// `cell_relative` (e.g. [`KINKED_CELL_RELATIVE_TOLERANCE`](crate::tolerance::KINKED_CELL_RELATIVE_TOLERANCE)) about a given lobe (e.g. measured
 /// once from the model's D by [`lobe::measure`]); `None` measures it from `pdf`.
 pub fn chi2_test_in<S, P>(
     sample: &S,
@@ -349,7 +349,7 @@ fn timed(
 /// The chi-square test with a batch sampler and a batch density (an external model: a round
 /// trip per batch), the expected masses integrated to the per-cell (relative, absolute)
 /// `cell_tolerance`: with ([`CELL_RELATIVE_TOLERANCE`] or the kinked one,
-/// [`CELL_ABSOLUTE_TOLERANCE`]) the same result as [`chi2_test_batch_in`] with the scalar
+/// [`CELL_ABSOLUTE_TOLERANCE`](crate::tolerance::CELL_ABSOLUTE_TOLERANCE)) the same result as [`chi2_test_batch_in`] with the scalar
 /// density. With no
 /// `lobe`, it is measured from the density ([`lobe::measure_with_batch`]).
 pub fn chi2_test_batches_in(

@@ -56,7 +56,7 @@ struct Piece {
 }
 
 impl CdfTable {
-    /// Tabulates F(x) = ∫_{cuts[0]}^x f for the density `density` (each value an estimate with
+    /// Tabulates F(x) = ∫_{cuts\[0\]}^x f for the density `density` (each value an estimate with
     /// its error bound) with adaptive Simpson, starting from [`INITIAL_PER_PIECE`] equal
     /// intervals per piece between consecutive `cuts` (sorted, end points included).
     pub fn build(density: &(dyn Fn(f64) -> Estimate + Sync), cuts: &[f64]) -> Self {
@@ -479,7 +479,7 @@ where
     }
 }
 
-/// [`marginal_cdf`] for a batch density (`pdf(m, out)` writes pdf(m[i]) into out[i]): the same
+/// [`marginal_cdf`] for a batch density (`pdf(m, out)` writes pdf(m\[i\]) into out\[i\]): the same
 /// table bit for bit, each step of each inner integral one call of `pdf`.
 pub fn marginal_cdf_batch(
     pdf: &(dyn Fn(&[Vec3], &mut [f64]) + Sync),
