@@ -182,6 +182,9 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
             escape(&measured_text(r)),
             escape(&r.source)
         );
+        if let Some(note) = r.oracle.and_then(|o| o.noise_note()) {
+            let _ = write!(h, "<p>{}</p>", escape(&note));
+        }
         let bsdf = super::bsdf_html::is_bsdf(&r.check)
             .then(|| super::bsdf_html::anchor(&report.records, &r.model))
             .flatten();

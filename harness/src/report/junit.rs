@@ -14,13 +14,17 @@ fn escape(s: &str) -> String {
 }
 
 fn detail(r: &CheckRecord) -> String {
-    format!(
+    let mut d = format!(
         "value {:?}, oracle {:?}, measured {:?}, tolerance {:?}",
         r.value,
         r.oracle.map(|o| o.value),
         r.measured,
         r.tolerance.as_ref().map(|t| t.value)
-    )
+    );
+    if let Some(note) = r.oracle.and_then(|o| o.noise_note()) {
+        d.push_str(&format!(" ({note})"));
+    }
+    d
 }
 
 /// Renders the report as JUnit XML.

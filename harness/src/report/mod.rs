@@ -134,3 +134,40 @@ pub fn write_all(report: &AuditReport, dir: &Path) -> Result<Vec<PathBuf>, Repor
     }
     Ok(written)
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::record::{CheckRecord, NoiseFloor, OracleValue, Verdict};
+    use crate::run::{AuditOptions, AuditReport};
+    use serde_json::Value;
+
+    /// A failing record whose oracle stopped at a float32 rounding floor says so in every
+    /// sink a person reads: the terminal summary, JUnit's failure text and the HTML report.
+    #[test]
+    fn a_failure_at_a_rounding_floor_says_so_in_every_sink() {
+        let mut r = CheckRecord::new("smith.white_furnace", Value::Null, Value::Null, "s");
+        r.verdict = Verdict::Fail;
+        r.oracle = Some(OracleValue {
+            value: 1.0,
+            uncertainty: 2.1e-7,
+            kind: "error_bound",
+            noise_floor: Some(NoiseFloor {
+                noise: 1.2e-7,
+                floor: 3.8e-6,
+            }),
+        });
+        let report = AuditReport::from_records(
+            "s".into(),
+            &AuditOptions::default(),
+            "mfh".into(),
+            vec![r],
+            (0, 0.001),
+            0.0,
+        );
+        let want = "integrand noise 1.2e-7 relative, floor 3.8e-6";
+        assert!(super::terminal::render(&report, 5).contains(want));
+        assert!(super::junit::render(&report).contains(want));
+        #[cfg(feature = "html")]
+        assert!(super::html::render(&report, None).is_ok_and(|h| h.contains(want)));
+    }
+}
