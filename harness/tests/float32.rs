@@ -9,18 +9,12 @@ use mfh_harness::record::Verdict;
 use mfh_harness::{Audit, Precision, Profile};
 #[path = "common/ggx32.rs"]
 mod ggx32;
+#[path = "common/verdicts.rs"]
+mod verdicts;
 
 use ggx32::{Defect, Ggx32};
 use mfh_reference::{Ndf, NormalSampler, Smith, Vec3};
-
-fn failing(report: &mfh_harness::run::AuditReport) -> Vec<String> {
-    report
-        .records
-        .iter()
-        .filter(|r| !matches!(r.verdict, Verdict::Pass | Verdict::Skipped { .. }))
-        .map(|r| format!("{} {} {:?}", r.check, r.case, r.verdict))
-        .collect()
-}
+use verdicts::{assert_named_float32, failing};
 
 #[test]
 fn a_float32_ggx_declared_f32_passes_the_ci_profile() {
@@ -87,20 +81,7 @@ fn an_f64_model_claims_no_noise_floor() {
 fn a_float32_ggx_audited_as_f64_is_named_by_audit_precision() {
     let m = Ggx32::new(0.3);
     let report = Audit::of(&m).profile(Profile::Quick).run();
-    let r = report
-        .records
-        .iter()
-        .find(|r| r.check == "audit.precision")
-        .expect("an audit.precision record");
-    assert!(
-        matches!(&r.verdict, Verdict::Error { message }
-            if message.contains("float32 values; declare precision f32")),
-        "{r:?}"
-    );
-    assert!(!report.passed());
-    // The rest was judged at f32 (and says so), not against f64 tolerances.
-    assert!(report.records.iter().all(|r| r.precision == Precision::F32));
-    assert_eq!(failing(&report).len(), 1, "{:#?}", failing(&report));
+    assert_named_float32(&report);
 }
 
 #[test]

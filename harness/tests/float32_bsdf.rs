@@ -11,12 +11,14 @@
 
 #[path = "common/ggx32.rs"]
 mod ggx32;
+#[path = "common/verdicts.rs"]
+mod verdicts;
 
 use ggx32::{normalize, v32, v64, Ggx32};
-use mfh_harness::record::Verdict;
 use mfh_harness::run::AuditReport;
 use mfh_harness::{Audit, Precision, Profile, Sampling};
 use mfh_reference::{Bsdf, BsdfSample, Masking, Vec3};
+use verdicts::{assert_fails_on, assert_named_float32, failing};
 
 /// Which defect the float32 dielectric carries.
 #[derive(Clone, Copy, PartialEq)]
@@ -345,15 +347,6 @@ fn audit<B: Bsdf>(bsdf: &B, ndf: &Ggx32, spec: &str, precision: Precision) -> Au
         .run()
 }
 
-fn failing(report: &AuditReport) -> Vec<String> {
-    report
-        .records
-        .iter()
-        .filter(|r| !matches!(r.verdict, Verdict::Pass | Verdict::Skipped { .. }))
-        .map(|r| format!("{} {} {:?} {:?}", r.check, r.case, r.verdict, r.measured))
-        .collect()
-}
-
 /// Prints each check's worst measured value against its tolerance (the budgets' evidence).
 fn print_worst(what: &str, report: &AuditReport) {
     let mut worst: std::collections::BTreeMap<String, (f64, f64)> = Default::default();
@@ -411,41 +404,21 @@ fn a_float32_conductor_declared_f32_passes_the_ci_profile() {
 fn a_float32_dielectric_audited_as_f64_is_named_by_audit_precision() {
     let b = Glass32::new(1.5, 0.3, Defect::None);
     let report = audit(&b, &b.facets.0, GLASS, Precision::F64);
-    let r = report
-        .records
-        .iter()
-        .find(|r| r.check == "audit.precision")
-        .expect("an audit.precision record");
-    assert!(
-        matches!(&r.verdict, Verdict::Error { message }
-            if message.contains("float32 values; declare precision f32")),
-        "{r:?}"
-    );
-    // The rest was judged at f32 (and says so), not against f64 tolerances.
-    assert!(report.records.iter().all(|r| r.precision == Precision::F32));
-    assert_eq!(failing(&report).len(), 1, "{:#?}", failing(&report));
+    assert_named_float32(&report);
 }
 
 #[test]
 fn a_float32_refraction_jacobian_with_wi_fails_the_chi_square() {
     let b = Glass32::new(1.5, 0.3, Defect::JacobianWithWi);
     let report = audit(&b, &b.facets.0, GLASS, Precision::F32);
-    let failed = failing(&report);
-    assert!(
-        failed.iter().any(|f| f.starts_with("bsdf.chi2")),
-        "{failed:#?}"
-    );
+    assert_fails_on(&report, "bsdf.chi2", "");
 }
 
 #[test]
 fn a_float32_radiance_btdf_without_eta_squared_fails_reciprocity() {
     let b = Glass32::new(1.5, 0.3, Defect::NoEtaSquared);
     let report = audit(&b, &b.facets.0, GLASS, Precision::F32);
-    let failed = failing(&report);
-    assert!(
-        failed.iter().any(|f| f.starts_with("bsdf.reciprocity")),
-        "{failed:#?}"
-    );
+    assert_fails_on(&report, "bsdf.reciprocity", "");
 }
 
 /// pbrt-v4's GGX D returns 0 where cos⁴θ < 1e-16 (within 1e-4 rad of the horizon), where D is
@@ -457,13 +430,7 @@ fn pbrts_grazing_guard_is_seen_by_against() {
     let mut b = Glass32::new(1.5, 0.3, Defect::None);
     b.facets.1 = true;
     let report = audit(&b, &b.facets.0, GLASS, Precision::F32);
-    let failed = failing(&report);
-    assert!(
-        failed
-            .iter()
-            .any(|f| f.starts_with("bsdf.against") && f.contains("\"quantity\":\"eval\"")),
-        "{failed:#?}"
-    );
+    assert_fails_on(&report, "bsdf.against", "\"quantity\":\"eval\"");
 }
 
 /// Tiny roughness in float32 (α = 0.001, a near-mirror): no false alarm. At normal incidence
@@ -493,11 +460,5 @@ fn float32_bsdfs_at_tiny_roughness_pass() {
 fn a_float32_sample_pdf_two_permille_high_fails_consistency() {
     let b = Glass32::new(1.5, 0.3, Defect::SamplePdf);
     let report = audit(&b, &b.facets.0, GLASS, Precision::F32);
-    let failed = failing(&report);
-    assert!(
-        failed
-            .iter()
-            .any(|f| f.starts_with("bsdf.sample_consistency")),
-        "{failed:#?}"
-    );
+    assert_fails_on(&report, "bsdf.sample_consistency", "");
 }
