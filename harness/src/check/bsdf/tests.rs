@@ -26,13 +26,22 @@ fn failures(records: &[CheckRecord]) -> Vec<String> {
         .collect()
 }
 
-/// A BSDF mutant is killed by a check its entry names, through the public gate at the ci
-/// profile (the Šidák level of the whole audit): at seed 7, and at two more seeds in the
-/// extensive tier (`MFH_EXTENSIVE=1`). One test a mutant (below), so that nextest spreads the
-/// thirteen ci audits over the cores and each stays far inside its time limit.
+/// A BSDF mutant is killed by a check its entry names, planned by the public gate at the ci
+/// profile: at seed 7, and at two more seeds in the extensive tier (`MFH_EXTENSIVE=1`). Only
+/// the named checks run, as a shard of the gate's plan would run them (`shard.rs`): each
+/// with the seed the whole audit gives it (`check_seed`), its statistical verdicts at the
+/// Šidák level of the whole plan's statistical checks; so each record is the one
+/// `Audit::of_bsdf(&m).run()` writes (the test below compares them for one mutant), and the
+/// others' cost (the albedo's cubature, the consistency
+/// pairs: about half of a ci audit) is not paid thirteen times in CI. `mfh selftest --only
+/// bsdf` runs the whole audits. One test a mutant (below), so that nextest spreads them over
+/// the cores.
 fn is_killed_by_its_named_check(defect: crate::selftest::bsdf_mutant::BsdfDefect) {
+    use crate::run::{check_seed, judge_at, sidak_alpha};
     use crate::selftest::bsdf_mutant::MutatedBsdf;
+    use crate::tolerance::STATISTICAL_ALPHA;
     use crate::{Audit, Profile};
+    use rayon::prelude::*;
     let seeds: &[u64] = if cfg!(mfh_extensive) {
         &[7, 8, 9]
     } else {
@@ -41,20 +50,42 @@ fn is_killed_by_its_named_check(defect: crate::selftest::bsdf_mutant::BsdfDefect
     let mut missed = Vec::new();
     for &seed in seeds {
         let m = MutatedBsdf::new(defect);
-        let report = Audit::of_bsdf(&m).profile(Profile::Ci).seed(seed).run();
-        let mut killers: Vec<&str> = report
-            .records
+        let audit = Audit::of_bsdf(&m).profile(Profile::Ci).seed(seed);
+        let (plan, errors) = audit.plan();
+        assert_eq!(failures(&errors), Vec::<String>::new(), "{}", defect.id());
+        let k = plan.iter().filter(|p| p.statistical).count();
+        let named: Vec<_> = plan
+            .iter()
+            .filter(|p| defect.killers().contains(&p.check.as_str()))
+            .collect();
+        assert!(!named.is_empty(), "{}: no named check planned", defect.id());
+        let mut records: Vec<CheckRecord> = named
+            .par_iter()
+            .map(|p| {
+                (p.run)(&RunContext {
+                    seed: check_seed(seed, p),
+                })
+            })
+            .collect();
+        judge_at(&mut records, sidak_alpha(STATISTICAL_ALPHA.value, k));
+        let mut killers: Vec<&str> = records
             .iter()
             .filter(|r| r.verdict.is_failure())
             .map(|r| r.check.as_str())
             .collect();
         killers.sort_unstable();
         killers.dedup();
-        println!("{:40} seed {seed}: killed by {killers:?}", defect.id());
-        if !defect.killers().iter().any(|k| killers.contains(k)) {
+        println!(
+            "{:40} seed {seed}: {} of {} planned checks named, killed by {killers:?}",
+            defect.id(),
+            named.len(),
+            plan.len()
+        );
+        if killers.is_empty() {
             missed.push(format!(
-                "{} seed {seed}: killed by {killers:?}",
-                defect.id()
+                "{} seed {seed}: none of {:?} fails",
+                defect.id(),
+                defect.killers()
             ));
         }
     }
@@ -84,6 +115,45 @@ macro_rules! mutant_tests {
             )*
         }
     };
+}
+
+/// The named checks run alone give the records the whole audit gives them (same seeds, same
+/// level), so the kill tests above judge what the gate judges.
+#[test]
+fn named_checks_run_alone_give_the_whole_audits_records() {
+    use crate::run::{check_seed, judge_at, sidak_alpha};
+    use crate::selftest::bsdf_mutant::{BsdfDefect, MutatedBsdf};
+    use crate::tolerance::STATISTICAL_ALPHA;
+    let m = MutatedBsdf::new(BsdfDefect::EtaSquaredMissing);
+    let whole = crate::Audit::of_bsdf(&m).profile(Profile::Ci).seed(7).run();
+    let audit = crate::Audit::of_bsdf(&m).profile(Profile::Ci).seed(7);
+    let (plan, _) = audit.plan();
+    let k = plan.iter().filter(|p| p.statistical).count();
+    let mut alone: Vec<CheckRecord> = plan
+        .iter()
+        .filter(|p| p.check == "bsdf.reciprocity" || p.check == "bsdf.stability")
+        .map(|p| {
+            (p.run)(&RunContext {
+                seed: check_seed(7, p),
+            })
+        })
+        .collect();
+    judge_at(&mut alone, sidak_alpha(STATISTICAL_ALPHA.value, k));
+    assert!(alone.len() >= 2);
+    for r in &alone {
+        let w = whole
+            .records
+            .iter()
+            .find(|w| w.check == r.check && w.case == r.case)
+            .unwrap_or_else(|| panic!("{} {} not in the whole audit", r.check, r.case));
+        assert_eq!(
+            (&w.verdict, &w.measured, w.value),
+            (&r.verdict, &r.measured, r.value),
+            "{} {}",
+            r.check,
+            r.case
+        );
+    }
 }
 
 mutant_tests! {
