@@ -226,12 +226,13 @@ pub fn expected_mass_global(
     target: f64,
     budget: u64,
 ) -> (Expected, bool) {
-    expected_mass_global_until(pdf, grid, lobe, target, budget, &|_| false)
+    expected_mass_global_until(pdf, grid, lobe, target, budget, &|_| false, &|_| None)
 }
 
 /// [`expected_mass_global`] that also stops, converged, once the masses so far satisfy
-/// `enough` (a caller's criterion on the cells' estimates; see
-/// [`crate::oracle::cubature::global::integrate_global_until`]).
+/// `enough` (a caller's criterion on the cells' estimates), bisecting first where `weights`
+/// (per cell: what a unit of error bound there adds to that criterion) says error costs most
+/// (see [`crate::oracle::cubature::global::integrate_global_weighted`]).
 pub fn expected_mass_global_until(
     pdf: &BatchPdf<'_>,
     grid: HemisphereGrid,
@@ -239,6 +240,7 @@ pub fn expected_mass_global_until(
     target: f64,
     budget: u64,
     enough: &dyn Fn(&Expected) -> bool,
+    weights: &dyn Fn(&Expected) -> Option<Vec<f64>>,
 ) -> (Expected, bool) {
     let polar = lobe.polar_cuts_with(FRAC_PI_2, &[]);
     let azimuth = lobe.azimuth_cuts();
@@ -255,12 +257,26 @@ pub fn expected_mass_global_until(
     }
     let f = in_angles(pdf);
     let cells = |pieces: &[Estimate]| sum_per_cell(pieces, &per_cell);
-    let result = crate::oracle::cubature::global::integrate_global_until(
+    let cell_of: Vec<usize> = per_cell
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &n)| std::iter::repeat_n(i, n))
+        .collect();
+    let result = crate::oracle::cubature::global::integrate_global_weighted(
         &f,
         &rectangles,
         target,
         budget,
         &|pieces| enough(&Expected::of_cells(&cells(pieces))),
+        &|pieces| {
+            let w = weights(&Expected::of_cells(&cells(pieces)))?;
+            Some(
+                cell_of
+                    .iter()
+                    .map(|&c| w.get(c).copied().unwrap_or(0.0))
+                    .collect(),
+            )
+        },
     );
     let mut e = Expected::of_cells(&cells(&result.estimates));
     e.evaluations = result.evaluations;

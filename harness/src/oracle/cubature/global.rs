@@ -7,18 +7,27 @@
 //! error target and one evaluation budget:
 //!
 //! 1. Every rectangle is integrated by the G7/K15 product rule (in batches).
-//! 2. While the summed error bound exceeds `target` and evaluations remain in `budget`, every
-//!    piece whose error exceeds the mean share target / pieces is bisected into quadrants,
-//!    largest error first and as many as the remaining budget allows (ties in error go to the
-//!    earlier piece: the result does not depend on scheduling), and the quadrants evaluated in
-//!    one batch per round. A piece at [`GLOBAL_MAX_DEPTH`] is not bisected again.
+//! 2. While the summed error bound exceeds `target` and evaluations remain in `budget`, the
+//!    pieces whose error exceeds the mean share target / pieces are candidates; a round
+//!    bisects into quadrants the worst of them (by error, or by error times the caller's
+//!    weight of its rectangle: [`integrate_global_weighted`]) that carry [`BULK`] of their
+//!    summed priority, as many as the remaining budget allows (ties go to the earlier piece:
+//!    the result does not depend on scheduling), and evaluates the quadrants in one batch.
+//!    A piece at [`GLOBAL_MAX_DEPTH`] is not bisected again.
 //! 3. Each rectangle's estimate is the sum of its pieces, with the sum of their error
 //!    estimates as its bound — honest whether the target was met or the budget ran out.
 //!
-//! Along a step each round halves the error of the pieces the step crosses, so the target is
-//! met in about log₂(initial error / target) rounds.
+//! Along a step each round halves the error of the pieces the step crosses. Bisecting every
+//! candidate each round (before 2026-12-05) quadrupled the pieces at once and overshot a
+//! caller's own criterion by a round; the bulk rounds stop closer to it.
 
 use super::{evaluate, BatchFn2, Estimate, Node};
+
+/// The share of the refinable pieces' summed error that one round bisects (the worst pieces
+/// first): Dörfler's bulk criterion of adaptive finite elements. Bisecting every piece above
+/// the mean share in each round (as before) overshot a caller's criterion (`enough`) by
+/// rounds that quadrupled the pieces at once.
+pub const BULK: f64 = 0.5;
 
 /// The deepest bisection of a piece (its side is 2⁻¹⁶ of the rectangle's).
 pub const GLOBAL_MAX_DEPTH: u32 = 16;
@@ -68,6 +77,23 @@ pub fn integrate_global_until(
     budget: u64,
     enough: &dyn Fn(&[Estimate]) -> bool,
 ) -> GlobalResult {
+    integrate_global_weighted(f, rectangles, target, budget, enough, &|_| None)
+}
+
+/// [`integrate_global_until`] whose rounds bisect first the pieces whose error costs the
+/// caller most: `weights` answers, from the per-rectangle estimates so far, what a unit of
+/// error bound in each rectangle adds to the caller's criterion (its derivative; `None`: the
+/// same everywhere), and a piece's priority is its error times its rectangle's weight. The
+/// bulk marking ([`BULK`]) then takes the pieces that carry half of the summed priority. The
+/// bounds are the same honest sums whatever the order; only where the evaluations go changes.
+pub fn integrate_global_weighted(
+    f: &BatchFn2<'_>,
+    rectangles: &[([f64; 2], [f64; 2])],
+    target: f64,
+    budget: u64,
+    enough: &dyn Fn(&[Estimate]) -> bool,
+    weights: &dyn Fn(&[Estimate]) -> Option<Vec<f64>>,
+) -> GlobalResult {
     let mut owners: Vec<usize> = (0..rectangles.len()).collect();
     let mut leaves: Vec<Node> = rectangles.iter().map(|&(x, y)| node(x, y, 0)).collect();
     evaluate(f, &mut leaves);
@@ -75,7 +101,8 @@ pub fn integrate_global_until(
     let mut converged;
     loop {
         let total: f64 = leaves.iter().map(|n| n.error).sum();
-        converged = total <= target || enough(&per_rectangle(rectangles.len(), &leaves, &owners));
+        let so_far = per_rectangle(rectangles.len(), &leaves, &owners);
+        converged = total <= target || enough(&so_far);
         if converged || evaluations >= budget || !total.is_finite() {
             break;
         }
@@ -86,9 +113,20 @@ pub fn integrate_global_until(
         if split.is_empty() {
             break;
         }
-        split.sort_by(|&a, &b| leaves[b].error.total_cmp(&leaves[a].error).then(a.cmp(&b)));
+        let priority = priorities(&leaves, &owners, &split, weights(&so_far));
+        split.sort_by(|&a, &b| priority[b].total_cmp(&priority[a]).then(a.cmp(&b)));
+        // Bulk marking: the first pieces that carry BULK of the candidates' priority.
+        let candidates: f64 = split.iter().map(|&i| priority[i]).sum();
+        let (mut carried, mut marked) = (0.0, 0);
+        for &i in &split {
+            if carried >= BULK * candidates {
+                break;
+            }
+            carried += priority[i];
+            marked += 1;
+        }
         let affordable = ((budget - evaluations) / (4 * 225)).max(1) as usize;
-        split.truncate(affordable);
+        split.truncate(marked.clamp(1, affordable));
         split.sort_unstable();
         let mut children = Vec::with_capacity(4 * split.len());
         let mut child_owners = Vec::with_capacity(4 * split.len());
@@ -137,6 +175,32 @@ pub fn integrate_global_until(
         estimates,
         converged,
         evaluations,
+    }
+}
+
+/// Each leaf's priority (its error, times its rectangle's weight when the weights are given,
+/// finite, non-negative and not all zero over the candidates `split`; else its error alone).
+fn priorities(
+    leaves: &[Node],
+    owners: &[usize],
+    split: &[usize],
+    weights: Option<Vec<f64>>,
+) -> Vec<f64> {
+    let raw: Vec<f64> = leaves.iter().map(|n| n.error).collect();
+    let Some(w) = weights.filter(|w| w.len() >= owners.iter().max().map_or(0, |&o| o + 1)) else {
+        return raw;
+    };
+    let weighted: Vec<f64> = leaves
+        .iter()
+        .zip(owners)
+        .map(|(n, &o)| n.error * w[o])
+        .collect();
+    let sum: f64 = split.iter().map(|&i| weighted[i]).sum();
+    let sane = split.iter().all(|&i| weighted[i] >= 0.0) && sum.is_finite() && sum > 0.0;
+    if sane {
+        weighted
+    } else {
+        raw
     }
 }
 
