@@ -249,12 +249,8 @@ impl<'a> Audit<'a> {
         }
         // What the model's answers say of its precision (`audit.precision`); a float32 model
         // declared f64 is judged at f32, and the record says so.
-        let seen = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let (seen, precision) = precision_probe::judge(self.precision, || {
             precision_probe::probe(self.model.as_ref())
-        }))
-        .ok();
-        let precision = seen.map_or(self.precision, |seen| {
-            precision_probe::effective(self.precision, seen)
         });
         let subject = Subject::user_at(
             self.model.clone(),
@@ -318,12 +314,8 @@ impl<'a> Audit<'a> {
             visible_normals: self.sampling == Some(Some(Sampling::VisibleNormals)),
         });
         // What its answers say of its precision, as for a model (`audit.precision`).
-        let seen = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let (seen, precision) = precision_probe::judge(self.precision, || {
             precision_probe::probe_bsdf(bsdf.as_ref())
-        }))
-        .ok();
-        let precision = seen.map_or(self.precision, |seen| {
-            precision_probe::effective(self.precision, seen)
         });
         let subject = BsdfSubject::user(bsdf, &self.name, own_ndf, precision);
         let why = format!("BSDF `{}`", self.name);

@@ -140,6 +140,16 @@ pub fn record(model: &serde_json::Value, declared: Precision, seen: Seen) -> Che
     r
 }
 
+/// Runs `probe` (a model's or a BSDF's, which may panic: then nothing was seen) and gives
+/// what it saw with the precision the audit judges at ([`effective`]).
+pub fn judge(declared: Precision, probe: impl FnOnce() -> Seen) -> (Option<Seen>, Precision) {
+    let seen = std::panic::catch_unwind(std::panic::AssertUnwindSafe(probe)).ok();
+    (
+        seen,
+        seen.map_or(declared, |seen| effective(declared, seen)),
+    )
+}
+
 /// The precision an audit judges at: the declared one, or float32 when a model declared f64
 /// answers only float32 values.
 pub fn effective(declared: Precision, seen: Seen) -> Precision {

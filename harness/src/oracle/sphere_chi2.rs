@@ -372,20 +372,30 @@ pub fn sphere_noncentrality(upper: &Expected, lower: &Expected, samples: u64) ->
 /// hemisphere.
 fn noncentrality_parts(e: &Expected, samples: u64) -> (f64, f64, f64) {
     let least = MIN_EXPECTED / samples.max(1) as f64;
-    let (mut large, mut pooled_mass, mut pooled_bound, mut summed, mut bound) =
-        (0.0, 0.0, 0.0, 0.0, 0.0);
-    for (&p, &d) in e.mass.iter().zip(&e.cell_bound) {
-        summed += p;
-        bound += d;
-        if p - d >= least {
-            large += d * d / (p - d);
-        } else {
-            pooled_mass += p;
-            pooled_bound += d;
-        }
-    }
+    let (pooled_mass, pooled_bound) = pooled(e, least);
+    let large: f64 = e
+        .mass
+        .iter()
+        .zip(&e.cell_bound)
+        .filter(|&(&p, &d)| p - d >= least)
+        .map(|(&p, &d)| d * d / (p - d))
+        .sum();
     let pooled = pooled_bound * pooled_bound / (pooled_mass - pooled_bound).max(least);
-    (large + pooled, summed, bound)
+    (
+        large + pooled,
+        e.mass.iter().sum(),
+        e.cell_bound.iter().sum(),
+    )
+}
+
+/// The summed mass and bound of the cells that are pooled: those whose mass may expect fewer
+/// than `least` (pᵢ − δᵢ < least).
+fn pooled(e: &Expected, least: f64) -> (f64, f64) {
+    e.mass
+        .iter()
+        .zip(&e.cell_bound)
+        .filter(|&(&p, &d)| p - d < least)
+        .fold((0.0, 0.0), |(m, b), (&p, &d)| (m + p, b + d))
 }
 
 /// 2n F Σ brackets, F from the summed masses and bounds of the parts.
@@ -411,13 +421,7 @@ fn noncentrality_of(parts: &[(f64, f64, f64)], samples: u64) -> f64 {
 pub fn noncentrality_weights(e: &Expected, samples: u64) -> Vec<f64> {
     let n = samples.max(1) as f64;
     let least = MIN_EXPECTED / n;
-    let (mut pooled_mass, mut pooled_bound) = (0.0, 0.0);
-    for (&p, &d) in e.mass.iter().zip(&e.cell_bound) {
-        if p - d < least {
-            pooled_mass += p;
-            pooled_bound += d;
-        }
-    }
+    let (pooled_mass, pooled_bound) = pooled(e, least);
     let pooled = 2.0 * pooled_bound / (pooled_mass - pooled_bound).max(least);
     e.mass
         .iter()

@@ -108,7 +108,7 @@ pub fn plan<'a>(
                 }
             }
         }
-        let conditioning = excuse(bsdf, wi, &mut beyond, s.precision.epsilon());
+        let excusing = excuse(bsdf, wi, &mut beyond, s.precision.epsilon());
         let excused = beyond
             .iter()
             .filter(|c| c.error - c.spread <= tolerance.value)
@@ -127,7 +127,7 @@ pub fn plan<'a>(
             }
         }
         r.cost.samples = n;
-        r.cost.evaluations += conditioning.evaluations;
+        r.cost.evaluations += excusing;
         r.value = Some(worst.error);
         r.measured = Some(Measured::Relative { error: worst.error });
         r.tolerance = Some(applied(&tolerance));
@@ -191,11 +191,6 @@ struct Candidate {
 /// them: a correct float32 dielectric has a handful at 10⁷ samples).
 const MAX_EXCUSED: usize = 1024;
 
-/// What [`excuse`] spent.
-struct Conditioning {
-    evaluations: u64,
-}
-
 /// The conditioning of each candidate (the worst [`MAX_EXCUSED`] by raw error): the largest
 /// relative change of pdf(wi, ·) and eval/pdf over the six directions wo ± 16 ε eₖ
 /// (renormalized), ε the BSDF's precision. `sample` computes its pdf and weight from the
@@ -203,8 +198,9 @@ struct Conditioning {
 /// BSDF's arithmetic knows only to a few ε: where the pdf varies by more than the tolerance
 /// over that neighbourhood (near a critical angle, where 1 − F has an infinite slope, or the
 /// horizon) the two legitimately differ by that much, and the check judges only the excess.
-/// A misplaced factor is not excused: it shows at the well-conditioned samples too.
-fn excuse(bsdf: &dyn Bsdf, wi: Vec3, candidates: &mut [Candidate], eps: f64) -> Conditioning {
+/// A misplaced factor is not excused: it shows at the well-conditioned samples too. Returns
+/// the evaluations spent.
+fn excuse(bsdf: &dyn Bsdf, wi: Vec3, candidates: &mut [Candidate], eps: f64) -> u64 {
     candidates.sort_by(|a, b| b.error.total_cmp(&a.error));
     let take = candidates.len().min(MAX_EXCUSED);
     let h = 16.0 * eps;
@@ -233,9 +229,7 @@ fn excuse(bsdf: &dyn Bsdf, wi: Vec3, candidates: &mut [Candidate], eps: f64) -> 
         }
         c.spread = spread;
     }
-    Conditioning {
-        evaluations: 2 * wo.len() as u64,
-    }
+    2 * wo.len() as u64
 }
 
 /// Judges `failed` of `n` samples against the failure probability 1 − mass: a z-test whose

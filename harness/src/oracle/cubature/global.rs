@@ -187,7 +187,7 @@ fn priorities(
     weights: Option<Vec<f64>>,
 ) -> Vec<f64> {
     let raw: Vec<f64> = leaves.iter().map(|n| n.error).collect();
-    let Some(w) = weights.filter(|w| w.len() >= owners.iter().max().map_or(0, |&o| o + 1)) else {
+    let Some(w) = weights.filter(|w| owners.iter().all(|&o| o < w.len())) else {
         return raw;
     };
     let weighted: Vec<f64> = leaves
