@@ -54,6 +54,8 @@ pub struct Audit<'a> {
     implemented: Option<capabilities::Implemented>,
     /// The precision the model computes in.
     precision: Precision,
+    /// The caller states that D is all the model offers ([`Audit::d_only`]).
+    d_only: bool,
 }
 
 impl<'a> Audit<'a> {
@@ -82,7 +84,27 @@ impl<'a> Audit<'a> {
             seed_error,
             implemented: None,
             precision: Precision::F64,
+            d_only: false,
         }
+    }
+
+    /// `Audit::of(model)` with the capability traits `found` wired in: what [`crate::audit!`]
+    /// calls, after the compiler has found the traits the model's type implements. Prefer the
+    /// macro.
+    #[doc(hidden)]
+    pub fn of_found<M: Ndf + 'a>(model: &'a M, found: capabilities::Found<'a>) -> Self {
+        let mut audit = Audit::of(model);
+        audit.model = Arc::new(capabilities::Wired::new(model, found));
+        audit.implemented = Some(found.implemented());
+        audit
+    }
+
+    /// States that D is all the model offers (no Smith Λ, no sampler, no slopes): without it, an
+    /// audit of a model that offers D alone fails `audit.capabilities`, since a gate written
+    /// for a model with Λ and samplers that forgot to offer them would otherwise pass on D.
+    pub fn d_only(mut self) -> Self {
+        self.d_only = true;
+        self
     }
 
     /// An audit of a whole BSDF `bsdf` (reflection and refraction, sampled and evaluated; see
@@ -279,6 +301,7 @@ impl<'a> Audit<'a> {
             &subject.label,
             self.model.as_ref(),
             self.implemented,
+            self.d_only,
         ));
         let mut plan = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             plan_model(&subject, &effects, self.options.profile, &why)
@@ -420,18 +443,21 @@ fn seed_from_env(value: Option<String>) -> (u64, Option<String>) {
     }
 }
 
-/// The `audit.capabilities` record: the capabilities the model declares (and so is audited
-/// on) and those it does not offer; with [`crate::audit!`], those its type implements, and a
-/// failure for each implemented but undeclared one (its checks would silently not run).
+/// The `audit.capabilities` record: the capabilities the model offers (and so is audited on)
+/// and those it does not; with [`crate::audit!`], those its type implements, among them the
+/// ones wired in because no `as_*` method declared them. It fails when the model offers D
+/// alone and the caller did not state so ([`Audit::d_only`]), or stated so of a model that
+/// offers more.
 fn capabilities_record(
     model: &serde_json::Value,
     ndf: &dyn Ndf,
     implemented: Option<capabilities::Implemented>,
+    d_only: bool,
 ) -> CheckRecord {
     let declared = capabilities::declared(ndf);
     let audited: Vec<&str> = declared.iter().filter(|d| d.2).map(|d| d.1).collect();
     let not_offered: Vec<&str> = declared.iter().filter(|d| !d.2).map(|d| d.1).collect();
-    let mut case = json!({"audited": audited, "not_offered": not_offered});
+    let mut case = json!({"audited": audited, "not_offered": not_offered, "d_only": d_only});
     let mut r = CheckRecord::new(
         "audit.capabilities",
         model.clone(),
@@ -441,30 +467,37 @@ fn capabilities_record(
     r.verdict = Verdict::Pass;
     match implemented {
         None => {
-            case["implemented"] = json!("not detected (audit with mfh_harness::audit!(model))");
+            case["implemented"] = json!(
+                "not detected: Audit::of sees only what the as_* methods declare \
+                 (audit with mfh_harness::audit!(model) to find and wire every trait)"
+            );
         }
         Some(i) => {
-            let undeclared: Vec<String> = declared
-                .iter()
-                .filter(|d| i.has(d.0) && !d.2)
-                .map(|d| {
-                    format!(
-                        "{} is implemented but as_{}() returns None: its checks would not run \
-                         (return Some(self))",
-                        d.1, d.0
-                    )
-                })
-                .collect();
             case["implemented"] = json!(declared
                 .iter()
                 .filter(|d| i.has(d.0))
                 .map(|d| d.1)
                 .collect::<Vec<_>>());
-            if !undeclared.is_empty() {
-                case["undeclared"] = json!(undeclared);
-                r.verdict = Verdict::Fail;
-            }
         }
+    }
+    let mut problems = Vec::new();
+    if audited.is_empty() && !d_only {
+        problems.push(
+            "the model offers D alone, so only D is audited: if D is all it has, say so with \
+             .d_only(); if its type implements Smith or a sampler, audit it with \
+             mfh_harness::audit!(model), which finds and wires them"
+                .to_string(),
+        );
+    }
+    if d_only && !audited.is_empty() {
+        problems.push(format!(
+            ".d_only() was stated, but the model offers {}",
+            audited.join(", ")
+        ));
+    }
+    if !problems.is_empty() {
+        case["problems"] = json!(problems);
+        r.verdict = Verdict::Fail;
     }
     r.case = case;
     r

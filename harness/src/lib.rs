@@ -41,6 +41,10 @@ pub mod tolerance;
 
 pub use audit::Audit;
 pub use check::Profile;
+/// The BSDF trait a renderer implements for [`Audit::of_bsdf`] (`Bsdf`, `BsdfSample`,
+/// `Transport`) and the reference BSDFs, so that one dependency on this crate gives a gate all
+/// it needs.
+pub use mfh_reference::bsdf;
 pub use mfh_reference::model;
 pub use precision::Precision;
 pub use scene::Sampling;

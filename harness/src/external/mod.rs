@@ -15,7 +15,7 @@ pub use against::Against;
 pub use model::ExternalModel;
 pub use process::{ExternalError, DEFAULT_TIMEOUT_SECONDS};
 
-use crate::audit::Audit;
+use crate::audit::{capabilities, Audit};
 use crate::check::{PlannedCheck, Profile};
 use crate::record::{CheckRecord, Verdict};
 use crate::run::{run_plan, AuditOptions, AuditReport};
@@ -123,7 +123,12 @@ pub fn plan<'a>(
     };
     let (mut plan, mut errors) = (Vec::new(), Vec::new());
     if description.has_ndf() {
-        let (p, e) = configure(Audit::of(model), |a| matches!(a, Against::Ndf(_))).plan();
+        let mut audit = configure(Audit::of(model), |a| matches!(a, Against::Ndf(_)));
+        if capabilities::declared(model).iter().all(|d| !d.2) {
+            // The child's describe names its capabilities: D alone is its own statement.
+            audit = audit.d_only();
+        }
+        let (p, e) = audit.plan();
         plan.extend(p);
         errors.extend(e);
     }

@@ -1,8 +1,8 @@
 //! The forgotten capability, as a renderer would forget it: a wrapper that implements `Smith`
-//! and `NormalSampler` but leaves `as_smith` / `as_sampler` at their defaults. Audited with
-//! `Audit::of` it is audited on D alone, and a planted Λ bug and a planted sampler bug go
-//! through; with `mfh_harness::audit!` the compiler finds the implemented traits and the gate
-//! fails loudly on `audit.capabilities`, naming what was not declared.
+//! and `NormalSampler` but leaves `as_smith` / `as_sampler` at their defaults. With
+//! `mfh_harness::audit!` the compiler finds the implemented traits and wires them in, so a
+//! planted Λ bug fails its smith check; with `Audit::of`, which sees D alone, the gate fails
+//! `audit.capabilities` unless the caller states that D is all the model offers.
 
 use mfh_harness::model::{Ndf, NormalSampler, Smith, Vec3};
 use mfh_harness::{audit, Audit, Profile};
@@ -34,26 +34,77 @@ fn ggx(defect: Defect) -> Microfacet {
 }
 
 #[test]
-fn a_forgotten_capability_fails_the_gate_with_the_macro() {
-    // A Λ bug the undeclared Smith capability hides (and the sampler's is as hidden).
+fn the_macro_finds_and_audits_a_forgotten_capability() {
+    // A Λ bug the undeclared Smith capability would hide from `Audit::of`.
     let m = Forgetful(ggx(Defect::LambdaWrongAboveOnePointThree));
     let report = audit!(m).profile(Profile::Ci).run();
+    let failed = report.failed_checks();
+    assert!(
+        failed.iter().any(|c| c.starts_with("smith.")),
+        "the Λ bug must fail a smith check: {failed:?}"
+    );
+    assert!(!failed.contains(&"audit.capabilities"), "{failed:?}");
+    let record = report.records_of("audit.capabilities").next().unwrap();
+    assert_eq!(
+        record.case["implemented"].to_string(),
+        r#"["Smith","NormalSampler"]"#
+    );
+    assert_eq!(
+        record.case["audited"].to_string(),
+        r#"["Smith","NormalSampler"]"#
+    );
+    // The sampler was wired too: its checks ran.
+    assert!(report.records_of("sampling.chi2").count() > 0);
+    // The same type without the defect passes.
+    let m = Forgetful(ggx(Defect::None));
+    let report = audit!(m).profile(Profile::Ci).run();
+    assert!(report.passed(), "{:?}", report.failed_checks());
+}
+
+#[test]
+fn a_gate_without_the_macro_cannot_pass_on_d_alone() {
+    // `Audit::of` sees only what the `as_*` methods declare: here D alone. Unless the caller
+    // states that D is all the model has, the gate fails and says how to fix it.
+    let m = Forgetful(ggx(Defect::LambdaWrongAboveOnePointThree));
+    let report = Audit::of(&m).profile(Profile::Ci).run();
     assert_eq!(report.failed_checks(), ["audit.capabilities"]);
     let record = report.records_of("audit.capabilities").next().unwrap();
-    let undeclared = record.case["undeclared"].to_string();
+    let problems = record.case["problems"].to_string();
     assert!(
-        undeclared.contains("as_smith") && undeclared.contains("as_sampler"),
-        "{undeclared}"
+        problems.contains("D alone") && problems.contains("audit!") && problems.contains("d_only"),
+        "{problems}"
     );
-    // Without the macro the audit cannot know, and says so in the same record.
-    let report = Audit::of(&m).profile(Profile::Ci).run();
-    let record = report.records_of("audit.capabilities").next().unwrap();
-    assert!(record.case["implemented"]
-        .as_str()
-        .is_some_and(|s| s.contains("audit!")));
     assert_eq!(record.case["not_offered"][0].as_str(), Some("Smith"));
-    // And the hidden Λ bug passes the audit that cannot see it: why the macro exists.
+    // Stated: D is all it offers, and D is right.
+    let report = Audit::of(&m).d_only().profile(Profile::Ci).run();
     assert!(report.passed(), "{:?}", report.failed_checks());
+}
+
+#[test]
+fn d_only_stated_of_a_model_that_offers_more_fails() {
+    struct WithSmith(Microfacet);
+    impl Ndf for WithSmith {
+        fn d(&self, m: Vec3) -> f64 {
+            self.0.d(m)
+        }
+        fn as_smith(&self) -> Option<&dyn Smith> {
+            Some(self)
+        }
+    }
+    impl Smith for WithSmith {
+        fn lambda(&self, w: Vec3) -> f64 {
+            self.0.lambda(w)
+        }
+    }
+    let m = WithSmith(ggx(Defect::None));
+    let report = Audit::of(&m).d_only().profile(Profile::Ci).run();
+    assert_eq!(report.failed_checks(), ["audit.capabilities"]);
+    let record = report.records_of("audit.capabilities").next().unwrap();
+    assert!(
+        record.case["problems"].to_string().contains("d_only"),
+        "{}",
+        record.case
+    );
 }
 
 #[test]

@@ -13,9 +13,12 @@
 //! A gated test carries, for example,
 //! `#[cfg_attr(not(mfh_extensive), ignore = "extensive tier: set MFH_EXTENSIVE=1")]`; code that
 //! only scales with the tier (more fuzz cases, more sweep points) reads `cfg!(mfh_extensive)`.
-//! The flags are decided when the crate is built; cargo rebuilds it when `MFH_EXTENSIVE`, `CI`
-//! or (for the tool gates) `PATH` changes. (`cargo test -- --include-ignored` runs the ignored
-//! tests anyway.)
+//! The flags are decided when the crate is built; cargo reruns the build script (and rebuilds
+//! the crate) when `MFH_EXTENSIVE`, `CI` or (for the tool gates) `PATH` changes, and when a
+//! tool is installed or removed: the build script watches the places a tool appears in
+//! ([`Tool::watched`]: the directories of `PATH`, and python3's site-packages for numpy), so
+//! a test compiled as "ignored, no chromium" runs after `apt-get install chromium` without a
+//! `cargo clean`. (`cargo test -- --include-ignored` runs the ignored tests anyway.)
 
 use std::process::{Command, Stdio};
 
@@ -86,8 +89,55 @@ impl Tool {
     }
 }
 
-/// What a build script prints: the flags' declarations, `mfh_extensive` by [`extensive`], and
-/// `has_<tool>` for each of `tools` that is present or wanted by [`ci`].
+impl Tool {
+    /// The directories whose contents change when the tool is installed or removed, for
+    /// `cargo::rerun-if-changed`: every existing directory of `PATH` (where `apt-get` and
+    /// `pip` put programs), and for numpy also python3's site-packages directories. Cargo
+    /// compares the newest modification time inside a watched directory, the directory's own
+    /// included, which moves when an entry is added or removed. Only existing directories are
+    /// listed: a missing path would make cargo rerun the build script, and rebuild the crate,
+    /// on every invocation.
+    pub fn watched(self) -> Vec<std::path::PathBuf> {
+        let mut dirs: Vec<std::path::PathBuf> = std::env::var_os("PATH")
+            .map(|p| std::env::split_paths(&p).collect())
+            .unwrap_or_default();
+        if self == Tool::Numpy {
+            dirs.extend(site_packages());
+        }
+        let mut seen = Vec::new();
+        for dir in dirs {
+            if dir.is_absolute() && dir.is_dir() && !seen.contains(&dir) {
+                seen.push(dir);
+            }
+        }
+        seen
+    }
+}
+
+/// python3's site-packages directories (system and user), as python3 on `PATH` reports them;
+/// none where python3 does not run.
+fn site_packages() -> Vec<std::path::PathBuf> {
+    let script =
+        "import site\nfor d in site.getsitepackages() + [site.getusersitepackages()]: print(d)";
+    Command::new("python3")
+        .args(["-c", script])
+        .stdin(Stdio::null())
+        .stderr(Stdio::null())
+        .output()
+        .ok()
+        .filter(|out| out.status.success())
+        .map(|out| {
+            String::from_utf8_lossy(&out.stdout)
+                .lines()
+                .map(std::path::PathBuf::from)
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// What a build script prints: the flags' declarations, `mfh_extensive` by [`extensive`],
+/// `has_<tool>` for each of `tools` that is present or wanted by [`ci`], and the directories
+/// to watch for each tool's arrival or removal ([`Tool::watched`]).
 pub fn emit(tools: &[Tool]) {
     let var = |name: &str| std::env::var(name).ok();
     println!("cargo::rustc-check-cfg=cfg({EXTENSIVE_CFG})");
@@ -103,6 +153,15 @@ pub fn emit(tools: &[Tool]) {
     }
     println!("cargo::rerun-if-env-changed=CI");
     println!("cargo::rerun-if-env-changed=PATH");
+    let mut watched = Vec::new();
+    for &tool in tools {
+        for dir in tool.watched() {
+            if !watched.contains(&dir) {
+                println!("cargo::rerun-if-changed={}", dir.display());
+                watched.push(dir);
+            }
+        }
+    }
     let ci = ci(var("CI").as_deref());
     for &tool in tools {
         if ci || tool.present() {
@@ -130,5 +189,29 @@ mod tests {
         }
         assert!(ci(Some("true")));
         assert!(!ci(None) && !ci(Some("false")));
+    }
+
+    #[test]
+    fn watched_directories_exist_and_include_path() {
+        for tool in Tool::ALL {
+            let dirs = tool.watched();
+            for dir in &dirs {
+                assert!(
+                    dir.is_absolute() && dir.is_dir(),
+                    "{tool:?}: {}",
+                    dir.display()
+                );
+            }
+            // The directory that holds `sh` is on PATH on every machine the tests run on.
+            let sh = std::env::split_paths(&std::env::var_os("PATH").unwrap())
+                .find(|d| d.join("sh").is_file());
+            if let Some(sh) = sh {
+                assert!(
+                    dirs.contains(&sh),
+                    "{tool:?} does not watch {}",
+                    sh.display()
+                );
+            }
+        }
     }
 }
