@@ -2,6 +2,12 @@
 //! model in float32 answers with float32 rounding noise, and every value tolerance and every
 //! oracle's rounding floor is a function of it (`tolerance::Tolerance::at`,
 //! `oracle::quadrature::Accuracy::at`).
+//!
+//! The subject carries the declared precision and every record says what it was judged at. Its
+//! ε sets the float32 rows of the tolerances (`tolerance/precision.rs`; the BSDF checks' `_f32`
+//! rows in `tolerance/bsdf.rs`) and the oracles' rounding floors (`oracle.noise_floor` in a
+//! record, absent at f64). A float32 model audited as f64 is found by
+//! `audit/precision_probe.rs`, which writes the `audit.precision` record.
 
 use serde::{Deserialize, Serialize};
 

@@ -1,6 +1,14 @@
 //! The audit: runs a plan in parallel with per-check seeds, applies the Šidák correction across
 //! its statistical checks, and summarizes. This is also the public API a renderer's own tests
 //! call as a CI gate (`audit_scene(..)?.assert_pass()`).
+//!
+//! **Seeds.** A check's seed is the audit seed ([`DEFAULT_SEED`] unless `--seed` or `MFH_SEED`
+//! gives one) mixed with the check's id, model and case ([`check_seed`]): independent of plan
+//! order, thread count and shard. A panic inside a model or a check is caught into an error
+//! record; the other checks still run. The statistical verdicts are judged at the Šidák level
+//! of the whole plan ([`sidak_alpha`]). [`RunControl`] sends each check's start and finish
+//! (with its record) to a callback, takes the records of an interrupted run (by [`plan_key`])
+//! and stops starting checks after a time limit; this module writes no file.
 
 use crate::check::{PlannedCheck, Profile, RunContext};
 use crate::plan::plan;

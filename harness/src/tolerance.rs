@@ -2,9 +2,18 @@
 //! errata and known numerical limits of printed routes), each with its reason (ARCHITECTURE.md,
 //! "Tolerances and expected failures").
 //!
-//! The tolerances are here; the expected-failure types (`Bound`, `Domain`, `ExpectedFailure`)
-//! and their table are in `tolerance/expected.rs`, and the chi-square oracle's numeric
-//! tolerances in `tolerance/chi2.rs`, both re-exported here.
+//! The tolerances are here — every one a record is judged by, the documents' claims included
+//! (`check/claims.rs` names them, it defines none) — except the BSDF checks', in
+//! `tolerance/bsdf.rs`; their float32 rows are in `tolerance/precision.rs` (the BSDF checks'
+//! `_f32` rows in `tolerance/bsdf.rs`), picked by [`Tolerance::at`]; the expected-failure types
+//! (`Bound`, `Domain`, `ExpectedFailure`) and their table are in `tolerance/expected.rs`, and
+//! the chi-square oracle's numeric tolerances in `tolerance/chi2.rs`; all re-exported here.
+//! [`TABLE`] lists every [`Tolerance`] (its test: a reason each, unique names).
+//!
+//! Not here, by design: an oracle's own accuracy targets and budgets (what it asks of its
+//! quadrature, e.g. `check/claims.rs`'s `GTR_CLAIM_RELATIVE`, `oracle::quadrature`'s
+//! `EVALUATION_BUDGET`) tune how an oracle reaches its error bound; the bound is then carried by
+//! the record and judged against a tolerance of this table (`ORACLE_BOUND_FRACTION`).
 
 mod bsdf;
 mod chi2;
@@ -295,6 +304,27 @@ pub const ASG_CONVOLUTION_CLAIM_SHARP: Tolerance = Tolerance {
              the SG is very sharp)",
 };
 
+/// Seed 003 §3.2.1's ASG integral with F, an approximation the document states no error for
+/// (not an erratum: "can be approximated as follows"). Judged by `claims.asg_integral`
+/// (`check/claims.rs`).
+pub const ASG_INTEGRAL_APPROXIMATION: Tolerance = Tolerance {
+    name: "asg_integral_approximation",
+    value: 0.045,
+    reason: "the document states no error; the reference measured max 4.24 % relative for \
+             bandwidths μ ≥ 1, λ ≥ μ (at λ = 2, μ = 1; exact for λ = μ; unbounded as μ → 0): \
+             4.5 % bounds the measured error over the planned grid, so a changed form fails",
+};
+
+/// Seed 003 §4.3's ∫g^c ≈ ∫g (erf form), as a multiple of its leading-order relative error
+/// σ²/16. Judged by `claims.circular_interval_erf` (`check/claims.rs`).
+pub const CIRCULAR_ERF_LEADING_ORDER: Tolerance = Tolerance {
+    name: "circular_erf_leading_order",
+    value: 1.2,
+    reason: "the document says \"approximated\" and states no error; g^c = g·e^{x⁴/(12σ²) + …} \
+             gives a relative error σ²/16 to leading order; measured ≤ 1.15 σ²/16 for σ ≤ 1 and \
+             means in [−1.4, 1.4]: the check allows 1.2 σ²/16",
+};
+
 /// Every tolerance, for the report and the README.
 pub const TABLE: &[Tolerance] = &[
     CLOSED_FORM,
@@ -318,6 +348,8 @@ pub const TABLE: &[Tolerance] = &[
     ASG_PRODUCT_FIT,
     ASG_CONVOLUTION_CLAIM,
     ASG_CONVOLUTION_CLAIM_SHARP,
+    ASG_INTEGRAL_APPROXIMATION,
+    CIRCULAR_ERF_LEADING_ORDER,
     ERRATUM,
     ERRATUM_ASYMPTOTIC,
     ERRATUM_VISIBLE_MOMENTS,

@@ -2,13 +2,17 @@
 //! docs/*.md reaches an existing file, and every `#anchor` a heading of its target (GitHub's
 //! slugs); every doc comment or string of the workspace's Rust files that cites a section of
 //! ARCHITECTURE.md (`ARCHITECTURE.md, "Section"`, `ARCHITECTURE.md "A", "B"`, or a record
-//! source's `ARCHITECTURE.md model boundary: …`) names one of its headings; every page of docs/
-//! is linked from the README; and the README stays at most 200 lines (issue 24: reference
-//! material goes to docs/). The checkers are tested on broken input too, so that a pass means
-//! they looked.
+//! source's `ARCHITECTURE.md model boundary: …`) names one of its headings; every file and code
+//! identifier ARCHITECTURE.md names in a code span exists (the rules at [`path_candidate`] and
+//! [`identifier_candidate`]); every page of docs/ is linked from the README; and the README
+//! stays at most 200 lines (reference material goes to docs/). The checkers are tested on
+//! broken input too, so that a pass means they looked.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+
+#[path = "../support/rust_source.rs"]
+mod rust_source;
 
 /// The README's length limit, in lines.
 const README_MAX_LINES: usize = 200;
@@ -314,6 +318,320 @@ fn citation_problems(file: &Path, text: &str, architecture: &str) -> Vec<String>
         .collect()
 }
 
+/// The code spans of a markdown text outside fenced code blocks, each with the line it starts
+/// on: a run of n backticks up to the next run of exactly n within the paragraph (a span may
+/// wrap over lines; its line breaks read as spaces), its content trimmed. A run with no closing
+/// run is literal text.
+fn code_spans(text: &str) -> Vec<(usize, String)> {
+    let mut fenced = false;
+    let mut chars: Vec<(usize, char)> = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let fence = line.trim_start().starts_with("```");
+        if fence {
+            fenced = !fenced;
+        }
+        // Fences, fenced lines and blank lines all read as an empty line: a paragraph break.
+        if !fence && !fenced && !line.trim().is_empty() {
+            chars.extend(line.chars().map(|c| (n + 1, c)));
+        }
+        chars.push((n + 1, '\n'));
+    }
+    let run_at = |i: usize| chars[i..].iter().take_while(|&&(_, c)| c == '`').count();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < chars.len() {
+        if chars[i].1 != '`' {
+            i += 1;
+            continue;
+        }
+        let run = run_at(i);
+        let mut j = i + run;
+        let mut close = None;
+        while j < chars.len() {
+            match chars[j].1 {
+                '\n' if chars.get(j + 1).is_some_and(|&(_, c)| c == '\n') => break,
+                '`' => {
+                    let r = run_at(j);
+                    if r == run {
+                        close = Some(j);
+                        break;
+                    }
+                    j += r;
+                }
+                _ => j += 1,
+            }
+        }
+        match close {
+            Some(j) => {
+                let body: String = chars[i + run..j]
+                    .iter()
+                    .map(|&(_, c)| if c == '\n' { ' ' } else { c })
+                    .collect();
+                out.push((chars[i].0, body.trim().to_string()));
+                i = j + run;
+            }
+            None => i += run,
+        }
+    }
+    out
+}
+
+/// The extensions that make a code span a file of the repository even without a folder.
+/// Outputs of mfh (`report.json`, `junit.xml`, `report.html`, …) are not among them: a span
+/// names one of those without being a file of the repository.
+const FILE_EXTENSIONS: &[&str] = &["rs", "md", "toml", "py", "hpp", "cpp"];
+
+/// Whether a code span names a file or folder of the repository, and which: a span of letters,
+/// digits and `_ - . / < >` only that either ends in one of [`FILE_EXTENSIONS`] (`Cargo.toml`,
+/// `ks.rs`) or has a `/` and begins with the name of a folder of the workspace
+/// (`harness/src/check/run.rs`, `check/bsdf/chi2.rs`, `oracle/chi2/`). A component with
+/// `<placeholder>` or `NNN` in it stands for any name (`reference/src/ndf/<family>.rs`,
+/// `seedNNN.rs`). Not paths: `family/quantity/route` (no folder is called `family`),
+/// `report.json` (an output, not a source extension).
+fn path_candidate(span: &str, folders: &BTreeSet<String>) -> Option<String> {
+    let allowed = |c: char| c.is_ascii_alphanumeric() || "_-./<>".contains(c);
+    if span.is_empty() || !span.chars().all(allowed) || span.starts_with('/') {
+        return None;
+    }
+    let path = span.trim_end_matches('/');
+    let has_extension = !span.ends_with('/')
+        && path
+            .rsplit_once('.')
+            .is_some_and(|(_, e)| FILE_EXTENSIONS.contains(&e));
+    let first = path.split('/').next().unwrap_or("");
+    let rooted = span.contains('/') && folders.contains(first);
+    (has_extension || rooted).then(|| path.to_string())
+}
+
+/// `name` matched against `pattern`, where `*` stands for any run of characters.
+fn glob(pattern: &str, name: &str) -> bool {
+    let p: Vec<char> = pattern.chars().collect();
+    let n: Vec<char> = name.chars().collect();
+    let (mut i, mut j) = (0, 0);
+    let mut back: Option<(usize, usize)> = None;
+    while j < n.len() {
+        if i < p.len() && p[i] == '*' {
+            back = Some((i, j));
+            i += 1;
+        } else if i < p.len() && p[i] == n[j] {
+            i += 1;
+            j += 1;
+        } else if let Some((bi, bj)) = back {
+            i = bi + 1;
+            j = bj + 1;
+            back = Some((bi, bj + 1));
+        } else {
+            return false;
+        }
+    }
+    p[i..].iter().all(|&c| c == '*')
+}
+
+/// A path component of a code span as a [`glob`] pattern: `<…>` and `NNN` stand for any name.
+fn component_pattern(component: &str) -> String {
+    let mut out = String::new();
+    let mut rest = component;
+    while let Some(open) = rest.find('<') {
+        out.push_str(&rest[..open]);
+        out.push('*');
+        rest = rest[open..]
+            .find('>')
+            .map_or("", |close| &rest[open + close + 1..]);
+    }
+    out.push_str(rest);
+    out.replace("NNN", "*")
+}
+
+/// Whether `path` (components separated by `/`) is the end of some entry's path, component by
+/// component: `check/bsdf/chi2.rs` is `harness/src/check/bsdf/chi2.rs`.
+fn path_resolves(path: &str, entries: &[Vec<String>]) -> bool {
+    let want: Vec<String> = path.split('/').map(component_pattern).collect();
+    entries.iter().any(|e| {
+        e.len() >= want.len()
+            && e[e.len() - want.len()..]
+                .iter()
+                .zip(&want)
+                .all(|(name, pattern)| glob(pattern, name))
+    })
+}
+
+/// Every file and folder of the workspace as its path's components (not `target/`, not
+/// `.git`), and the names of its folders.
+fn workspace_entries(root: &Path) -> (Vec<Vec<String>>, BTreeSet<String>) {
+    fn walk(
+        dir: &Path,
+        prefix: &[String],
+        out: &mut Vec<Vec<String>>,
+        folders: &mut BTreeSet<String>,
+    ) {
+        for entry in std::fs::read_dir(dir).expect("readable folder") {
+            let path = entry.expect("entry").path();
+            let name = path
+                .file_name()
+                .and_then(|n| n.to_str())
+                .unwrap_or("")
+                .to_string();
+            if name == "target" || name == ".git" {
+                continue;
+            }
+            let mut components = prefix.to_vec();
+            components.push(name.clone());
+            if path.is_dir() {
+                folders.insert(name);
+                walk(&path, &components, out, folders);
+            }
+            out.push(components);
+        }
+    }
+    let (mut entries, mut folders) = (Vec::new(), BTreeSet::new());
+    walk(root, &[], &mut entries, &mut folders);
+    (entries, folders)
+}
+
+/// How a code span names code: a Rust path as written, a call `name()` or a macro `name!`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Naming {
+    Path,
+    Function,
+    Macro,
+}
+
+/// Whether a code span names a code identifier that must exist, and its segments: a Rust path
+/// (`Check`, `Audit::of`, `sphere_chi2::draw_chunks`), optionally followed by `()` (a function)
+/// or `!` (a macro), that has a `::`, or a capital letter (types, traits, variants, constants:
+/// `PlannedCheck`, `FamilyInfo`, `MEASURED`), or the `()` or `!`. A lone lowercase word (`d`,
+/// `seed`, `case`) is prose about a method, a field or a JSON key, and is not checked; nor is
+/// anything with spaces or punctuation (`Check::new(id, …)`, `bsdf.chi2`).
+fn identifier_candidate(span: &str) -> Option<(Vec<String>, Naming)> {
+    let (body, naming) = if let Some(b) = span.strip_suffix("()") {
+        (b, Naming::Function)
+    } else if let Some(b) = span.strip_suffix('!') {
+        (b, Naming::Macro)
+    } else {
+        (span, Naming::Path)
+    };
+    let segments: Vec<String> = body.split("::").map(str::to_string).collect();
+    let identifier = |s: &String| {
+        s.chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+            && s.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+    };
+    if !segments.iter().all(identifier) {
+        return None;
+    }
+    let named = segments.len() > 1
+        || naming != Naming::Path
+        || body.chars().any(|c| c.is_ascii_uppercase());
+    named.then_some((segments, naming))
+}
+
+/// What the workspace's Rust code names: its identifier tokens outside comments and literals,
+/// the names it declares (after `fn`, `struct`, `enum`, `trait`, `type`, `const`, `static`,
+/// `mod`, `union`, `macro_rules!`), its code with the literals blanked, and its raw text (for
+/// environment variables, named only in string literals).
+struct RustIndex {
+    tokens: BTreeSet<String>,
+    declared: BTreeMap<String, BTreeSet<String>>,
+    code: String,
+    raw: String,
+}
+
+impl RustIndex {
+    fn of<'t>(texts: impl IntoIterator<Item = &'t str>) -> RustIndex {
+        const KEYWORDS: &[&str] = &[
+            "fn",
+            "struct",
+            "enum",
+            "trait",
+            "type",
+            "const",
+            "static",
+            "mod",
+            "union",
+            "macro_rules",
+        ];
+        let mut index = RustIndex {
+            tokens: BTreeSet::new(),
+            declared: BTreeMap::new(),
+            code: String::new(),
+            raw: String::new(),
+        };
+        for text in texts {
+            let code = rust_source::code_only(text);
+            let words: Vec<&str> = code
+                .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .filter(|w| !w.is_empty())
+                .collect();
+            for pair in words.windows(2) {
+                if KEYWORDS.contains(&pair[0]) {
+                    index
+                        .declared
+                        .entry(pair[1].to_string())
+                        .or_default()
+                        .insert(pair[0].to_string());
+                }
+            }
+            index.tokens.extend(words.iter().map(|w| w.to_string()));
+            index.code.push_str(&code);
+            index.code.push('\n');
+            index.raw.push_str(text);
+            index.raw.push('\n');
+        }
+        index
+    }
+
+    /// Whether the code has what a span names: a macro is declared by `macro_rules!`, a function
+    /// by `fn`; a path of several segments ends in a declared name or occurs as written; a
+    /// single name occurs as a token of the code, or — all in capitals — as a whole string
+    /// literal (an environment variable the code reads).
+    fn has(&self, segments: &[String], naming: Naming) -> bool {
+        let last = segments.last().expect("a path has a segment");
+        let declared = |kw: &str| self.declared.get(last).is_some_and(|k| k.contains(kw));
+        match naming {
+            Naming::Macro => declared("macro_rules"),
+            Naming::Function => declared("fn"),
+            Naming::Path if segments.len() > 1 => {
+                self.declared.contains_key(last) || self.code.contains(&segments.join("::"))
+            }
+            Naming::Path => {
+                self.tokens.contains(last)
+                    || (!last.chars().any(|c| c.is_ascii_lowercase())
+                        && self.raw.contains(&format!("\"{last}\"")))
+            }
+        }
+    }
+}
+
+/// What is wrong with the files and identifiers the markdown text `text` (of `file`) names in
+/// code spans, and how many spans it checked as (paths, identifiers).
+fn named_code_problems(
+    file: &str,
+    text: &str,
+    entries: &[Vec<String>],
+    folders: &BTreeSet<String>,
+    index: &RustIndex,
+) -> ((usize, usize), Vec<String>) {
+    let (mut paths, mut identifiers) = (0, 0);
+    let mut problems = Vec::new();
+    for (line, span) in code_spans(text) {
+        if let Some(path) = path_candidate(&span, folders) {
+            paths += 1;
+            if !path_resolves(&path, entries) {
+                problems.push(format!("{file}:{line}: `{span}`: no such file or folder"));
+            }
+        } else if let Some((segments, naming)) = identifier_candidate(&span) {
+            identifiers += 1;
+            if !index.has(&segments, naming) {
+                problems.push(format!(
+                    "{file}:{line}: `{span}`: named nowhere in the workspace's Rust code"
+                ));
+            }
+        }
+    }
+    ((paths, identifiers), problems)
+}
+
 #[test]
 fn every_relative_link_and_anchor_resolves() {
     let root = root();
@@ -354,6 +672,33 @@ fn every_architecture_citation_in_rust_names_a_section() {
     assert!(
         problems.is_empty(),
         "citations of missing sections:\n{}",
+        problems.join("\n")
+    );
+}
+
+#[test]
+fn every_file_and_identifier_architecture_names_exists() {
+    let root = root();
+    let text = read(&root.join("ARCHITECTURE.md"));
+    let (entries, folders) = workspace_entries(&root);
+    let mut files = Vec::new();
+    rust_files(&root, &mut files);
+    // This file names made-up identifiers on purpose (its checkers' own test).
+    let texts: Vec<String> = files
+        .iter()
+        .filter(|f| !f.ends_with(file!()))
+        .map(|f| read(f))
+        .collect();
+    let index = RustIndex::of(texts.iter().map(String::as_str));
+    let ((paths, identifiers), problems) =
+        named_code_problems("ARCHITECTURE.md", &text, &entries, &folders, &index);
+    assert!(
+        paths > 100 && identifiers > 40,
+        "only {paths} paths and {identifiers} identifiers checked: is the parser blind?"
+    );
+    assert!(
+        problems.is_empty(),
+        "ARCHITECTURE.md names what does not exist:\n{}",
         problems.join("\n")
     );
 }
@@ -435,4 +780,97 @@ fn the_checkers_catch_broken_links_and_citations() {
         problems[1].contains("\"Evaluating closed forms\""),
         "{problems:?}"
     );
+}
+
+/// The checker of named files and identifiers sees what it must: spans over two lines, spans in
+/// code blocks (ignored), paths by suffix and with placeholders, outputs and ids that are not
+/// paths, declared and undeclared names, environment variables.
+#[test]
+fn the_checker_catches_missing_files_and_identifiers() {
+    assert_eq!(
+        code_spans("a `x` and ``y ` z`` and `wrapped\nspan` `open\n\n`\n```\n`fenced`\n```\n"),
+        [
+            (1, "x".to_string()),
+            (1, "y ` z".to_string()),
+            (1, "wrapped span".to_string())
+        ]
+    );
+    assert!(glob("seed*.rs", "seed004.rs") && glob("*", "") && !glob("a*b", "ac"));
+    assert_eq!(component_pattern("<family>.rs"), "*.rs");
+    assert_eq!(component_pattern("seedNNN.rs"), "seed*.rs");
+
+    let entries: Vec<Vec<String>> = [
+        "harness/src/check/bsdf/chi2.rs",
+        "harness/src/check/bsdf",
+        "harness/src/check",
+        "harness/src",
+        "harness",
+        "reference/src/ndf/ggx.rs",
+        "reference/src/ndf",
+        "reference/src",
+        "reference",
+        "reference/src/errata/seed001.rs",
+        "reference/src/errata",
+        "Cargo.toml",
+    ]
+    .iter()
+    .map(|p| p.split('/').map(str::to_string).collect())
+    .collect();
+    let folders: BTreeSet<String> = [
+        "harness",
+        "src",
+        "check",
+        "bsdf",
+        "reference",
+        "ndf",
+        "errata",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let rust = [
+        "pub struct PlannedCheck;\npub fn of() {}\nmacro_rules! registry { () => {} }\n\
+         const MEASURED: u8 = 0;\nimpl Audit { fn of_bsdf() {} }\n\
+         fn f() { let _ = std::env::var(\"MFH_SEED\"); let v = Precision::F32; }\n\
+         // struct InAComment;\nconst S: &str = \"NotCode\";\n",
+    ];
+    let index = RustIndex::of(rust);
+    let markdown = "\
+`harness/src/check/bsdf/chi2.rs` `check/bsdf/chi2.rs` `check/bsdf/` `Cargo.toml`
+`reference/src/ndf/<family>.rs` `reference/src/errata/seedNNN.rs`
+`family/quantity/route` `report.json` `bsdf.chi2` `d` `seed` `Check::new(id, model)`
+`PlannedCheck` `Audit::of` `Audit::of_bsdf` `Precision::F32` `registry!` `of()` `MEASURED`
+`MFH_SEED`
+```
+`harness/src/fenced.rs` `Fenced`
+```
+`harness/src/nowhere.rs` `check/bsdf/missing.rs` `ndf/<family>/deep.rs` `src/NNN/x.rs` `Cargo.lock`
+`NoSuchType` `Audit::gone` `model_spec!` `PlannedCheck()` `InAComment` `NotCode` `MFH_UNREAD`
+";
+    let ((paths, identifiers), problems) =
+        named_code_problems("A.md", markdown, &entries, &folders, &index);
+    let named: Vec<&str> = problems
+        .iter()
+        .map(|p| p.split('`').nth(1).expect("the span is quoted"))
+        .collect();
+    assert_eq!(
+        named,
+        [
+            "harness/src/nowhere.rs",
+            "check/bsdf/missing.rs",
+            "ndf/<family>/deep.rs",
+            "src/NNN/x.rs",
+            "NoSuchType",
+            "Audit::gone",
+            "model_spec!",
+            "PlannedCheck()",
+            "InAComment",
+            "NotCode",
+            "MFH_UNREAD",
+        ],
+        "{problems:?}"
+    );
+    assert!(problems[0].starts_with("A.md:9: "), "{problems:?}");
+    // `Cargo.lock` is neither a source extension nor under a folder: not checked.
+    assert_eq!((paths, identifiers), (6 + 4, 8 + 7));
 }

@@ -18,8 +18,8 @@ use crate::oracle::Estimate;
 use crate::record::{Measured, Verdict};
 use crate::subject::Subject;
 use crate::tolerance::{
-    Tolerance, CLOSED_FORM, GTR_CLAMP, GTR_LIMIT, GTR_SPLINE, IDENTITY, PIECEWISE_TRAPEZOID,
-    SLOPE_MOMENT_CLAIM,
+    Tolerance, ASG_INTEGRAL_APPROXIMATION, CIRCULAR_ERF_LEADING_ORDER, CLOSED_FORM, GTR_CLAMP,
+    GTR_LIMIT, GTR_SPLINE, IDENTITY, PIECEWISE_TRAPEZOID, SLOPE_MOMENT_CLAIM,
 };
 use mfh_reference::errata::seed001;
 use mfh_reference::geometry::from_spherical;
@@ -30,28 +30,6 @@ use mfh_reference::{Model, ModelSpec};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::f64::consts::FRAC_PI_2;
-
-/// Seed 003 §3.2.1's ASG integral with F, an approximation the document states no error for
-/// (not an erratum: "can be approximated as follows").
-// To move to crate::tolerance (owned by another change): kept here with its reason.
-pub const ASG_INTEGRAL_APPROXIMATION: Tolerance = Tolerance {
-    name: "asg_integral_approximation",
-    value: 0.045,
-    reason: "the document states no error; the reference measured max 4.24 % relative for \
-             bandwidths μ ≥ 1, λ ≥ μ (at λ = 2, μ = 1; exact for λ = μ; unbounded as μ → 0): \
-             4.5 % bounds the measured error over the planned grid, so a changed form fails",
-};
-
-/// Seed 003 §4.3's ∫g^c ≈ ∫g (erf form), as a multiple of its leading-order relative error
-/// σ²/16.
-// To move to crate::tolerance (owned by another change): kept here with its reason.
-pub const CIRCULAR_ERF_LEADING_ORDER: Tolerance = Tolerance {
-    name: "circular_erf_leading_order",
-    value: 1.2,
-    reason: "the document says \"approximated\" and states no error; g^c = g·e^{x⁴/(12σ²) + …} \
-             gives a relative error σ²/16 to leading order; measured ≤ 1.15 σ²/16 for σ ≤ 1 and \
-             means in [−1.4, 1.4]: the check allows 1.2 σ²/16",
-};
 
 /// What a claim check measured.
 struct Measurement {

@@ -1,6 +1,28 @@
 //! Checks: one property family per file, each planning cases for a model and turning each case
 //! into a [`CheckRecord`] against an oracle (ARCHITECTURE.md, "Checks and records"). A check never
 //! panics and never asserts; only the audit's verdicts decide.
+//!
+//! **Layout.** A family of several concepts is a folder: `sampling/` (the normal sampler in
+//! `sampling.rs`, the KS marginals in `ks.rs`, visible normals in `visible.rs`, seed 001's
+//! pseudo-VNIS in `pseudo_vnis.rs`, a batch sampler against its scalar one in
+//! `batch_agrees.rs`); `bsdf/` (a whole BSDF, planned from the `Bsdf` capability at normal,
+//! oblique and grazing incidences and, when it transmits, from inside and beyond the critical
+//! angle; the integrals an incidence's checks share computed once in `bsdf/mod.rs`, their
+//! samples drawn by the chi-square oracle's one loop, `oracle::sphere_chi2::draw_chunks`;
+//! `bsdf.ndf_consistency` in `ndf.rs` where the subject offers the NDF the BSDF is built on —
+//! `subject::bsdf::OwnNdf`, from `Audit::of_bsdf(…).ndf(…)` or a reference BSDF's spec);
+//! `sg/` (the shared helpers in `sg.rs`, then `isotropic.rs`, `circular.rs`, `asg.rs`
+//! mirroring `reference/src/sg/`); `errata/` (one file per source document). A Λ route is
+//! planned only at the cases where it answers; `route_domain.rs` gives each route that refuses
+//! somewhere one `smith.lambda_route_domain` record that checks the refusal and its edge.
+//!
+//! **How a check is built** (`run.rs`): `Check::new(id, model, case, source).why(…).covers(…)
+//! .statistical().run(|r, ctx| …)` creates the record, seeds it (statistical, or `.seeded()`),
+//! times it and sets its coverage; in the body, `need(model.as_sampler(), "normal sampler")?`
+//! turns a missing capability into an `error` verdict, and `.skipped(reason)` plans a check the
+//! model cannot support. Its tolerance comes from `crate::tolerance`, its oracle from
+//! `crate::oracle`, and it writes nothing: `RunContext` carries only the seed, and tables and
+//! curves go into the record's data for the sinks.
 
 pub mod against;
 pub mod bsdf;

@@ -2,6 +2,13 @@
 //! (JSON lines over stdin / stdout, [`protocol`]) is one more implementation of the capability
 //! traits and of [`mfh_reference::bsdf::Bsdf`] ([`model::ExternalModel`], [`bsdf`]), audited
 //! by [`crate::audit::Audit`] like a Rust model or BSDF.
+//!
+//! **One concept per file.** `protocol.rs` the wire format of versions 1 (JSON arrays) and 2
+//! (base64 f64 arrays); `process.rs` the child, its reader and writer threads and timeouts;
+//! `group.rs` its process group (ended by SIGTERM, then SIGKILL; the live groups listed for a
+//! signal handler); `stderr_tail.rs` its stderr drained into a ring buffer of fixed size;
+//! `model.rs` the capability traits; `bsdf.rs` the `Bsdf` capability; `against.rs` the NDF or
+//! BSDF spec of `--against`.
 
 pub mod against;
 pub mod bsdf;

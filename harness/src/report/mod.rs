@@ -1,6 +1,17 @@
 //! Sinks of an audit report: the terminal summary, `report.json`, JUnit XML, the artefact
 //! files of records that carry data (chi-square tables and heat maps, KS curves) and the
 //! self-contained `report.html`. Checks do no I/O: everything written is written here.
+//!
+//! **One concept per file.** `terminal.rs` the summary; `json.rs` `report.json`
+//! (schema-versioned; read back by `crate::readback`); `jsonl.rs` `report.jsonl` (each record
+//! appended as its check finishes, read back by `--resume`); `junit.rs` `junit.xml`;
+//! `artefacts.rs` the tables and SVG heat maps that records carry as `RecordData`; `plan_table.rs`
+//! `mfh plan`'s table; `cost.rs` `mfh cost`'s files. With the `html` feature: `html.rs` the audit
+//! page, `bsdf_html.rs` its BSDF section, `record_plots.rs` the plots of records, `plot.rs` the
+//! drawing (plotters), `bitmap.rs` a heat map's cells as the image its SVG embeds, `colour.rs`
+//! its colour scales, `page.rs` what every page shares (escaping, images, style, a record's
+//! error and verdict), `cost_html.rs` and `selftest_html.rs` the pages of `mfh cost` and
+//! `mfh selftest`. No circle of imports between these files (`harness/tests/layers.rs`).
 
 pub mod artefacts;
 #[cfg(feature = "html")]

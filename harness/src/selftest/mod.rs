@@ -11,6 +11,13 @@
 //! Calibration ([`calibrate`]): seeded chi-square and KS runs of correct samplers; the
 //! rejection fraction must lie in the 99 % binomial interval of α and the p-values must be
 //! uniform.
+//!
+//! **One concept per file.** `catalog.rs` the mutants (id, base spec, `Defect`, the checks
+//! expected to kill it); `mutant.rs` the defect wrappers; this file the kill matrix;
+//! `bsdf_mutant.rs` the BSDF mutants (`BsdfDefect`) and `bsdf.rs` their rows of the matrix;
+//! `power.rs` the smallest sampler distortion each profile detects; `calibrate.rs` the
+//! false-alarm calibration. Everything returns data: the CLI and the sinks
+//! (`report/selftest_html.rs`) write it.
 
 pub mod bsdf;
 pub mod bsdf_mutant;

@@ -55,6 +55,13 @@
 //! - [`conductor`] and [`dielectric`]: the BSDFs.
 //! - [`spec`]: the serde description `{"bsdf": "dielectric", "eta": 1.5, "ndf": {...}, …}`,
 //!   validated with typed errors, built into `Arc<dyn Bsdf>`.
+//! - [`error`]: `BsdfError`, naming the field and the limit.
+//! - `directions.rs`: [`Directions`], the sampled directions of `Bsdf::sample_wo_batch` as
+//!   separate x, y, z and flag arrays, so that the scatter and the chi-square's cell finder load
+//!   whole vectors.
+//! - `fresnel_block.rs` and `scatter_block.rs`: the batch forms of the dielectric's and
+//!   conductor's sampled directions (Fresnel of a block of cosines; lobe choice and scatter),
+//!   bit for bit the scalar ones on every dispatch path.
 
 pub mod conductor;
 pub mod dielectric;

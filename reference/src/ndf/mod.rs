@@ -1,4 +1,13 @@
 //! Normal distribution functions, one model per file.
+//!
+//! Beside the models: their Λ routes (`student_lambda.rs`, `gtr_lambda.rs`,
+//! `piecewise_lambda.rs`), seed 001's pseudo-VNIS (`student_vnis.rs`), and the batch samplers —
+//! `batch.rs`, the one block loop the elliptic normal samplers (GGX, Beckmann, Student) share,
+//! each giving only its radius kernel, compiled for AVX-512 or AVX2 + FMA by `pulp`'s safe
+//! runtime dispatch where the CPU has it and bit for bit the scalar result on every path (so a
+//! count never depends on the CPU); and `ggx_visible_batch.rs`, GGX's visible-normal batch on
+//! the same block loop, within [`GGX_VISIBLE_BATCH_MAX_ULPS`] per component of the scalar
+//! sampler and the same bits on every path. A new family: ARCHITECTURE.md, "A new NDF family".
 
 pub mod angular_profile;
 mod batch;
