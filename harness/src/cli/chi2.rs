@@ -73,6 +73,8 @@ pub struct Chi2Args {
 
 /// Prints a bad-input message; the exit status 2.
 pub(super) fn bad(stderr: &mut dyn Write, message: String) -> i32 {
+    // Long numbers shortened: a value such as 1e308 printed whole is 309 digits.
+    let message = crate::messages::compact_numbers(&message);
     let _ = writeln!(stderr, "mfh chi2: {message}");
     EXIT_BAD_INPUT
 }
@@ -293,7 +295,7 @@ fn report(
              parts: {}\n\
              expected mass {:.12} (cubature error bound {:.2e} counts)\n\
              sampling+binning {:.3e} samples/s ({:.3} s), expected-count integration {:.3} s\n\
-             verdict {} at α = {:e}{}\n{}\
+             verdict {} at α = {}{}\n{}\
              reproduce: {}",
                 2 * r.resolution,
                 r.resolution,
@@ -316,7 +318,7 @@ fn report(
                 } else {
                     "FAIL"
                 },
-                r.alpha,
+                crate::report::text::err(r.alpha),
                 reason.map(|r| format!(": {r}")).unwrap_or_default(),
                 artefacts
                     .iter()
