@@ -354,7 +354,7 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
             c.failures,
             c.expected_failures,
             c.seconds,
-            escape(&super::text::worst_text(worst.get(id.as_str())))
+            escape(&super::text::worst_text_of(&report.records, &worst, id))
         );
     }
     h.push_str(

@@ -266,6 +266,15 @@ pub(crate) fn smith_plots(
     for (_, _, v) in series.values_mut() {
         v.sort_by(|a, b| a.theta.total_cmp(&b.theta));
     }
+    // On Λ's log axis the model's curve reaches down only a decade below the smallest
+    // positive value the records hold: near normal incidence Λ of a Beckmann-like lobe falls
+    // to 1e-300 and would squeeze every record into the top of the plot.
+    let floor = series
+        .values()
+        .flat_map(|(_, _, points)| points.iter().flat_map(|p| [p.value, p.oracle]))
+        .filter(|v| *v > 0.0 && v.is_finite())
+        .fold(f64::INFINITY, f64::min)
+        / 10.0;
     let mut html = String::new();
     for (name, f) in [
         ("Λ", (|l: f64| l) as fn(f64) -> f64),
@@ -279,7 +288,12 @@ pub(crate) fn smith_plots(
             let range = (points[0].theta, points[points.len() - 1].theta);
             let curve = model
                 .and_then(|m| model_curve(m, route, *phi, range))
-                .map(|c| c.into_iter().map(|(t, l)| (t, f(l))).collect())
+                .map(|c| {
+                    c.into_iter()
+                        .filter(|&(_, l)| name != "Λ" || l >= floor)
+                        .map(|(t, l)| (t, f(l)))
+                        .collect()
+                })
                 .unwrap_or_else(|| points.iter().map(|p| (p.theta, f(p.value))).collect());
             values.push(Series {
                 label: key.clone(),
@@ -302,12 +316,12 @@ pub(crate) fn smith_plots(
                 )
             };
             errors.push(Series::new(key.clone(), points.iter().map(error).collect()));
+            // Marked where the log axis can show the point (an exact zero has no place on it,
+            // and a legend entry without a cross would mislead).
             for p in points {
-                if let Some(mark) = p.mark {
-                    marked
-                        .entry(format!("{key}: {mark}"))
-                        .or_default()
-                        .push(error(p));
+                let e = error(p);
+                if let (Some(mark), true) = (p.mark, e.1 > 0.0 && e.1.is_finite()) {
+                    marked.entry(format!("{key}: {mark}")).or_default().push(e);
                 }
             }
         }

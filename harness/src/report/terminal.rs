@@ -50,7 +50,7 @@ pub fn render(report: &AuditReport, max_failures: usize) -> String {
             c.failures,
             c.expected_failures,
             c.seconds,
-            text::worst_text(worst.get(id.as_str()))
+            text::worst_text_of(&report.records, &worst, id)
         );
     }
     let _ = writeln!(o, "\nworst error per family (passing records):");
@@ -61,7 +61,7 @@ pub fn render(report: &AuditReport, max_failures: usize) -> String {
                 "  {family:<24} {:<18} ({} {})",
                 unit.show(e),
                 r.check,
-                text::case_name(&r.case)
+                text::case_name_cut(&r.case, 60)
             );
         }
     }

@@ -115,6 +115,16 @@ pub fn model_name(model: &Value) -> String {
     parts.join(" ")
 }
 
+/// [`case_name`] cut to `max` characters (with "…").
+pub fn case_name_cut(case: &Value, max: usize) -> String {
+    let name = case_name(case);
+    if name.chars().count() > max {
+        name.chars().take(max.saturating_sub(1)).collect::<String>() + "…"
+    } else {
+        name
+    }
+}
+
 /// A short human name of a case: `key value` pairs ([`json`]).
 pub fn case_name(case: &Value) -> String {
     match case.as_object() {
@@ -169,6 +179,7 @@ impl ErrorUnit {
     /// An error in this unit: ulps as a count, the others with two significant digits.
     pub fn show(self, error: f64) -> String {
         match self {
+            ErrorUnit::Ulps if error == 1.0 => "1 ulp".into(),
             ErrorUnit::Ulps => format!("{} ulps", short(error, 3)),
             other => format!("{} {}", err(error), other.name()),
         }
@@ -190,9 +201,24 @@ pub fn error_unit(r: &CheckRecord) -> Option<ErrorUnit> {
 }
 
 fn in_ulps(r: &CheckRecord) -> bool {
-    r.tolerance
-        .as_ref()
-        .is_some_and(|t| t.reason.starts_with("ulps"))
+    case_unit(r) == Some("ulp")
+        || r.tolerance
+            .as_ref()
+            .is_some_and(|t| t.reason.starts_with("ulps"))
+}
+
+/// The unit a check states in its case (`"unit": "ulp"`, `"unit": "σ²/16"`: the error is a
+/// multiple of it), if any.
+pub fn case_unit(r: &CheckRecord) -> Option<&str> {
+    r.case.get("unit").and_then(Value::as_str)
+}
+
+/// " (in units of σ²/16)" where the case states a unit other than ulps, else nothing.
+fn scaled(r: &CheckRecord) -> String {
+    match case_unit(r) {
+        Some(unit) if unit != "ulp" => format!(" (in units of {unit})"),
+        _ => String::new(),
+    }
 }
 
 /// The measured discrepancy as one line, its quantity named: `relative error 3.2e-16`,
@@ -207,7 +233,7 @@ pub fn measured(r: &CheckRecord) -> String {
             let unit = error_unit(r).unwrap_or(ErrorUnit::Absolute);
             match unit {
                 ErrorUnit::Ulps => format!("error {}", unit.show(error)),
-                _ => format!("{} error {}", unit.name(), err(error)),
+                _ => format!("{} error {}{}", unit.name(), err(error), scaled(r)),
             }
         }
         Measured::PValue {
@@ -326,6 +352,21 @@ pub fn block(r: &CheckRecord, indent: &str) -> String {
 /// error. P-values have no error and are left out.
 pub fn worst_passing(records: &[CheckRecord]) -> BTreeMap<&str, BTreeMap<ErrorUnit, f64>> {
     worst_by(records, |r| r.check.as_str())
+}
+
+/// [`worst_text`] of one check id, with the unit its cases state where they state one
+/// (`1.1 relative (in units of σ²/16)`).
+pub fn worst_text_of(
+    records: &[CheckRecord],
+    worst: &BTreeMap<&str, BTreeMap<ErrorUnit, f64>>,
+    check: &str,
+) -> String {
+    let note = records
+        .iter()
+        .find(|r| r.check == check && r.verdict == Verdict::Pass)
+        .map(scaled)
+        .unwrap_or_default();
+    worst_text(worst.get(check)) + &note
 }
 
 /// [`worst_passing`] by model family (the model's `family`, else the check id's first part),
@@ -534,6 +575,13 @@ mod tests {
         assert_eq!(
             worst_text(worst.get("smith.lambda_route")),
             "3.2e-16 relative; 1e-12 absolute; 2 ulps"
+        );
+        assert_eq!(ErrorUnit::Ulps.show(1.0), "1 ulp");
+        let mut scaled = records[0].clone();
+        scaled.case = json!({"unit": "σ²/16"});
+        assert_eq!(
+            measured(&scaled),
+            "relative error 3.2e-16 (in units of σ²/16)"
         );
     }
 
