@@ -472,7 +472,7 @@ mod tests {
         assert_eq!(table["counts"].as_array().unwrap().len(), 8);
         assert_eq!(table["counts"][0].as_array().unwrap().len(), 16);
         assert!(dir.join("chi2_expected.json").exists());
-        // The heat maps: SVGs with axes in θ and φ, a colour bar and the model, listed.
+        // The heat maps: SVGs with axes in θ and φ (radians), a colour bar and the model, listed.
         let listed: Vec<&str> = v["artefacts"]
             .as_array()
             .unwrap()
@@ -489,7 +489,7 @@ mod tests {
             assert!(listed.contains(&path.to_str().unwrap()), "{listed:?}");
             let svg = std::fs::read_to_string(&path).unwrap();
             assert!(svg.starts_with("<svg"), "{name}");
-            for text in ["θ (degrees)", "φ (degrees)", "ggx alpha=0.3"] {
+            for text in ["θ (radians)", "φ (radians)", "ggx alpha=0.3"] {
                 assert!(svg.contains(text), "{name}: {text}");
             }
             // The 16 φ × 8 cos θ cells as one embedded bitmap, and the colour bar's 64 steps.

@@ -498,9 +498,9 @@ mod tests {
                     json!({"route": "default", "theta": theta, "phi": 0.0}),
                     "s",
                 );
-                r.value = Some(0.1 * theta);
+                r.value = Some(1e-9 * theta);
                 r.oracle = Some(OracleValue {
-                    value: 0.1 * theta * if i == 2 { 1.01 } else { 1.0 },
+                    value: 1e-9 * theta * if i == 2 { 1.01 } else { 1.0 },
                     uncertainty: 1e-15,
                     kind: "error_bound",
                     noise_floor: None,
