@@ -273,8 +273,9 @@ impl AuditReport {
 }
 
 /// A readable table of an audit's failures: per failing record its check, model and case, the
-/// value against the oracle, the measured error against the tolerance and why, and the verdict;
-/// then the seed and the command that reproduces the run.
+/// value against the oracle, the measured error and the tolerance and why, and the verdict, as
+/// every sink prints a record (`report::text::block`); then the seed and the command that
+/// reproduces the run.
 pub fn failure_table(report: &AuditReport) -> String {
     use std::fmt::Write;
     let failures: Vec<&CheckRecord> = report
@@ -291,49 +292,8 @@ pub fn failure_table(report: &AuditReport) -> String {
         report.seed
     );
     for r in failures {
-        let _ = writeln!(out, "\n  ✗ {}  {}", r.check, r.model);
-        let _ = writeln!(out, "    case      {}", r.case);
-        if let (Some(v), Some(o)) = (r.value, r.oracle) {
-            let _ = writeln!(
-                out,
-                "    value     {v:e}   oracle {:e} (± {:e})",
-                o.value, o.uncertainty
-            );
-        }
-        if let Some(note) = r.oracle.and_then(|o| o.noise_note()) {
-            let _ = writeln!(out, "    oracle    {note}");
-        }
-        match (r.measured, &r.tolerance) {
-            (Some(m), Some(t)) => {
-                let measured = match m {
-                    Measured::PValue { p, alpha, .. } => format!("p = {p:e} < α = {alpha:e}"),
-                    Measured::Rate { exponent, expected } => {
-                        format!("rate {exponent} (expected {expected})")
-                    }
-                    other => format!("error {:e}", other.error().unwrap_or(f64::NAN)),
-                };
-                let _ = writeln!(
-                    out,
-                    "    measured  {measured}   tolerance {} = {:e}: {}",
-                    t.name, t.value, t.reason
-                );
-            }
-            (Some(m), None) => {
-                let _ = writeln!(out, "    measured  {m:?}");
-            }
-            _ => {}
-        }
-        match &r.verdict {
-            Verdict::Error { message } => {
-                let _ = writeln!(out, "    error     {message}");
-            }
-            v => {
-                let _ = writeln!(out, "    verdict   {}", v.name());
-            }
-        }
-        if !r.source.is_empty() {
-            let _ = writeln!(out, "    source    {}", r.source);
-        }
+        out.push('\n');
+        out.push_str(&crate::report::text::block(r, "  "));
     }
     let _ = write!(out, "\nreproduce: {}", report.command);
     out

@@ -178,6 +178,13 @@ fn the_audit_writes_a_self_contained_report_html() {
     ] {
         assert!(html.contains(section), "report.html lacks {section:?}");
     }
+    // Written for people: no "1 records", the heat maps' densities explained, no Rust
+    // `Debug` forms.
+    assert!(!html.contains(">1 records") && !html.contains("(1 records"));
+    assert!(html.contains("counts / (N · cell solid angle)"));
+    for debug in ["Some(", "None,", "PValue {"] {
+        assert!(!html.contains(debug), "report.html contains {debug}");
+    }
     // A size a browser opens at once (issue 14: report.html of the default scene's quick audit
     // was 19 MB; plots now only for failures, expected failures and one per check family,
     // decimated paths, heat maps as embedded bitmaps): the bound 3 MB, and no image over
@@ -230,6 +237,18 @@ fn the_audit_writes_a_self_contained_report_html() {
         assert!(Path::new(a).starts_with(&folder), "{a}");
         assert!(Path::new(a).is_file(), "{a}");
     }
+    // The heat maps: densities, axes in radians (as every other plot), ticks at π/8 and π/2.
+    let map = std::fs::read_to_string(folder.join("chi2_observed.svg")).unwrap();
+    for text in [
+        "observed density",
+        "density (sr⁻¹)",
+        "θ (radians)",
+        "φ (radians)",
+        "3π/2",
+    ] {
+        assert!(map.contains(text), "chi2_observed.svg lacks {text:?}");
+    }
+    assert!(!map.contains("degrees"));
 }
 
 /// Headless Chromium opens report.html without console or resource errors, every image with a
@@ -359,17 +378,9 @@ fn an_unwritable_out_exits_2_and_a_failing_sink_keeps_report_json() {
     assert!(out.join("junit.xml").is_file());
 }
 
-/// A number as report.html's tables write it (`report::page::fmt_num`).
+/// A number as report.html's tables write it (the one short form of every sink).
 fn fmt_num(x: f64) -> String {
-    if x == 0.0 {
-        "0".into()
-    } else if !x.is_finite() {
-        format!("{x}")
-    } else if x.abs() >= 1e4 || x.abs() < 1e-3 {
-        format!("{x:.3e}")
-    } else {
-        format!("{x:.6}")
-    }
+    mfh_harness::report::text::num(x)
 }
 
 /// Issue 25: the BSDF section of a dielectric's audit — both hemispheres' observed / expected /
@@ -494,7 +505,7 @@ fn the_report_html_has_a_bsdf_section() {
     // Reciprocity: the worst relative error, where, the tolerance and the verdict.
     let rec = &of("bsdf.reciprocity")[0];
     has(format!(
-        "{} direction pairs, transport radiance, η = 1.500000",
+        "{} direction pairs, transport radiance, η = 1.5",
         rec["case"]["pairs"]
     ));
     has(format!(

@@ -73,6 +73,8 @@ pub struct Chi2Args {
 
 /// Prints a bad-input message; the exit status 2.
 pub(super) fn bad(stderr: &mut dyn Write, message: String) -> i32 {
+    // Long numbers shortened: a value such as 1e308 printed whole is 309 digits.
+    let message = crate::messages::compact_numbers(&message);
     let _ = writeln!(stderr, "mfh chi2: {message}");
     EXIT_BAD_INPUT
 }
@@ -293,7 +295,7 @@ fn report(
              parts: {}\n\
              expected mass {:.12} (cubature error bound {:.2e} counts)\n\
              sampling+binning {:.3e} samples/s ({:.3} s), expected-count integration {:.3} s\n\
-             verdict {} at α = {:e}{}\n{}\
+             verdict {} at α = {}{}\n{}\
              reproduce: {}",
                 2 * r.resolution,
                 r.resolution,
@@ -316,7 +318,7 @@ fn report(
                 } else {
                     "FAIL"
                 },
-                r.alpha,
+                crate::report::text::err(r.alpha),
                 reason.map(|r| format!(": {r}")).unwrap_or_default(),
                 artefacts
                     .iter()
@@ -470,7 +472,7 @@ mod tests {
         assert_eq!(table["counts"].as_array().unwrap().len(), 8);
         assert_eq!(table["counts"][0].as_array().unwrap().len(), 16);
         assert!(dir.join("chi2_expected.json").exists());
-        // The heat maps: SVGs with axes in θ and φ, a colour bar and the model, listed.
+        // The heat maps: SVGs with axes in θ and φ (radians), a colour bar and the model, listed.
         let listed: Vec<&str> = v["artefacts"]
             .as_array()
             .unwrap()
@@ -487,7 +489,7 @@ mod tests {
             assert!(listed.contains(&path.to_str().unwrap()), "{listed:?}");
             let svg = std::fs::read_to_string(&path).unwrap();
             assert!(svg.starts_with("<svg"), "{name}");
-            for text in ["θ (degrees)", "φ (degrees)", "ggx alpha=0.3"] {
+            for text in ["θ (radians)", "φ (radians)", "ggx alpha=0.3"] {
                 assert!(svg.contains(text), "{name}: {text}");
             }
             // The 16 φ × 8 cos θ cells as one embedded bitmap, and the colour bar's 64 steps.

@@ -67,18 +67,21 @@ pub fn run(
         } else {
             let r = &result;
             let (theta, phi) = plan.incidence;
+            let num = crate::report::text::num;
             writeln!(
                 stdout,
                 "bsdf {spec_text}\n\
-                 incidence θi {theta} φi {phi} from {} (wi = {:?})\n\
+                 incidence θi {} φi {} from {} (wi = {})\n\
                  grid 2 × {} φ × {} cos θ cells, {} samples ({} failed), seed {}\n\
                  statistic {:.4}, dof {}, p-value {:.6e}\n\
                  expected mass {:.12} (cubature error bound {:.2e})\n\
                  sampling+binning {:.3} s, expected-mass integration {:.3} s\n\
-                 verdict {} at α = {:e}{}\n{}\
+                 verdict {} at α = {}{}\n{}\
                  reproduce: {}",
+                num(theta),
+                num(phi),
                 if plan.inside { "inside" } else { "outside" },
-                plan.wi,
+                crate::report::text::json(&serde_json::json!(plan.wi)),
                 2 * r.resolution,
                 r.resolution,
                 r.samples,
@@ -96,7 +99,7 @@ pub fn run(
                 } else {
                     "FAIL"
                 },
-                r.alpha,
+                crate::report::text::err(r.alpha),
                 r.reason
                     .as_ref()
                     .map(|r| format!(": {r}"))

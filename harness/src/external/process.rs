@@ -289,10 +289,10 @@ impl Session {
         let answer: Answer =
             parsed.map_err(|e| malformed(format!("not a JSON answer object: {e}")))?;
         if answer.id != Some(id) {
-            return Err(malformed(format!(
-                "the answer's id is {:?}, expected {id}",
-                answer.id
-            )));
+            return Err(malformed(match answer.id {
+                Some(got) => format!("the answer's id is {got}, expected {id}"),
+                None => format!("the answer has no id, expected {id}"),
+            }));
         }
         if let Some(message) = answer.error.clone() {
             return Err(ExternalError::Child {

@@ -37,46 +37,7 @@ pub fn folder_name(model: &Value, case: &Value) -> String {
     }
 }
 
-/// A short human name of a model spec: its family (a BSDF spec's kind), then its parameters
-/// (`ggx alpha=0.3`); arrays and objects stay compact JSON.
-pub fn model_name(model: &Value) -> String {
-    let Some(map) = model.as_object() else {
-        return if model.is_null() {
-            "(no model)".into()
-        } else {
-            model.to_string()
-        };
-    };
-    // A reference BSDF's spec names its kind under `bsdf` (`dielectric eta=1.5 …`).
-    let kind = ["family", "bsdf"]
-        .into_iter()
-        .find(|k| map.get(*k).is_some_and(Value::is_string))
-        .unwrap_or("family");
-    let mut out = map
-        .get(kind)
-        .and_then(Value::as_str)
-        .unwrap_or("?")
-        .to_string();
-    for (k, v) in map.iter().filter(|(k, _)| *k != kind) {
-        out.push_str(&format!(" {k}={v}"));
-    }
-    out
-}
-
-/// A short human name of a case: `key value` pairs.
-pub fn case_name(case: &Value) -> String {
-    match case.as_object() {
-        Some(map) => map
-            .iter()
-            .map(|(k, v)| match v {
-                Value::String(s) => format!("{k} {s}"),
-                _ => format!("{k} {v}"),
-            })
-            .collect::<Vec<_>>()
-            .join(", "),
-        None => case.to_string(),
-    }
-}
+pub use super::text::{case_name, model_name};
 
 /// The folder (relative to the output folder) a record's artefacts go to, if it has data.
 pub fn relative_folder(record: &CheckRecord) -> Option<PathBuf> {
@@ -176,29 +137,82 @@ pub fn hemispheres(data: &RecordData) -> Vec<Hemisphere<'_>> {
     }
 }
 
+/// What the chi-square heat maps show, for the page that shows them: densities, because the
+/// cells are unequal.
+pub const CHI2_MAPS_NOTE: &str = "The observed and expected maps show densities, counts / (N · \
+     cell solid angle) per steradian (N the samples drawn), not counts: the chi-square cells \
+     follow the lobe's quantiles (or equal areas) and are unequal in solid angle, so counts \
+     would make the lobe's small cells look dark. The residual map is per cell, (O − E)/√E. \
+     Axes in radians: φ across, θ down.";
+
+/// The solid angle of each cell of a (cos θ, φ) grid, row-major: (z_{i+1} − z_i)(φ_{j+1} −
+/// φ_j), the edges i/R and 2πj/C where none are given.
+pub fn cell_solid_angles(
+    (rows, columns): (usize, usize),
+    (z_edges, phi_edges): (&[f64], &[f64]),
+) -> Vec<f64> {
+    let z = |i: usize| {
+        if z_edges.len() == rows + 1 {
+            z_edges[i]
+        } else {
+            i as f64 / rows as f64
+        }
+    };
+    let phi = |j: usize| {
+        if phi_edges.len() == columns + 1 {
+            phi_edges[j]
+        } else {
+            std::f64::consts::TAU * j as f64 / columns as f64
+        }
+    };
+    (0..rows)
+        .flat_map(|i| (0..columns).map(move |j| (z(i + 1) - z(i)) * (phi(j + 1) - phi(j))))
+        .collect()
+}
+
 /// The three chi-square heat maps (observed, expected, (O − E)/√E) as (file name, SVG), titled
-/// `title` plus what each shows. Observed and expected share one linear scale (0 to the
-/// largest count of either); the difference is diverging, ±max(4, largest |residual|), grey
-/// where E = O = 0, magenta where samples fell in a cell of zero expected count.
+/// `title` plus what each shows. Observed and expected are densities, count / (`samples` ·
+/// cell solid angle) per steradian ([`CHI2_MAPS_NOTE`]), on one linear scale (0 to the
+/// largest of either); the difference is per cell and diverging, ±max(4, largest |residual|),
+/// grey where E = O = 0, magenta where samples fell in a cell of zero expected count.
 #[cfg(feature = "html")]
 pub fn chi2_heat_maps(
     title: &str,
     (rows, columns): (usize, usize),
     (z_edges, phi_edges): (&[f64], &[f64]),
+    samples: u64,
     observed: &[u64],
     expected: &[f64],
 ) -> Result<Vec<(&'static str, String)>, PlotError> {
-    let observed: Vec<f64> = observed.iter().map(|&o| o as f64).collect();
-    let max = observed
+    let solid_angles = cell_solid_angles((rows, columns), (z_edges, phi_edges));
+    let n = samples.max(1) as f64;
+    let density = |count: f64, omega: f64| {
+        if omega > 0.0 {
+            count / (n * omega)
+        } else {
+            f64::NAN
+        }
+    };
+    let observed_density: Vec<f64> = observed
         .iter()
-        .chain(expected)
+        .zip(&solid_angles)
+        .map(|(&o, &w)| density(o as f64, w))
+        .collect();
+    let expected_density: Vec<f64> = expected
+        .iter()
+        .zip(&solid_angles)
+        .map(|(&e, &w)| density(e, w))
+        .collect();
+    let max = observed_density
+        .iter()
+        .chain(&expected_density)
         .copied()
         .filter(|v| v.is_finite())
         .fold(0.0f64, f64::max);
     let difference: Vec<f64> = observed
         .iter()
         .zip(expected)
-        .map(|(&o, &e)| match (o, e) {
+        .map(|(&o, &e)| match (o as f64, e) {
             (o, e) if e > 0.0 => (o - e) / e.sqrt(),
             (o, _) if o > 0.0 => f64::INFINITY,
             _ => f64::NAN,
@@ -209,25 +223,26 @@ pub fn chi2_heat_maps(
         .copied()
         .filter(|v| v.is_finite())
         .fold(4.0f64, |a, v| a.max(v.abs()));
-    let counts = ColourScale::Sequential { min: 0.0, max };
+    let densities = ColourScale::Sequential { min: 0.0, max };
+    let density_unit = "density (sr⁻¹)";
     let maps = [
         (
             "chi2_observed.svg",
-            "observed counts",
-            "counts",
-            &observed,
-            counts,
+            "observed density, counts / (N · cell solid angle)",
+            density_unit,
+            &observed_density,
+            densities,
         ),
         (
             "chi2_expected.svg",
-            "expected counts",
-            "counts",
-            &expected.to_vec(),
-            counts,
+            "expected density, counts / (N · cell solid angle)",
+            density_unit,
+            &expected_density,
+            densities,
         ),
         (
             "chi2_difference.svg",
-            "(O − E)/√E",
+            "residual per cell, (O − E)/√E",
             "(O − E)/√E",
             &difference,
             ColourScale::Diverging { limit },
@@ -235,9 +250,9 @@ pub fn chi2_heat_maps(
     ];
     maps.into_iter()
         .map(|(name, what, quantity, values, scale)| {
-            let title = format!("{title} — {what}");
             let svg = heat_map_svg(&HeatMap {
-                title: &title,
+                title,
+                subtitle: what,
                 quantity,
                 rows,
                 columns,
@@ -359,6 +374,7 @@ pub fn write_record_data(
                 title,
                 (*rows, *columns),
                 (z_edges, phi_edges),
+                *samples,
                 observed,
                 expected,
             )?);
@@ -400,6 +416,7 @@ pub fn write_record_data(
                     &format!("{title} · {}", h.side),
                     (*rows, *columns),
                     edges,
+                    *samples,
                     h.observed,
                     h.expected,
                 )? {
@@ -420,15 +437,7 @@ pub fn write_record_data(
         .collect()
 }
 
-/// The title of a record's plots: check, model and case.
-pub fn record_title(record: &CheckRecord) -> String {
-    format!(
-        "{} · {} · {}",
-        record.check,
-        model_name(&record.model),
-        case_name(&record.case)
-    )
-}
+pub use super::text::record_title;
 
 #[cfg(test)]
 mod tests {

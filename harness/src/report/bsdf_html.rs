@@ -54,15 +54,15 @@ fn cos_theta_i(r: &CheckRecord) -> Option<f64> {
     case_num(&r.case, "cos_theta_i")
 }
 
-/// An incidence as people read it: its name and θi in degrees on its side.
+/// An incidence as people read it: its name and θi in radians on its side.
 fn incidence_label(r: &CheckRecord) -> String {
     let name = case_str(r, "incidence")
         .unwrap_or("?")
         .replace("total_internal_reflection", "total internal reflection");
     match cos_theta_i(r) {
         Some(c) => format!(
-            "{name} (θi = {:.1}° {})",
-            c.abs().min(1.0).acos().to_degrees(),
+            "{name} (θi = {:.3} rad {})",
+            c.abs().min(1.0).acos(),
             if c < 0.0 {
                 "from inside"
             } else {
@@ -117,7 +117,15 @@ fn p_value_text(r: &CheckRecord) -> String {
 /// The heat maps of one `bsdf.chi2` record: a row of reflection maps and a row of transmission
 /// maps (left out, with a note, where the hemisphere has neither samples nor expected counts).
 fn chi2_maps(r: &CheckRecord) -> Result<String, PlotError> {
-    let Some(data @ RecordData::SphereChi2Table { rows, columns, .. }) = &r.data else {
+    let Some(
+        data @ RecordData::SphereChi2Table {
+            rows,
+            columns,
+            samples,
+            ..
+        },
+    ) = &r.data
+    else {
         return Ok(
             "<p class=note>No table in this record (read back from report.json?): \
                    the counts are in its chi2/ artefacts.</p>"
@@ -145,7 +153,14 @@ fn chi2_maps(r: &CheckRecord) -> Result<String, PlotError> {
         }
         let title = format!("{incidence} · {what}, {side}");
         let edges = (hemisphere.z_edges, hemisphere.phi_edges);
-        let maps = chi2_heat_maps(&title, (*rows, *columns), edges, observed, expected)?;
+        let maps = chi2_heat_maps(
+            &title,
+            (*rows, *columns),
+            edges,
+            *samples,
+            observed,
+            expected,
+        )?;
         h.push_str("<div class=\"plots maps\">");
         for (name, svg) in &maps {
             h.push_str(&img(svg, &format!("bsdf.chi2 {incidence} {what} {name}")));
@@ -155,13 +170,13 @@ fn chi2_maps(r: &CheckRecord) -> Result<String, PlotError> {
     Ok(h)
 }
 
-/// The albedo records' points: (θi in degrees, cos θi, the record), from outside first.
+/// The albedo records' points: (θi in radians, cos θi, the record), from outside first.
 fn albedo_points<'r>(albedo: &[&'r CheckRecord]) -> Vec<(f64, f64, &'r CheckRecord)> {
     let mut points: Vec<(f64, f64, &CheckRecord)> = albedo
         .iter()
         .filter_map(|r| {
             let c = cos_theta_i(r)?;
-            Some((c.abs().min(1.0).acos().to_degrees(), c, *r))
+            Some((c.abs().min(1.0).acos(), c, *r))
         })
         .collect();
     // From outside first, then from inside; by θi within each.
@@ -232,6 +247,7 @@ fn albedo_plot(albedo: &[&CheckRecord]) -> Result<Option<String>, PlotError> {
                 points: values.iter().map(|v| (v.0, v.1)).collect(),
                 markers: false,
                 line: true,
+                emphasis: false,
             });
             bars.push(ErrorBars {
                 series: series.len(),
@@ -242,12 +258,13 @@ fn albedo_plot(albedo: &[&CheckRecord]) -> Result<Option<String>, PlotError> {
                 points: values.iter().map(|v| (v.0, v.3)).collect(),
                 markers: true,
                 line: false,
+                emphasis: false,
             });
         }
         panels.push((
             LinePlot {
                 title: format!("albedo {side} (bars: quadrature bound, ± 2 s.e.)"),
-                x_label: "θi (degrees)".into(),
+                x_label: "θi (radians)".into(),
                 y_label: "albedo".into(),
                 x_log: false,
                 y_log: false,
@@ -258,14 +275,14 @@ fn albedo_plot(albedo: &[&CheckRecord]) -> Result<Option<String>, PlotError> {
             bars,
         ));
     }
-    // θi over [0°, 90°] in both panels: the incidences from inside stop short of grazing,
+    // θi over [0, π/2] in both panels: the incidences from inside stop short of grazing,
     // which leaves the legend its corner.
     let refs: Vec<Panel<'_>> = panels
         .iter()
         .map(|(plot, bars)| Panel {
             plot,
             bars,
-            x_range: Some((0.0, 90.0)),
+            x_range: Some((0.0, std::f64::consts::FRAC_PI_2)),
         })
         .collect();
     Ok(Some(img(
@@ -476,19 +493,21 @@ pub(crate) fn bsdf_section(
         let bad = rs.iter().filter(|r| r.verdict.is_failure()).count();
         let _ = writeln!(
             h,
-            "<h3 id=bsdf-{i}>{} <span class=note>({} records, {} failing)</span></h3>",
+            "<h3 id=bsdf-{i}>{} <span class=note>({}, {} failing)</span></h3>",
             escape(&name),
-            rs.len(),
+            super::text::count(rs.len(), "record", "records"),
             bad
         );
         let chi2 = of("bsdf.chi2");
         if !chi2.is_empty() {
-            h.push_str(
+            let _ = writeln!(
+                h,
                 "<h4>Sampled directions against the pdf over the whole sphere (bsdf.chi2)</h4>\n\
                  <p class=note>Per incidence, the reflected hemisphere (wo on wi's side) above, \
-                 the transmitted one below: observed counts, expected counts (the pdf's cell \
-                 masses by cubature) and (O − E)/√E. The hemisphere below the surface is \
-                 mirrored (θ from −z). Failed samples fall in no cell.</p>\n",
+                 the transmitted one below: the observed density, the expected density (the \
+                 pdf's cell masses by cubature) and (O − E)/√E. The hemisphere below the surface \
+                 is mirrored (θ from −z). Failed samples fall in no cell. {}</p>",
+                escape(super::artefacts::CHI2_MAPS_NOTE)
             );
         }
         for r in &chi2 {

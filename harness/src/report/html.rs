@@ -111,7 +111,7 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
     let counts: Vec<String> = s.counts.iter().map(|(k, v)| format!("{k} {v}")).collect();
     let _ = write!(
         h,
-        "<p><span class=\"verdict {}\">{}</span> &nbsp; {} records: {}</p>\n\
+        "<p><span class=\"verdict {}\">{}</span> &nbsp; {}: {}</p>\n\
          <table><tr><th>reproduce</th><td><code>{}</code></td></tr>\
          <tr><th>seed</th><td>{}</td></tr><tr><th>profile</th><td>{}</td></tr>\
          <tr><th>versions</th><td>mfh {}, record schema {}</td></tr>\
@@ -120,7 +120,7 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
          <tr><th>wall time</th><td>{:.1} s</td></tr></table>\n",
         if passed { "pass" } else { "fail" },
         if passed { "PASS" } else { "FAIL" },
-        report.records.len(),
+        super::text::count(report.records.len(), "record", "records"),
         escape(&counts.join(", ")),
         escape(&report.command),
         report.seed,
@@ -170,21 +170,16 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
         h.push_str("<p>None: every check passed or failed as expected.</p>\n");
     }
     for r in &failures {
+        // The fields every sink prints for a record (`text.rs`), as a table.
         let _ = write!(
             h,
-            "<div class=failure><h3>{}</h3><p>{} · value {} · oracle {} · {}</p><p>source: {}</p>",
-            escape(&record_title(r)),
-            escape(&verdict_text(&r.verdict)),
-            r.value.map(fmt_num).unwrap_or("—".into()),
-            r.oracle
-                .map(|o| format!("{} ± {}", fmt_num(o.value), fmt_num(o.uncertainty)))
-                .unwrap_or("—".into()),
-            escape(&measured_text(r)),
-            escape(&r.source)
+            "<div class=failure><h3>{}</h3><table>",
+            escape(&record_title(r))
         );
-        if let Some(note) = r.oracle.and_then(|o| o.noise_note()) {
-            let _ = write!(h, "<p>{}</p>", escape(&note));
+        for (label, text) in super::text::fields(r) {
+            let _ = write!(h, "<tr><th>{label}</th><td>{}</td></tr>", escape(&text));
         }
+        h.push_str("</table>");
         let bsdf = super::bsdf_html::is_bsdf(&r.check)
             .then(|| super::bsdf_html::anchor(&report.records, &r.model))
             .flatten();
@@ -224,9 +219,9 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
         let bad = records.iter().filter(|r| r.verdict.is_failure()).count();
         let _ = writeln!(
             h,
-            "<h3 id=material-{i}>{} <span class=note>({} records, {} failing)</span></h3>",
+            "<h3 id=material-{i}>{} <span class=note>({}, {} failing)</span></h3>",
             escape(&name),
-            records.len(),
+            super::text::count(records.len(), "record", "records"),
             bad
         );
         let mut plots = String::new();
@@ -346,8 +341,9 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
     h.push_str(&super::cost_html::cost_section(cost));
     h.push_str(
         "<h2 id=checks>By check</h2>\n<table><tr><th>check</th><th>records</th><th>failing</th>\
-         <th>expected failures</th><th>CPU seconds</th><th>worst passing error</th></tr>",
+         <th>expected failures</th><th>CPU seconds</th><th>worst passing error (its unit)</th></tr>",
     );
+    let worst = super::text::worst_passing(&report.records);
     for (id, c) in &s.by_check {
         let _ = write!(
             h,
@@ -358,7 +354,7 @@ pub fn render(report: &AuditReport, cost: Option<&str>) -> Result<String, PlotEr
             c.failures,
             c.expected_failures,
             c.seconds,
-            fmt_num(c.worst_passing_error)
+            escape(&super::text::worst_text_of(&report.records, &worst, id))
         );
     }
     h.push_str(

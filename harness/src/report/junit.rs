@@ -13,18 +13,14 @@ fn escape(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
+/// A failing record's text ([`super::text::fields`], the layout every sink prints), one field
+/// a line.
 fn detail(r: &CheckRecord) -> String {
-    let mut d = format!(
-        "value {:?}, oracle {:?}, measured {:?}, tolerance {:?}",
-        r.value,
-        r.oracle.map(|o| o.value),
-        r.measured,
-        r.tolerance.as_ref().map(|t| t.value)
-    );
-    if let Some(note) = r.oracle.and_then(|o| o.noise_note()) {
-        d.push_str(&format!(" ({note})"));
-    }
-    d
+    super::text::fields(r)
+        .iter()
+        .map(|(label, text)| format!("{label}: {text}"))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// Renders the report as JUnit XML.
@@ -85,8 +81,8 @@ pub fn render(report: &AuditReport) -> String {
                 Verdict::Pass => out.push_str("/>\n"),
                 Verdict::Fail => out.push_str(&format!(
                     ">\n      <failure message=\"{}\">{}</failure>\n    </testcase>\n",
-                    escape(&detail(r)),
-                    escape(&r.source)
+                    escape(&super::text::measured_against(r)),
+                    escape(&detail(r))
                 )),
                 Verdict::Error { message } => out.push_str(&format!(
                     ">\n      <error message=\"{}\"/>\n    </testcase>\n",

@@ -38,6 +38,7 @@ pub mod record_plots;
 #[cfg(feature = "html")]
 pub mod selftest_html;
 pub mod terminal;
+pub mod text;
 
 use crate::run::AuditReport;
 use std::path::{Path, PathBuf};

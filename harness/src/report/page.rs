@@ -1,9 +1,9 @@
 //! The pieces every HTML page of mfh shares (`report.html`, `cost.html`, `selftest.html`):
-//! escaping, SVG images as `data:` URIs, the style sheet, number formatting and a record's
-//! measured error and verdict as text. A leaf of
-//! `report/`: it imports no other sink, so the pages and the plots can all use it.
+//! escaping, SVG images as `data:` URIs and the style sheet; a record's numbers, measured error
+//! and verdict come from `text.rs` (the text every sink shares). It imports no other sink, so
+//! the pages and the plots can all use it.
 
-use crate::record::{CheckRecord, Measured, Verdict};
+use crate::record::{CheckRecord, Verdict};
 use base64::Engine as _;
 
 /// Escapes text for HTML element content and attribute values.
@@ -37,56 +37,17 @@ border:1px solid #ddd;vertical-align:top;max-width:100%}.failure{border-left:4px
 padding-left:.8em;margin:1em 0}.num{text-align:right;font-variant-numeric:tabular-nums}\
 .maps img{width:calc(33.3% - 12px)}nav a{margin-right:1em}details{margin:.4em 0}.note{color:#555;font-size:.9em}";
 
-/// A number for a table cell: fixed below 10⁴ and above 10⁻³, scientific otherwise.
+/// A number for a table cell ([`super::text::num`]: the one short form of every sink).
 pub(crate) fn fmt_num(x: f64) -> String {
-    if x == 0.0 {
-        "0".into()
-    } else if !x.is_finite() {
-        format!("{x}")
-    } else if x.abs() >= 1e4 || x.abs() < 1e-3 {
-        format!("{x:.3e}")
-    } else {
-        format!("{x:.6}")
-    }
+    super::text::num(x)
 }
 
-/// The measured discrepancy against the tolerance, as one line of text.
+/// The measured discrepancy against the tolerance, as one line of text
+/// ([`super::text::measured_against`]).
 pub fn measured_text(r: &CheckRecord) -> String {
-    let tol = r
-        .tolerance
-        .as_ref()
-        .map(|t| format!(" against {} = {}", t.name, fmt_num(t.value)))
-        .unwrap_or_default();
-    match r.measured {
-        Some(Measured::Absolute { error }) => format!("absolute error {}{tol}", fmt_num(error)),
-        Some(Measured::Relative { error }) => format!("relative error {}{tol}", fmt_num(error)),
-        Some(Measured::PValue {
-            p,
-            statistic,
-            dof,
-            alpha,
-        }) => format!(
-            "p = {} (statistic {}, dof {dof}) at α = {}",
-            fmt_num(p),
-            fmt_num(statistic),
-            fmt_num(alpha)
-        ),
-        Some(Measured::Rate { exponent, expected }) => format!(
-            "rate {} (expected {}){tol}",
-            fmt_num(exponent),
-            fmt_num(expected)
-        ),
-        None => "not measured".into(),
-    }
+    super::text::measured_against(r)
 }
 
 pub(crate) fn verdict_text(v: &Verdict) -> String {
-    match v {
-        Verdict::Pass => "pass".into(),
-        Verdict::Fail => "FAIL".into(),
-        Verdict::ExpectedFailure { reason } => format!("expected failure: {reason}"),
-        Verdict::Skipped { reason } => format!("skipped: {reason}"),
-        Verdict::Error { message } => format!("ERROR: {message}"),
-        Verdict::UnexpectedPass { reason } => format!("UNEXPECTED PASS: {reason}"),
-    }
+    super::text::verdict(v)
 }

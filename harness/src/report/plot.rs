@@ -36,6 +36,9 @@ pub struct Series {
     pub markers: bool,
     /// Join the points with a line.
     pub line: bool,
+    /// Mark the points with large crosses instead of dots (points that failed, or failed as
+    /// expected, drawn over the passing ones).
+    pub emphasis: bool,
 }
 
 impl Series {
@@ -46,6 +49,7 @@ impl Series {
             points,
             markers: true,
             line: true,
+            emphasis: false,
         }
     }
 }
@@ -331,7 +335,16 @@ fn draw_lines(
                 .label(s.label.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
         }
-        if s.markers {
+        if s.markers && s.emphasis {
+            let style = ShapeStyle::from(&colour).stroke_width(2);
+            let anno = chart
+                .draw_series(points.iter().map(|&p| Cross::new(p, 6, style)))
+                .map_err(&err)?;
+            if !s.line {
+                anno.label(s.label.as_str())
+                    .legend(move |(x, y)| Cross::new((x + 9, y), 6, style));
+            }
+        } else if s.markers {
             let anno = chart
                 .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
                 .map_err(&err)?;
@@ -432,12 +445,14 @@ pub fn panels_svg(panels: &[Panel<'_>], height: u32) -> Result<String, PlotError
 
 /// A heat map over the hemisphere's (φ, cos θ) grid: `rows` cos θ-rows (row 0 at the horizon,
 /// cos θ ∈ [z_i, z_{i+1}), by default z_i = i/R) × `columns` φ-columns over [0, 2π) (by default
-/// equal), row-major. Drawn with φ in degrees across and θ in degrees down, each cell where its
-/// edges put it (rows are uneven in θ).
+/// equal), row-major. Drawn with φ in radians across and θ in radians down (as every other plot
+/// of the report), each cell where its edges put it (rows are uneven in θ).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HeatMap<'a> {
-    /// The caption (name the model and the case).
+    /// The caption's first line (name the model and the case).
     pub title: &'a str,
+    /// The caption's second line: what the map shows.
+    pub subtitle: &'a str,
     /// What the colours show (the colour bar's label).
     pub quantity: &'a str,
     /// cos θ-rows.
@@ -455,10 +470,43 @@ pub struct HeatMap<'a> {
 }
 
 /// Height of a heat map, pixels.
-pub const HEAT_MAP_HEIGHT: u32 = 320;
+pub const HEAT_MAP_HEIGHT: u32 = 400;
 
-/// A heat map with axes in φ and θ and a colour bar, as SVG.
+/// The text size of a heat map's tick labels, pixels: the page shows three maps side by side,
+/// each at about two thirds of its drawn width, so 18 px reads as 12 px.
+const HEAT_MAP_LABEL_PX: u32 = 18;
+
+/// A multiple of π/8 as a tick label: `0`, `π/8`, `π/4`, `3π/8`, `π/2`, `π`, `3π/2`, `2π`.
+pub fn pi_label(v: f64) -> String {
+    let eighths = (v / (std::f64::consts::PI / 8.0)).round() as i64;
+    if eighths == 0 {
+        return "0".into();
+    }
+    let g = gcd(eighths.unsigned_abs(), 8) as i64;
+    let (n, d) = (eighths / g, 8 / g);
+    let n = match n {
+        1 => String::new(),
+        -1 => "−".into(),
+        n => n.to_string(),
+    };
+    if d == 1 {
+        format!("{n}π")
+    } else {
+        format!("{n}π/{d}")
+    }
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// A heat map with axes in φ and θ (radians) and a colour bar, as SVG.
 pub fn heat_map_svg(map: &HeatMap<'_>) -> Result<String, PlotError> {
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
     let err = plot_error(map.title);
     if map.rows == 0 || map.columns == 0 || map.values.len() != map.rows * map.columns {
         return Err(PlotError {
@@ -476,28 +524,39 @@ pub fn heat_map_svg(map: &HeatMap<'_>) -> Result<String, PlotError> {
     {
         let root = SVGBackend::with_string(&mut svg, (WIDTH, HEAT_MAP_HEIGHT)).into_drawing_area();
         root.fill(&WHITE).map_err(&err)?;
-        let (main, bar) = root.split_horizontally(WIDTH - 110);
+        let root = root
+            .titled(map.title, ("sans-serif", 16))
+            .map_err(&err)?
+            .titled(map.subtitle, ("sans-serif", HEAT_MAP_LABEL_PX))
+            .map_err(&err)?;
+        let (main, bar) = root.split_horizontally(WIDTH - 130);
+        // The axes count φ in quarter turns (π/2) and θ in eighths of π, so that plotters'
+        // ticks at whole numbers fall on π/2 and π/8 and are labelled as such.
+        let (phi_unit, theta_unit) = (FRAC_PI_2, PI / 8.0);
         let mut chart = ChartBuilder::on(&main)
-            .caption(map.title, ("sans-serif", 14))
             .margin(8)
-            .x_label_area_size(36)
-            .y_label_area_size(48)
-            .build_cartesian_2d(0.0..360.0, 90.0..0.0)
+            .margin_right(20)
+            .x_label_area_size(56)
+            .y_label_area_size(80)
+            .build_cartesian_2d(0.0..TAU / phi_unit, FRAC_PI_2 / theta_unit..0.0)
             .map_err(&err)?;
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc("φ (degrees)")
-            .y_desc("θ (degrees)")
-            .x_labels(9)
-            .y_labels(7)
-            .label_style(("sans-serif", 12))
+            .x_desc("φ (radians)")
+            .y_desc("θ (radians)")
+            .x_labels(5)
+            .y_labels(5)
+            .x_label_formatter(&|v| pi_label(*v * phi_unit))
+            .y_label_formatter(&|v| pi_label(*v * theta_unit))
+            .label_style(("sans-serif", HEAT_MAP_LABEL_PX))
+            .axis_desc_style(("sans-serif", HEAT_MAP_LABEL_PX))
             .draw()
             .map_err(&err)?;
         // The cells as one embedded bitmap stretched over the plotting area (one `<rect>` per
         // cell made a 32-row map ~250 kB): placed after drawing, under the axes' labels.
         let (x0, y0) = chart.backend_coord(&(0.0, 0.0));
-        let (x1, y1) = chart.backend_coord(&(360.0, 90.0));
+        let (x1, y1) = chart.backend_coord(&(TAU / phi_unit, FRAC_PI_2 / theta_unit));
         cells_image = Some(format!(
             "<image x=\"{x0}\" y=\"{y0}\" width=\"{}\" height=\"{}\" \
              preserveAspectRatio=\"none\" style=\"image-rendering:pixelated\" \
@@ -523,20 +582,20 @@ pub fn heat_map_svg(map: &HeatMap<'_>) -> Result<String, PlotError> {
             }
         };
         let mut scale_chart = ChartBuilder::on(&bar)
-            .margin_top(30)
-            .margin_bottom(44)
+            .margin_top(8)
+            .margin_bottom(64)
             .margin_right(8)
-            .y_label_area_size(62)
-            .caption(map.quantity, ("sans-serif", 11))
+            .y_label_area_size(78)
+            .caption(map.quantity, ("sans-serif", 15))
             .build_cartesian_2d(0.0..1.0, lo..hi)
             .map_err(&err)?;
         scale_chart
             .configure_mesh()
             .disable_mesh()
             .disable_x_axis()
-            .y_labels(6)
+            .y_labels(5)
             .y_label_formatter(&|v| tick_label(*v, false))
-            .label_style(("sans-serif", 11))
+            .label_style(("sans-serif", HEAT_MAP_LABEL_PX - 2))
             .draw()
             .map_err(&err)?;
         let steps = 64;
@@ -705,15 +764,21 @@ mod tests {
         let map = HeatMap {
             z_edges: &[],
             phi_edges: &[],
-            title: "ggx α = 0.3, observed",
-            quantity: "counts",
+            title: "ggx α = 0.3",
+            subtitle: "observed density",
+            quantity: "density (sr⁻¹)",
             rows: 2,
             columns: 3,
             values: &values,
             scale: ColourScale::Diverging { limit: 4.0 },
         };
         let svg = heat_map_svg(&map).unwrap();
-        assert!(svg.contains("θ (degrees)") && svg.contains("φ (degrees)"));
+        assert!(svg.contains("θ (radians)") && svg.contains("φ (radians)"));
+        for tick in ["π/8", "3π/8", "π/2", "3π/2", "2π"] {
+            assert!(plot_svg_has_tick(&svg, tick), "{tick}: {svg}");
+        }
+        assert_eq!(pi_label(-std::f64::consts::PI), "−π");
+        assert_eq!(pi_label(0.0), "0");
         let bad = HeatMap {
             z_edges: &[],
             phi_edges: &[],

@@ -181,6 +181,7 @@ pub fn render_selftest(report: &crate::selftest::SelftestReport) -> Result<Strin
                 series: vec![
                     Series {
                         line: false,
+                        emphasis: false,
                         ..Series::new("sorted p-values", qq)
                     },
                     Series {

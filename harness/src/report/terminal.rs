@@ -1,6 +1,7 @@
 //! The terminal summary of an audit: counts by verdict, the failures, the worst error per
 //! family, time per check family, the seed and the command that reproduces the run.
 
+use super::text;
 use crate::run::AuditReport;
 use std::fmt::Write;
 
@@ -18,8 +19,8 @@ pub fn render(report: &AuditReport, max_failures: usize) -> String {
     let counts: Vec<String> = s.counts.iter().map(|(k, v)| format!("{k} {v}")).collect();
     let _ = writeln!(
         o,
-        "{} records in {:.1} s: {}",
-        report.records.len(),
+        "{} in {:.1} s: {}",
+        text::count(report.records.len(), "record", "records"),
         s.wall_seconds,
         counts.join(", ")
     );
@@ -30,22 +31,39 @@ pub fn render(report: &AuditReport, max_failures: usize) -> String {
         s.statistical.1,
         crate::tolerance::STATISTICAL_ALPHA.value
     );
-    let _ = writeln!(o, "\nby check:");
+    let worst = text::worst_passing(&report.records);
     let _ = writeln!(
         o,
-        "  {:<32} {:>7} {:>6} {:>9} {:>9} {:>12}",
-        "check", "records", "fail", "expected", "cpu s", "worst pass"
+        "\nby check (worst error of the passing records, in its unit):"
+    );
+    let _ = writeln!(
+        o,
+        "  {:<32} {:>7} {:>6} {:>9} {:>9}  worst passing error",
+        "check", "records", "fail", "expected", "cpu s"
     );
     for (id, c) in &s.by_check {
         let _ = writeln!(
             o,
-            "  {:<32} {:>7} {:>6} {:>9} {:>9.2} {:>12.2e}",
-            id, c.records, c.failures, c.expected_failures, c.seconds, c.worst_passing_error
+            "  {:<32} {:>7} {:>6} {:>9} {:>9.2}  {}",
+            id,
+            c.records,
+            c.failures,
+            c.expected_failures,
+            c.seconds,
+            text::worst_text_of(&report.records, &worst, id)
         );
     }
     let _ = writeln!(o, "\nworst error per family (passing records):");
-    for (family, (e, at)) in &s.worst_error {
-        let _ = writeln!(o, "  {family:<24} {e:.2e}  ({at})");
+    for (family, by_unit) in text::worst_passing_by_family(&report.records) {
+        for (unit, (e, r)) in by_unit {
+            let _ = writeln!(
+                o,
+                "  {family:<24} {:<18} ({} {})",
+                unit.show(e),
+                r.check,
+                text::case_name_cut(&r.case, 60)
+            );
+        }
     }
     let failures: Vec<_> = report
         .records
@@ -55,20 +73,7 @@ pub fn render(report: &AuditReport, max_failures: usize) -> String {
     if !failures.is_empty() {
         let _ = writeln!(o, "\nfailures ({}):", failures.len());
         for r in failures.iter().take(max_failures) {
-            let _ = writeln!(
-                o,
-                "  {} {} {} — value {:?}, oracle {:?}, measured {:?}, {:?}",
-                r.check,
-                r.model,
-                r.case,
-                r.value,
-                r.oracle.map(|x| x.value),
-                r.measured,
-                r.verdict
-            );
-            if let Some(note) = r.oracle.and_then(|o| o.noise_note()) {
-                let _ = writeln!(o, "    ({note})");
-            }
+            o.push_str(&text::block(r, "  "));
         }
         if failures.len() > max_failures {
             let _ = writeln!(
