@@ -56,6 +56,8 @@ pub struct Audit<'a> {
     precision: Precision,
     /// The caller states that D is all the model offers ([`Audit::d_only`]).
     d_only: bool,
+    /// The model is a child behind the external protocol ([`Audit::remote`]).
+    remote: bool,
 }
 
 impl<'a> Audit<'a> {
@@ -85,6 +87,7 @@ impl<'a> Audit<'a> {
             implemented: None,
             precision: Precision::F64,
             d_only: false,
+            remote: false,
         }
     }
 
@@ -97,6 +100,15 @@ impl<'a> Audit<'a> {
         audit.model = Arc::new(capabilities::Wired::new(model, found));
         audit.implemented = Some(found.implemented());
         audit
+    }
+
+    /// The model answers from another process (the external protocol): each evaluation is a
+    /// round trip, and checks whose oracle accuracy is a cost trade-off may use the looser of
+    /// their two stated tolerances ([`crate::subject::Subject::remote`]).
+    #[doc(hidden)]
+    pub fn remote(mut self) -> Self {
+        self.remote = true;
+        self
     }
 
     /// States that D is all the model offers (no Smith Λ, no sampler, no slopes): without it, an
@@ -274,7 +286,12 @@ impl<'a> Audit<'a> {
         let (seen, precision) = precision_probe::judge(self.precision, || {
             precision_probe::probe(self.model.as_ref())
         });
-        let subject = Subject::user_at(
+        let constructor = if self.remote {
+            Subject::remote_at
+        } else {
+            Subject::user_at
+        };
+        let subject = constructor(
             self.model.clone(),
             &self.name,
             self.hints.clone(),

@@ -1,8 +1,14 @@
-//! mfh-harness: the verification harness for microfacet BSDF mathematics — evaluation of
-//! closed forms (`mfh eval`), and, as the project grows, oracles, checks, audits and reports.
+//! mfh-harness: the verification harness for microfacet BSDF mathematics. Oracles that owe
+//! nothing to the code they check (adaptive quadrature and cubature with error bounds,
+//! double-double references, Monte Carlo, chi-square and Kolmogorov–Smirnov tests), the checks
+//! that compare a model with them, each giving a record with a verdict, and the sinks that
+//! report them (terminal, `report.json`, `junit.xml`, `report.html`).
 //!
-//! The binary `mfh` is a thin layer over `cli::run` (feature `cli`). A renderer's own tests use [`Audit`]
-//! on their models, which implement the traits of [`model`].
+//! A renderer's own tests gate its NDF with [`audit!`] (or [`Audit::of`]) and its BSDF with
+//! [`Audit::of_bsdf`]; the model implements the traits of [`model`] and [`bsdf`], re-exported
+//! here so that one dependency suffices. The binary `mfh` (feature `cli`) is a thin layer over
+//! `cli::run`: audits of scenes, `mfh eval`, `mfh chi2`, `mfh cost`, `mfh selftest`, and
+//! `mfh audit-external` for a model in any language behind the external protocol.
 
 // Doc comments name the private constants and helpers a function's contract rests on (budgets,
 // block sizes); `cargo doc --document-private-items` renders them as links, the public docs

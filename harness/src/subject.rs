@@ -39,6 +39,11 @@ pub struct Subject<'a> {
     /// The precision the implementation computes in (declared; F64 for reference models):
     /// value tolerances and the oracles' rounding floors follow it.
     pub precision: Precision,
+    /// Whether every evaluation crosses a process boundary (a child behind the external
+    /// protocol): checks whose oracle accuracy is a cost trade-off may then use the looser of
+    /// two stated tolerances that both keep their margin (each such check says which). A
+    /// harness concern, so it is the subject's, not a method of the model's traits.
+    pub remote: bool,
     measured: OnceLock<Lobe>,
 }
 
@@ -79,6 +84,7 @@ impl<'a> Subject<'a> {
             reference: Some((spec, info)),
             hints,
             precision: Precision::F64,
+            remote: false,
             measured: OnceLock::new(),
         }
     }
@@ -108,6 +114,25 @@ impl<'a> Subject<'a> {
             reference: None,
             hints,
             precision,
+            remote: false,
+            measured: OnceLock::new(),
+        })
+    }
+
+    /// A user's model behind a process boundary ([`Subject::remote`]).
+    pub fn remote_at(
+        model: Arc<dyn Ndf + 'a>,
+        name: &str,
+        hints: Hints,
+        precision: Precision,
+    ) -> Arc<Self> {
+        Arc::new(Self {
+            model,
+            label: json!({ "name": name }),
+            reference: None,
+            hints,
+            precision,
+            remote: true,
             measured: OnceLock::new(),
         })
     }

@@ -58,14 +58,6 @@ pub trait Ndf: Send + Sync {
         None
     }
 
-    /// Whether every evaluation crosses a process boundary (an implementation in another
-    /// language behind a protocol): checks whose oracle accuracy is a cost trade-off may then
-    /// use the looser of two stated tolerances that both keep their margin (each such check
-    /// says which). Default false.
-    fn is_remote(&self) -> bool {
-        false
-    }
-
     /// `out[i] = self.d(m[i])` for every i: a batch capability for throughput (the default
     /// loops over [`Ndf::d`]; models may override it with a vectorized form that agrees with
     /// `d` to the number of ulps they document).
@@ -89,9 +81,6 @@ macro_rules! delegate_ndf {
             }
             fn d_batch(&self, m: &[Vec3], out: &mut [f64]) {
                 (**self).d_batch(m, out)
-            }
-            fn is_remote(&self) -> bool {
-                (**self).is_remote()
             }
             fn as_smith(&self) -> Option<&dyn Smith> {
                 (**self).as_smith()

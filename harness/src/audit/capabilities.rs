@@ -168,9 +168,6 @@ impl<M: Ndf + ?Sized> Ndf for Wired<'_, M> {
     fn d_batch(&self, m: &[mfh_reference::Vec3], out: &mut [f64]) {
         self.model.d_batch(m, out)
     }
-    fn is_remote(&self) -> bool {
-        self.model.is_remote()
-    }
     fn as_smith(&self) -> Option<&dyn Smith> {
         self.model
             .as_smith()

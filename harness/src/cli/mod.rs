@@ -1,6 +1,8 @@
 //! The clap command line of `mfh`, callable in-process (the tests crate drives it this way): one
-//! file per command (`audit`, `plan`, `chi2`, `eval`), each parsing its options, calling the
-//! library and mapping its errors to exit codes. The library knows nothing of clap.
+//! file per command (`audit`, `plan`, `chi2` with `chi2_bsdf`, `cost`, `eval`, `selftest`,
+//! `external` for `audit-external`), each parsing its options, calling the library and mapping
+//! its errors to exit codes, except `merge`, which shares `audit.rs`'s report writing. The
+//! library knows nothing of clap.
 //!
 //! Exit codes: [`EXIT_PASS`] 0 success, [`EXIT_FAIL`] 1 failed checks, [`EXIT_BAD_INPUT`] 2 bad
 //! input, or an output that could not be written ([`write_stdout`]).

@@ -130,7 +130,7 @@ pub fn plan<'a>(
     };
     let (mut plan, mut errors) = (Vec::new(), Vec::new());
     if description.has_ndf() {
-        let mut audit = configure(Audit::of(model), |a| matches!(a, Against::Ndf(_)));
+        let mut audit = configure(Audit::of(model), |a| matches!(a, Against::Ndf(_))).remote();
         if capabilities::declared(model).iter().all(|d| !d.2) {
             // The child's describe names its capabilities: D alone is its own statement.
             audit = audit.d_only();

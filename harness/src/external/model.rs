@@ -244,10 +244,6 @@ impl Ndf for ExternalModel {
     fn d(&self, m: Vec3) -> f64 {
         self.one_value(Request::D { m: &[m] }, format!("m = {}", show(m)))
     }
-    /// A child process: every call is a round trip.
-    fn is_remote(&self) -> bool {
-        true
-    }
     /// D through the protocol: up to 65 536 directions per request.
     fn d_batch(&self, m: &[Vec3], out: &mut [f64]) {
         same_length("d_batch", "m", m.len(), out.len());

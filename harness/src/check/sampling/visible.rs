@@ -89,7 +89,7 @@ pub fn plan_visible<'a>(
                         (resolution, samples),
                         &|u: &[[f64; 2]], out: &mut [Vec3]| v.sample_wm_visible_batch(wi, u, out),
                         &|mm: &[Vec3], out: &mut [f64]| v.pdf_wm_visible_batch(wi, mm, out),
-                        (m.model.is_remote(), m.precision),
+                        (m.remote, m.precision),
                     );
                     Ok(())
                 }),
