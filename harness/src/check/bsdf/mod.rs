@@ -10,7 +10,7 @@
 //! | `bsdf.energy` | `albedo.rs` | ∫ eval ≤ 1 where the transport makes that a law |
 //! | `bsdf.reciprocity` | `reciprocity.rs` | f(wi, wo) against f(wo, wi) with the transport's η² |
 //! | `bsdf.stability` | `stability.rs` | finite, non-negative, sampled where valued, at the hard cases |
-//! | `bsdf.against` | `against.rs` | eval, pdf and sampled wo against a reference BSDF |
+//! | `bsdf.against` | `against.rs` | eval and pdf against a reference BSDF on a grid and in its lobes, the samples' pdf and weight at their wo, the wo for the same u where the BSDF declares the reference map |
 //! | `bsdf.ndf_consistency` | `ndf.rs` | eval (and a visible-normal pdf) against Walter's eq 20/21 from the BSDF's own D and Λ |
 //!
 //! Incidences ([`incidences`]): normal, oblique and grazing (cos θi = 0.05) from outside; for a
