@@ -261,7 +261,9 @@ def bsdf_sample(wi, u):
 def main():
     name = "dielectric.py" + (" --defect " + DEFECT if DEFECT else "")
     functions = {"bsdf_eval": bsdf_eval, "bsdf_pdf": bsdf_pdf, "bsdf_sample": bsdf_sample}
-    extra = {"eta": ETA, "transport": "radiance"}
+    # Its sample map is mfh's reference map (visible normals: u1 the disk radius, u2 the
+    # azimuth; u0 the lobe), so it declares it and mfh compares its directions for each u too.
+    extra = {"eta": ETA, "transport": "radiance", "reference_map": "visible_normals"}
     if NDF:
         name += " --ndf " + NDF
         functions = dict({"d": ndf_d, "lambda": ndf_lambda}, **functions)

@@ -678,6 +678,7 @@ mod tests {
                 ndf: beckmann,
                 masking: Masking::Uncorrelated,
                 sampling: BsdfSampling::VisibleNormals,
+                two_sided: false,
             }))
         );
     }

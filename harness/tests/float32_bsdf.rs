@@ -115,8 +115,8 @@ impl Facets {
     }
     /// D(m) as Mitsuba 3 writes it, 1/(π α² (x²/α² + y²/α² + z²)²): finite up to the
     /// horizon without a guard. (pbrt-v4's form, `Ggx32::d32`, returns 0 where cos⁴θ < 1e-16,
-    /// i.e. within 1e-4 rad of the horizon, where D is far from 0: `bsdf.against` sees that
-    /// at its grazing pairs, see `pbrts_grazing_guard_is_seen_by_against`.)
+    /// i.e. within 1e-4 rad of the horizon, where D is far from 0: `bsdf.against` accepts
+    /// that as a guard, see `pbrts_grazing_guard_passes_against_and_is_counted`.)
     fn d(&self, m: [f32; 3]) -> f32 {
         if self.1 {
             return self.0.d32(m);
@@ -423,14 +423,22 @@ fn a_float32_radiance_btdf_without_eta_squared_fails_reciprocity() {
 
 /// pbrt-v4's GGX D returns 0 where cos⁴θ < 1e-16 (within 1e-4 rad of the horizon), where D is
 /// far from 0 (α²/π at the horizon): a float32 BSDF on it differs from the reference by 100 %
-/// at the grazing pairs of `bsdf.against` (cos θ = 1e-6 on both sides), which the float32
-/// budget (1e-3) does not excuse: float32 itself evaluates D there to ε₃₂.
+/// at the grazing pairs of `bsdf.against` (cos θ = 1e-6 on both sides). That is a renderer's
+/// guard, not a defect: `bsdf.against` accepts a value between 0 and the reference's where the
+/// half vector is within cos θh < 1e-4 of the horizon, counts those pairs, and the audit passes.
 #[test]
-fn pbrts_grazing_guard_is_seen_by_against() {
+fn pbrts_grazing_guard_passes_against_and_is_counted() {
     let mut b = Glass32::new(1.5, 0.3, Defect::None);
     b.facets.1 = true;
     let report = audit(&b, &b.facets.0, GLASS, Precision::F32);
-    assert_fails_on(&report, "bsdf.against", "\"quantity\":\"eval\"");
+    assert!(report.passed(), "{:#?}", failing(&report));
+    let excused: u64 = report
+        .records
+        .iter()
+        .filter(|r| r.check == "bsdf.against")
+        .filter_map(|r| r.case["excused_grazing_guard"].as_u64())
+        .sum();
+    assert!(excused > 0, "no pair in the grazing band");
 }
 
 /// Tiny roughness in float32 (α = 0.001, a near-mirror): no false alarm. At normal incidence

@@ -3,6 +3,11 @@
 //! tolerances and chased by the oracles; this probe notices it from the answers themselves —
 //! every D, Λ and pdf on a fixed set of directions exactly representable in float32 — and says
 //! so, instead of a report of value failures or an audit that spins.
+//!
+//! The reverse lie is found the same way: a model declared float32 whose answers are (almost)
+//! never float32 values computes in f64, and float32 tolerances would hide its defects (a
+//! weight error of 5e-4 passes a float32 BSDF's tolerances and fails an f64 one's). It is
+//! judged at f64, and the record fails saying so.
 
 use crate::precision::Precision;
 use crate::record::{CheckRecord, Verdict};
@@ -38,6 +43,9 @@ pub struct Seen {
     pub nontrivial: usize,
     /// Of them, exactly representable in float32.
     pub float32: usize,
+    /// The batches probed (D, Λ, pdf_wm; a BSDF's eval and pdf at each incidence) in which
+    /// more than half of the non-trivial answers are float32 values.
+    pub float32_quantities: usize,
 }
 
 impl Seen {
@@ -46,22 +54,32 @@ impl Seen {
     pub fn is_float32(&self) -> bool {
         self.nontrivial >= MIN_NONTRIVIAL && self.float32 == self.nontrivial
     }
+
+    /// Whether the model answers in f64: at least [`MIN_NONTRIVIAL`] non-trivial answers, and
+    /// in no batch are most of them float32 values. A float32 model's own quantities (its D,
+    /// Λ, eval or pdf) are all float32 values, even where another is finished in f64 by a trait
+    /// default or by mfh (`pdf_wm` = D·cos θ from its D); an f64 computation gives a float32
+    /// value by chance only (measured: 18 of the 512 answers of D = 0.7 cos³θ, whose inputs are
+    /// float32 values and whose cubes are exact; ~2⁻²⁹ per answer of a GGX).
+    pub fn is_float64(&self) -> bool {
+        self.nontrivial >= MIN_NONTRIVIAL && self.float32_quantities == 0
+    }
 }
 
 /// Evaluates D, Λ and pdf_wm (those the model has) on the probe's directions, in batches.
 pub fn probe(model: &dyn Ndf) -> Seen {
     let dirs = directions();
     let mut answers = vec![0.0; dirs.len()];
-    let mut all = Vec::with_capacity(3 * dirs.len());
+    let mut all = Vec::with_capacity(3);
     model.d_batch(&dirs, &mut answers);
-    all.extend_from_slice(&answers);
+    all.push(answers.clone());
     if let Some(s) = model.as_smith() {
         s.lambda_batch(&dirs, &mut answers);
-        all.extend_from_slice(&answers);
+        all.push(answers.clone());
     }
     if let Some(s) = model.as_sampler() {
         s.pdf_wm_batch(&dirs, &mut answers);
-        all.extend_from_slice(&answers);
+        all.push(answers.clone());
     }
     seen(all)
 }
@@ -81,39 +99,51 @@ pub fn probe_bsdf(bsdf: &dyn Bsdf) -> Seen {
         incidences.push(-0.7);
     }
     let mut answers = vec![0.0; wo.len()];
-    let mut all = Vec::with_capacity(2 * incidences.len() * wo.len());
+    let mut all = Vec::with_capacity(2 * incidences.len());
     for cos in incidences {
         let wi = vec![[(1.0 - cos * cos).sqrt(), 0.0, cos]; wo.len()];
         bsdf.eval_batch(&wi, &wo, &mut answers);
-        all.extend_from_slice(&answers);
+        all.push(answers.clone());
         bsdf.pdf_batch(&wi, &wo, &mut answers);
-        all.extend_from_slice(&answers);
+        all.push(answers.clone());
     }
     seen(all)
 }
 
-/// What answers say: their distinct non-trivial values and how many are float32 values.
-fn seen(all: Vec<f64>) -> Seen {
-    // Distinct values only: a constant (or dyadic) answer repeated says nothing.
-    let mut nontrivial: Vec<f64> = all
-        .into_iter()
-        .filter(|x| x.is_finite() && *x != 0.0 && x.fract() != 0.0)
-        .collect();
-    nontrivial.sort_by(f64::total_cmp);
-    nontrivial.dedup();
-    Seen {
-        nontrivial: nontrivial.len(),
-        float32: nontrivial
+/// What answers say, batch by batch: their distinct non-trivial values and how many are
+/// float32 values.
+fn seen(batches: Vec<Vec<f64>>) -> Seen {
+    let mut out = Seen {
+        nontrivial: 0,
+        float32: 0,
+        float32_quantities: 0,
+    };
+    for all in batches {
+        // Distinct values only: a constant (or dyadic) answer repeated says nothing.
+        let mut nontrivial: Vec<f64> = all
+            .into_iter()
+            .filter(|x| x.is_finite() && *x != 0.0 && x.fract() != 0.0)
+            .collect();
+        nontrivial.sort_by(f64::total_cmp);
+        nontrivial.dedup();
+        let float32 = nontrivial
             .iter()
             .filter(|&&x| Precision::F32.represents(x))
-            .count(),
+            .count();
+        out.nontrivial += nontrivial.len();
+        out.float32 += float32;
+        if 2 * float32 > nontrivial.len() {
+            out.float32_quantities += 1;
+        }
     }
+    out
 }
 
 /// The `audit.precision` record of a model declared at `declared` that answered as `seen`: it
 /// fails when a model declared f64 answers only float32 values (the audit then judges it at
-/// float32 precision, so that the report says what is wrong instead of spinning), and passes
-/// otherwise, stating what it saw.
+/// float32 precision, so that the report says what is wrong instead of spinning), and when a
+/// model declared f32 answers f64 values ([`Seen::is_float64`]: the audit judges it at f64, so
+/// that float32 tolerances hide none of its defects); it passes otherwise, stating what it saw.
 pub fn record(model: &serde_json::Value, declared: Precision, seen: Seen) -> CheckRecord {
     let mut r = CheckRecord::new(
         "audit.precision",
@@ -134,6 +164,15 @@ pub fn record(model: &serde_json::Value, declared: Precision, seen: Seen) -> Che
                 seen.nontrivial
             ),
         }
+    } else if declared == Precision::F32 && seen.is_float64() {
+        Verdict::Error {
+            message: format!(
+                "{} of {} answers are float32 values: the implementation computes in f64, \
+                 not in the float32 it declares; the audit judged it at f64 (declare precision \
+                 f64, the default, or round its answers to float32 if it computes in float32)",
+                seen.float32, seen.nontrivial
+            ),
+        }
     } else {
         Verdict::Pass
     };
@@ -150,11 +189,13 @@ pub fn judge(declared: Precision, probe: impl FnOnce() -> Seen) -> (Option<Seen>
     )
 }
 
-/// The precision an audit judges at: the declared one, or float32 when a model declared f64
-/// answers only float32 values.
+/// The precision an audit judges at: the declared one, float32 when a model declared f64
+/// answers only float32 values, f64 when a model declared float32 answers f64 values.
 pub fn effective(declared: Precision, seen: Seen) -> Precision {
     if declared == Precision::F64 && seen.is_float32() {
         Precision::F32
+    } else if declared == Precision::F32 && seen.is_float64() {
+        Precision::F64
     } else {
         declared
     }
@@ -209,6 +250,43 @@ mod tests {
             record(&json!({}), Precision::F64, seen).verdict,
             Verdict::Pass
         );
+        // The reverse lie: declared f32, answers f64 values: judged at f64, and the record
+        // fails saying so.
+        assert!(seen.is_float64(), "{seen:?}");
+        assert_eq!(effective(Precision::F32, seen), Precision::F64);
+        let r = record(&json!({}), Precision::F32, seen);
+        assert!(
+            matches!(&r.verdict, Verdict::Error { message } if message.contains("computes in f64")),
+            "{r:?}"
+        );
+        assert!(!probe(&Rounded(3.0)).is_float64());
+        assert!(!probe(&Half).is_float64());
+    }
+
+    /// A float32 model whose one quantity is finished in f64 (D in float32, pdf_wm = D·cos θ
+    /// by the trait's default) is no f64 model: a third or more of its answers are float32.
+    #[test]
+    fn a_float32_model_finished_in_f64_is_not_taken_for_f64() {
+        struct Mixed;
+        impl Ndf for Mixed {
+            fn d(&self, m: Vec3) -> f64 {
+                f64::from((m[2] as f32).powf(3.0) * 0.7)
+            }
+            fn as_sampler(&self) -> Option<&dyn mfh_reference::model::NormalSampler> {
+                Some(self)
+            }
+        }
+        impl mfh_reference::model::NormalSampler for Mixed {
+            fn sample_wm(&self, _: [f64; 2]) -> Vec3 {
+                [0.0, 0.0, 1.0]
+            }
+            fn pdf_wm(&self, m: Vec3) -> f64 {
+                self.d(m) * m[2]
+            }
+        }
+        let seen = probe(&Mixed);
+        assert!(!seen.is_float64() && !seen.is_float32(), "{seen:?}");
+        assert_eq!(effective(Precision::F32, seen), Precision::F32);
     }
 
     /// A BSDF whose answers are rounded to float32 is told from the f64 reference it rounds.

@@ -4,12 +4,15 @@
 //!
 //! As for the NDF methods ([`super::model`]), the first protocol error is recorded, the child is
 //! stopped, and every later call answers at once: NaN values, and samples with a NaN direction,
-//! pdf and weight (so that the checks fail quickly, beside the `external.protocol` record).
+//! pdf and weight (so that the checks fail quickly, beside the `external.protocol` record). A
+//! NaN the child answers is no protocol error: it reaches the checks as a Rust BSDF's would,
+//! and is listed by array (`values`, `wo`, `pdf`, `weight`) and item for the `external.nan`
+//! records (a failed sample's — pdf 0 — wo and weight are ignored).
 
 use super::model::{chunked, fill, same_length, show, ExternalModel, MAX_BATCH};
 use super::process::ExternalError;
 use super::protocol::Request;
-use mfh_reference::bsdf::{Bsdf, BsdfSample, Transport};
+use mfh_reference::bsdf::{Bsdf, BsdfSample, Sampling, Transport};
 use mfh_reference::Vec3;
 
 /// The answer to a sample after a protocol error.
@@ -56,9 +59,13 @@ impl ExternalModel {
         let request = Request::BsdfSample { wi, u };
         let inputs = |i: usize| format!("wi = {}, u = {:?}", show(wi[i]), u[i]);
         let answer = self.call(&request)?;
-        let wo = self.items(&request, &inputs, "wo", answer.wo)?;
+        let wo = self.items_raw(&request, "wo", answer.wo)?;
         let pdf = self.items(&request, &inputs, "pdf", answer.pdf)?;
-        let weight = self.items(&request, &inputs, "weight", answer.weight)?;
+        let weight = self.items_raw(&request, "weight", answer.weight)?;
+        // A failed sample's wo and weight mean nothing, NaN included.
+        let failed = |i: usize| pdf[i] == 0.0;
+        self.note_nans(&request, &inputs, "wo", (&wo, 3), &failed);
+        self.note_nans(&request, &inputs, "weight", (&weight, 1), &failed);
         Ok(pdf
             .iter()
             .zip(&weight)
@@ -100,6 +107,14 @@ impl Bsdf for ExternalModel {
 
     fn transport(&self) -> Transport {
         self.description().transport()
+    }
+
+    fn two_sided(&self) -> bool {
+        self.description().two_sided()
+    }
+
+    fn reference_map(&self) -> Option<Sampling> {
+        self.description().reference_map()
     }
 
     /// eval through the protocol: up to 65 536 pairs per request.

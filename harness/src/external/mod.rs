@@ -82,7 +82,9 @@ pub fn audit(request: &ExternalAudit) -> Result<AuditReport, ExternalError> {
     drop(plan);
     records.append(&mut errors);
     let protocol_error = model.first_error();
+    let nans = model.nan_answers();
     model.shutdown();
+    records.extend(nans.iter().map(|n| nan_record(&label, n)));
     if let Some(e) = protocol_error {
         records.push(error_record("external.protocol", &label, e.to_string()));
     }
@@ -175,6 +177,35 @@ pub fn plan<'a>(
         _ => {}
     }
     (plan, errors)
+}
+
+/// The failing `external.nan` record of one array that held NaN answers: the request, the
+/// array, how many items and the first (its index and input). The checks that met the NaN fail
+/// on their own, as for a Rust model; this record says where it came from.
+pub fn nan_record(label: &serde_json::Value, n: &model::NanAnswers) -> CheckRecord {
+    let (index, input) = match &n.first {
+        ExternalError::NotANumber { index, input, .. } => (*index, input.clone()),
+        _ => (0, String::new()),
+    };
+    let mut r = CheckRecord::new(
+        "external.nan",
+        label.clone(),
+        json!({
+            "request": n.op,
+            "array": n.field,
+            "nan_items": n.count,
+            "first_item": index,
+            "input": input,
+            "finding": format!(
+                "the child answered NaN in {:?} of {} ({} items; first: {})",
+                n.field, n.op, n.count, n.first
+            ),
+        }),
+        "the external protocol: answers are numbers; NaN is a defect of the model",
+    );
+    r.value = Some(n.count as f64);
+    r.verdict = Verdict::Fail;
+    r
 }
 
 /// A record of `check` that errs with `message`.

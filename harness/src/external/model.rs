@@ -9,6 +9,12 @@
 //! [`ExternalModel::first_error`]), the child is killed, and every later call answers NaN
 //! (values) or a NaN direction (samples) at once: the audit's checks fail quickly, and the
 //! runner appends an `external.protocol` error record with the message.
+//!
+//! A NaN in an answer is not a protocol error: the child may compute a NaN as a Rust model
+//! may, and the checks judge it the same way (their records fail) while the audit goes on.
+//! Each array that held one is listed by [`ExternalModel::nan_answers`] (the request, the
+//! array, how many items, the first item and its input), from which the runner writes failing
+//! `external.nan` records.
 
 use super::process::{ExternalError, Session};
 use super::protocol::{Answer, Description, Item, Request, Wire};
@@ -22,12 +28,26 @@ pub const MAX_BATCH: usize = 65_536;
 
 const NAN3: Vec3 = [f64::NAN; 3];
 
+/// The NaN items of one array of one kind of request (`op`) over the session.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NanAnswers {
+    /// The request (`d`, `bsdf_sample`, …).
+    pub op: &'static str,
+    /// The answer's array (`values`, `m`, `wo`, `pdf`, `weight`).
+    pub field: String,
+    /// How many items of that array were NaN, over every such request.
+    pub count: u64,
+    /// The first of them: the request, its item index and the item's input.
+    pub first: ExternalError,
+}
+
 /// A model implemented by a child process speaking the external protocol.
 pub struct ExternalModel {
     session: Mutex<Session>,
     description: Description,
     version: u32,
     first_error: Mutex<Option<ExternalError>>,
+    nans: Mutex<Vec<NanAnswers>>,
 }
 
 impl ExternalModel {
@@ -44,6 +64,7 @@ impl ExternalModel {
             session: Mutex::new(session),
             description,
             first_error: Mutex::new(None),
+            nans: Mutex::new(Vec::new()),
         })
     }
 
@@ -60,6 +81,53 @@ impl ExternalModel {
     /// The first protocol error of the session, if any.
     pub fn first_error(&self) -> Option<ExternalError> {
         self.first_error.lock().ok().and_then(|e| e.clone())
+    }
+
+    /// The arrays that held NaN answers, in the order first seen (each with its count and
+    /// first item).
+    pub fn nan_answers(&self) -> Vec<NanAnswers> {
+        self.nans.lock().map(|n| n.clone()).unwrap_or_default()
+    }
+
+    /// Notes the NaN items of `field` (`width` numbers an item) among `numbers`, except the
+    /// items `ignored` says mean nothing (a failed sample's wo and weight).
+    pub(super) fn note_nans(
+        &self,
+        request: &Request<'_>,
+        inputs: &dyn Fn(usize) -> String,
+        field: &str,
+        (numbers, width): (&[f64], usize),
+        ignored: &dyn Fn(usize) -> bool,
+    ) {
+        let mut items = numbers
+            .chunks_exact(width)
+            .enumerate()
+            .filter(|(i, c)| c.iter().any(|v| v.is_nan()) && !ignored(*i))
+            .map(|(i, _)| i);
+        let Some(index) = items.next() else {
+            return;
+        };
+        let count = 1 + items.count() as u64;
+        let Ok(mut nans) = self.nans.lock() else {
+            return;
+        };
+        match nans
+            .iter_mut()
+            .find(|n| n.op == request.op() && n.field == field)
+        {
+            Some(n) => n.count += count,
+            None => nans.push(NanAnswers {
+                op: request.op(),
+                field: field.to_string(),
+                count,
+                first: ExternalError::NotANumber {
+                    request: format!("{} ({} items)", request.op(), request.len()),
+                    field: field.to_string(),
+                    index,
+                    input: inputs(index),
+                },
+            }),
+        }
     }
 
     /// Asks the child to exit and reaps it.
@@ -109,11 +177,11 @@ impl ExternalModel {
     }
 
     /// Checks an answer's array `field` against `request`: present, decodable in the session's
-    /// protocol version, one item per item asked, no NaN. Its numbers, row-major.
-    pub(super) fn items<T: Item>(
+    /// protocol version, one item per item asked. Its numbers, row-major, NaN included (noted
+    /// by the caller with [`ExternalModel::note_nans`]; [`ExternalModel::items`] does).
+    pub(super) fn items_raw<T: Item>(
         &self,
         request: &Request<'_>,
-        inputs: &dyn Fn(usize) -> String,
         field: &str,
         wire: Option<Wire<T>>,
     ) -> Result<Vec<f64>, ExternalError> {
@@ -136,13 +204,19 @@ impl ExternalModel {
                 got,
             }));
         }
-        if let Some(index) = numbers.iter().position(|v| v.is_nan()) {
-            return Err(self.record(ExternalError::NotANumber {
-                request: label(),
-                index: index / T::WIDTH,
-                input: inputs(index / T::WIDTH),
-            }));
-        }
+        Ok(numbers)
+    }
+
+    /// [`ExternalModel::items_raw`], with its NaN items noted.
+    pub(super) fn items<T: Item>(
+        &self,
+        request: &Request<'_>,
+        inputs: &dyn Fn(usize) -> String,
+        field: &str,
+        wire: Option<Wire<T>>,
+    ) -> Result<Vec<f64>, ExternalError> {
+        let numbers = self.items_raw(request, field, wire)?;
+        self.note_nans(request, inputs, field, (&numbers, T::WIDTH), &|_| false);
         Ok(numbers)
     }
 

@@ -88,11 +88,14 @@ pub enum ExternalError {
         /// Items answered.
         got: usize,
     },
-    /// The answer contains NaN.
-    #[error("request {request}: the answer is NaN at item {index} (input {input})")]
+    /// The answer contains NaN (not a protocol error: the audit goes on with the NaN, which
+    /// the checks judge as a Rust model's; [`super::ExternalModel::nan_answers`] lists them).
+    #[error("request {request}: the answer's {field:?} is NaN at item {index} (input {input})")]
     NotANumber {
         /// The request.
         request: String,
+        /// The answer's array (`values`, `m`, `wo`, `pdf`, `weight`).
+        field: String,
         /// The first NaN item.
         index: usize,
         /// The input of that item.

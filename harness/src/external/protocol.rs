@@ -3,8 +3,9 @@
 //!
 //! Every request is one line `{"v":V,"id":N,"op":"…", …arrays…}`; every answer is one line
 //! carrying the same `id` and either the result (`values` or `m`) or `{"error":"…"}`. The
-//! answer has exactly one item per item asked. NaN is refused as an answer (a protocol error
-//! naming the item); infinity is allowed (Λ at grazing incidence).
+//! answer has exactly one item per item asked. Infinity is allowed (Λ at grazing incidence);
+//! NaN is read as NaN (a defect of the model, not of the protocol: `model.rs` lists it by
+//! array and item, and the checks judge it as a Rust model's).
 //!
 //! - **Version 1**: arrays are JSON arrays of directions (`[x,y,z]`) or uniform pairs
 //!   (`[u1,u2]`). Non-finite numbers may be written as the bare tokens `Infinity`, `-Infinity`,
@@ -303,6 +304,17 @@ pub struct Description {
     /// `"f32"`; checked by [`Description::validate`], read by [`Description::precision`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub precision: Option<Value>,
+    /// Whether a reflection-only BSDF reflects from below as from above (`true`; absent or
+    /// `false`: black from below); checked by [`Description::validate`], read by
+    /// [`Description::two_sided`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub two_sided: Option<Value>,
+    /// The reference sampler whose map u ↦ wo `bsdf_sample` reproduces (`"visible_normals"`,
+    /// `"normals"` or `"pseudo_vnis"`; absent: its own map, whose directions for a given u are
+    /// not compared); checked by [`Description::validate`], read by
+    /// [`Description::reference_map`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_map: Option<Value>,
 }
 
 impl Description {
@@ -350,6 +362,20 @@ impl Description {
         self.sampling.as_ref().and_then(Value::as_str) == Some("visible_normals")
     }
 
+    /// Whether the BSDF declared itself two-sided (false when absent or invalid: see
+    /// [`Description::validate`]).
+    pub fn two_sided(&self) -> bool {
+        self.two_sided.as_ref().and_then(Value::as_bool) == Some(true)
+    }
+
+    /// The reference map the BSDF declared (None when absent or invalid: see
+    /// [`Description::validate`]).
+    pub fn reference_map(&self) -> Option<mfh_reference::bsdf::Sampling> {
+        self.reference_map
+            .as_ref()
+            .and_then(|m| serde_json::from_value(m.clone()).ok())
+    }
+
     /// The BSDF's transport convention (radiance when absent or invalid: see
     /// [`Description::validate`]).
     pub fn transport(&self) -> Transport {
@@ -365,7 +391,8 @@ impl Description {
     /// needs `sample_wm`, visible sampling needs `lambda`; `bsdf_pdf` and `bsdf_sample` need
     /// `bsdf_eval`; `eta`, when given, is a finite number in [0.1, 10] at least 5e-5 away from
     /// 1; `transport`, when given, is `"importance"` or `"radiance"`; `masking`, when given,
-    /// is `"uncorrelated"` or `"height_correlated"`.
+    /// is `"uncorrelated"` or `"height_correlated"`; `two_sided`, when given, is a boolean, and
+    /// `true` only without `eta`; `reference_map`, when given, names a reference sampler.
     pub fn validate(&self) -> Result<(), String> {
         if !VERSIONS.contains(&self.protocol) {
             return Err(format!(
@@ -437,6 +464,33 @@ impl Description {
             if self.masking().is_none() {
                 return Err(format!(
                     "\"masking\" is {m}; it must be \"uncorrelated\" or \"height_correlated\""
+                ));
+            }
+        }
+        if let Some(t) = &self.two_sided {
+            match t.as_bool() {
+                None => {
+                    return Err(format!(
+                        "\"two_sided\" is {t}; it must be true or false (a reflector that \
+                         reflects from below as from above)"
+                    ))
+                }
+                Some(true) if self.eta.is_some() => {
+                    return Err(
+                        "\"two_sided\": true is for a reflection-only BSDF; this one declares \
+                         \"eta\" (a transmitting BSDF has both sides already)"
+                            .into(),
+                    )
+                }
+                _ => {}
+            }
+        }
+        if let Some(m) = &self.reference_map {
+            if self.reference_map().is_none() {
+                return Err(format!(
+                    "\"reference_map\" is {m}; it must be \"visible_normals\", \"normals\" or \
+                     \"pseudo_vnis\" (the reference sampler whose map u ↦ wo bsdf_sample \
+                     reproduces), or absent"
                 ));
             }
         }
@@ -827,6 +881,8 @@ mod tests {
             masking: None,
             sampling: None,
             precision: None,
+            two_sided: None,
+            reference_map: None,
         };
         assert!(d(&["d", "lambda", "g2"], 1).validate().is_ok());
         // "precision": "f64" or "f32"; anything else is an error naming the field.
@@ -873,6 +929,8 @@ mod tests {
             masking: None,
             sampling: None,
             precision: None,
+            two_sided: None,
+            reference_map: None,
         };
         let bsdf = ["bsdf_eval", "bsdf_pdf", "bsdf_sample"];
         let ok = d(&bsdf, Some(1.5.into()), Some("importance".into()));
@@ -901,6 +959,45 @@ mod tests {
             .validate()
             .unwrap_err();
             assert!(e.contains("\"masking\""), "{e}");
+        }
+        // A reflector may declare itself two-sided; a transmitting BSDF may not (it has both
+        // sides); either may declare the reference map it reproduces.
+        assert!(!both.two_sided() && both.reference_map().is_none());
+        let two = Description {
+            two_sided: Some(true.into()),
+            reference_map: Some("normals".into()),
+            ..both.clone()
+        };
+        assert!(two.validate().is_ok() && two.two_sided());
+        assert_eq!(
+            two.reference_map(),
+            Some(mfh_reference::bsdf::Sampling::Normals)
+        );
+        for (bad, want) in [
+            (
+                Description {
+                    two_sided: Some("yes".into()),
+                    ..both.clone()
+                },
+                "\"two_sided\" is",
+            ),
+            (
+                Description {
+                    two_sided: Some(true.into()),
+                    ..d(&bsdf, Some(1.5.into()), None)
+                },
+                "declares \"eta\"",
+            ),
+            (
+                Description {
+                    reference_map: Some("concentric".into()),
+                    ..both.clone()
+                },
+                "\"reference_map\"",
+            ),
+        ] {
+            let e = bad.validate().unwrap_err();
+            assert!(e.contains(want), "{e}");
         }
         let e = d(&["bsdf_pdf"], None, None).validate().unwrap_err();
         assert!(e.contains("bsdf_eval"), "{e}");

@@ -81,6 +81,7 @@ impl Reader<'_, '_> {
                 ndf: ndf.clone(),
                 masking: Masking::Uncorrelated,
                 sampling,
+                two_sided: false,
             })
         };
         if let Err(e) = spec.validate() {

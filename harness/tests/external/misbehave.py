@@ -3,7 +3,8 @@
 way named by its argument: crash, hang, garbage, nan, wrong_length, early_exit, bad_describe,
 wrong_id (protocol version 1); bad_base64, short_array, ragged_array, nan_binary, oversized
 (version 2: it chooses "protocol":2 at describe); base64_in_v1 (a version-1 child answering a
-version-2 array). Writes its pid to the file named by the second argument (the test checks that mfh
+version-2 array); bsdf_nan (a BSDF whose answers hold NaN: the last eval or pdf value; the
+weight of the first sample; the wo of the second sample, a failed one with pdf 0). Writes its pid to the file named by the second argument (the test checks that mfh
 leaves no child running)."""
 import base64
 import json
@@ -35,8 +36,27 @@ for line in sys.stdin:
         if mode == "bad_describe":
             send({"id": req["id"], "protocol": 1, "capabilities": ["lambda"]})
             continue
+        if mode == "bsdf_nan":
+            send({"id": req["id"], "protocol": 1, "name": "misbehave-" + mode,
+                  "capabilities": ["bsdf_eval", "bsdf_pdf", "bsdf_sample"], "parameters": {}})
+            continue
         send({"id": req["id"], "protocol": 2 if V2 else 1, "name": "misbehave-" + mode,
               "capabilities": ["d", "lambda", "sample_wm"], "parameters": {}})
+        continue
+    if mode == "bsdf_nan":
+        nan = float("nan")
+        if req["op"] == "bsdf_sample":
+            n = len(req["u"])
+            wo = [[0.0, 0.0, 1.0]] * n
+            pdf = [1.0] * n
+            weight = [0.5] * n
+            weight[0] = nan
+            if n > 1:
+                wo[1], pdf[1], weight[1] = [nan, nan, nan], 0.0, 0.0
+            send({"id": req["id"], "wo": wo, "pdf": pdf, "weight": weight})
+        else:
+            n = len(req["wo"])
+            send({"id": req["id"], "values": [0.5] * (n - 1) + [nan]})
         continue
     n = req["n"] if V2 else len(req.get("m", req.get("u", req.get("w", []))))
 

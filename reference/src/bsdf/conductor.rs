@@ -115,6 +115,10 @@ impl Bsdf for Conductor {
         self.evaluate(wi, wo)
     }
 
+    fn reference_map(&self) -> Option<super::Sampling> {
+        Some(self.microfacet.sampling())
+    }
+
     fn sample(&self, wi: Vec3, u: [f64; 3]) -> Option<BsdfSample> {
         if !finite(wi) || !(wi[2] > 0.0) {
             return None;

@@ -249,6 +249,10 @@ impl Bsdf for Dielectric {
         Some(self.eta)
     }
 
+    fn reference_map(&self) -> Option<super::Sampling> {
+        Some(self.microfacet.sampling())
+    }
+
     fn transport(&self) -> Transport {
         self.transport
     }

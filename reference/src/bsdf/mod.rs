@@ -20,6 +20,34 @@
 //!   ∫ pdf dωo = 1 − (probability of failure) ≤ 1.
 //! - **Relative index.** `eta()` = η_inside / η_outside (`None`: reflection only). The index on
 //!   `wi`'s side is η_i (1 if wi_z > 0, else η), the one on `wo`'s side η_o.
+//! - **Sides of a reflector.** A reflection-only BSDF is one-sided by default: 0 for wi_z < 0
+//!   (a conductor seen from below is black). A two-sided one ([`Bsdf::two_sided`], Mitsuba's
+//!   `twosided` wrapper, a renderer's conductor that mirrors wi below the surface) evaluates
+//!   (wi, wo) with wi_z < 0 as its front side evaluates (wi', wo') with z negated in both
+//!   ([`TwoSided`]): it reflects into the hemisphere of wi, from either side.
+//! - **Below the horizon: D and Λ.** D(m) = 0 for m_z ≤ 0 (microfacet normals face out). An
+//!   NDF's Λ(w) is asked only for w_z > 0. A BSDF needs the masking of a direction below the
+//!   surface too (transmission, incidence from inside): the reference BSDFs evaluate it as
+//!   Λ(w⁺), w⁺ = −w for w_z < 0 (the microsurface seen from below; [`microfacet`]'s module
+//!   documentation). Smith's Λ continued below the horizon obeys Λ(−w) = −1 − Λ(w) (the
+//!   relation Heitz, Hanika, d'Eon & Dachsbacher 2016, "Multiple-scattering microfacet BSDFs
+//!   with the Smith model", use for downward directions); mfh never asks for that
+//!   continuation (an external child's `lambda` is asked only for w_z > 0), and the masking
+//!   of a downward direction in a BSDF is Λ(w⁺), not the continued Λ(w).
+//! - **The sample map and its u.** `sample(wi, u)`: `u[0]` chooses the lobe (a dielectric
+//!   reflects when u\[0\] < F(wi·m), the Fresnel reflectance of the sampled normal m, and
+//!   refracts otherwise); `u[1]`, `u[2]` draw the microfacet normal, by convention of the
+//!   reference samplers: visible normals (Heitz 2018, polar disk map): `u[1]` is the *radial*
+//!   coordinate (disk radius √u\[1\]) and `u[2]` the azimuth 2π u\[2\]; normals (Walter 2007 in
+//!   slope space): `u[1]` the azimuth 2π u\[1\] and `u[2]` the *polar* coordinate (slope radius
+//!   from u\[2\]). A renderer's map may differ (a concentric disk map, the other u order, its own
+//!   tangent frame): only the distribution of `wo` is a property of the BSDF, so mfh compares
+//!   sampled directions for the same u only with a BSDF that declares the reference map
+//!   ([`Bsdf::reference_map`]).
+//! - **A failed sample.** `sample` returns `None` (through the external protocol: pdf 0 and
+//!   weight 0, wo ignored) where it produces no direction: a reflected or refracted direction on
+//!   the wrong side, a back-facing normal, a non-finite input. A sample of pdf 0 is a failed
+//!   sample too. The failure probability is 1 − ∫ pdf dωo.
 //!
 //! # Transport convention
 //!
@@ -72,6 +100,7 @@ pub mod fresnel_block;
 pub mod microfacet;
 mod scatter_block;
 pub mod spec;
+mod two_sided;
 
 #[cfg(test)]
 mod direction_tests;
@@ -87,6 +116,7 @@ pub use error::BsdfError;
 pub use fresnel::FresnelModel;
 pub use microfacet::{Microfacet, Sampling};
 pub use spec::{BsdfSpec, ConductorSpec, DielectricSpec};
+pub use two_sided::TwoSided;
 
 use crate::geometry::Vec3;
 
@@ -195,6 +225,24 @@ pub trait Bsdf: Send + Sync {
         Transport::Radiance
     }
 
+    /// Whether a reflection-only BSDF reflects from both sides (default `false`: black from
+    /// below). A two-sided one evaluates and samples (wi, wo) with wi_z < 0 as (wi', wo') with
+    /// z negated in both ([`TwoSided`]); it is audited from below too. Meaningless for a
+    /// transmitting BSDF (`eta()` is `Some`), which has both sides anyway.
+    fn two_sided(&self) -> bool {
+        false
+    }
+
+    /// The reference sampler whose map u ↦ wo [`Bsdf::sample`] reproduces, if any (default
+    /// `None`: the BSDF's own map). A BSDF that declares `Some(s)` promises the reference
+    /// BSDF's map with sampling `s` (see the module documentation, *The sample map and its
+    /// u*), and `bsdf.against` then compares its sampled direction with the reference's for the
+    /// same u; otherwise only what the map's distribution determines is compared (eval and pdf
+    /// at the sampled directions, and the chi-square of `bsdf.chi2`).
+    fn reference_map(&self) -> Option<Sampling> {
+        None
+    }
+
     /// `out[k] = self.eval(wi[k], wo[k])` (the default loops over [`Bsdf::eval`]).
     ///
     /// # Panics
@@ -285,6 +333,12 @@ macro_rules! delegate_bsdf {
             }
             fn transport(&self) -> Transport {
                 (**self).transport()
+            }
+            fn two_sided(&self) -> bool {
+                (**self).two_sided()
+            }
+            fn reference_map(&self) -> Option<Sampling> {
+                (**self).reference_map()
             }
             fn eval_batch(&self, wi: &[Vec3], wo: &[Vec3], out: &mut [f64]) {
                 (**self).eval_batch(wi, wo, out)

@@ -6,12 +6,14 @@
 //!  "masking": "height_correlated", "sampling": "visible_normals", "transport": "radiance"}
 //! {"bsdf": "conductor", "n": 0.18, "k": 3.42, "fresnel": "exact",
 //!  "ndf": {"family": "beckmann", "alpha_x": 0.1, "alpha_y": 0.4},
-//!  "masking": "uncorrelated", "sampling": "normals"}
+//!  "masking": "uncorrelated", "sampling": "normals", "two_sided": true}
 //! ```
 //!
 //! `ndf` is any model spec (`ModelSpec`) whose model has a Smith Λ. Defaults: `masking`
-//! `height_correlated`, `sampling` `visible_normals`, `transport` `radiance`, `fresnel` `exact`
-//! (serialization writes every field). Unknown keys are errors.
+//! `height_correlated`, `sampling` `visible_normals`, `transport` `radiance`, `fresnel` `exact`,
+//! `two_sided` `false` (a conductor only: [`super::TwoSided`]; a dielectric has both sides).
+//! Serialization writes every field but `two_sided: false` (so that specs written before it
+//! existed serialize as they did). Unknown keys are errors.
 
 use std::sync::Arc;
 
@@ -60,6 +62,10 @@ pub struct ConductorSpec {
     /// `visible_normals` (default), `normals` or `pseudo_vnis`.
     #[serde(default)]
     pub sampling: Sampling,
+    /// Whether it reflects from below as from above ([`super::TwoSided`]; default `false`:
+    /// black from below).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub two_sided: bool,
 }
 
 /// A rough dielectric ([`Dielectric`]).
@@ -142,6 +148,11 @@ impl BsdfSpec {
         }
     }
 
+    /// Whether the BSDF reflects from both sides (a two-sided conductor).
+    pub fn two_sided(&self) -> bool {
+        matches!(self, BsdfSpec::Conductor(s) if s.two_sided)
+    }
+
     /// Validates every field (building the NDF): the first error, naming its field and limit.
     pub fn validate(&self) -> Result<(), BsdfError> {
         self.build().map(|_| ())
@@ -154,7 +165,12 @@ impl BsdfSpec {
                 // The numbers first, so that an error names the first bad field as written.
                 super::conductor::check_nk(s.n, s.k)?;
                 let mf = microfacet(&s.ndf, s.masking, s.sampling)?;
-                Arc::new(Conductor::new(s.n, s.k, s.fresnel, mf)?)
+                let conductor = Conductor::new(s.n, s.k, s.fresnel, mf)?;
+                if s.two_sided {
+                    Arc::new(super::TwoSided(conductor))
+                } else {
+                    Arc::new(conductor)
+                }
             }
             BsdfSpec::Dielectric(s) => {
                 super::dielectric::check_eta(s.eta)?;

@@ -10,7 +10,7 @@
 //! | `bsdf.energy` | `albedo.rs` | ∫ eval ≤ 1 where the transport makes that a law |
 //! | `bsdf.reciprocity` | `reciprocity.rs` | f(wi, wo) against f(wo, wi) with the transport's η² |
 //! | `bsdf.stability` | `stability.rs` | finite, non-negative, sampled where valued, at the hard cases |
-//! | `bsdf.against` | `against.rs` | eval, pdf and sampled wo against a reference BSDF |
+//! | `bsdf.against` | `against.rs` | eval and pdf against a reference BSDF on a grid and in its lobes, the samples' pdf and weight at their wo, the wo for the same u where the BSDF declares the reference map |
 //! | `bsdf.ndf_consistency` | `ndf.rs` | eval (and a visible-normal pdf) against Walter's eq 20/21 from the BSDF's own D and Λ |
 //!
 //! Incidences ([`incidences`]): normal, oblique and grazing (cos θi = 0.05) from outside; for a
@@ -19,6 +19,8 @@
 //! transport) are those of [`mfh_reference::bsdf`].
 
 mod against;
+#[cfg(test)]
+mod against_tests;
 mod albedo;
 mod chi2;
 mod consistency;
@@ -46,7 +48,8 @@ pub const SOURCE: &str = "Walter et al. 2007 (seed 001 [13]) eq 13–23; Walter 
 /// An incidence at which the direction-dependent checks run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Incidence {
-    /// What it is (`normal`, `oblique`, `grazing`, `inside`, `total_internal_reflection`).
+    /// What it is (`normal`, `oblique`, `grazing`, `inside`, `total_internal_reflection`,
+    /// `back_oblique`, `back_grazing`).
     pub name: &'static str,
     /// The direction (unit; z < 0 from inside).
     pub wi: Vec3,
@@ -75,7 +78,8 @@ impl Incidence {
 }
 
 /// The incidences of a BSDF: normal (cos θ = 1 − 5e-7), oblique (θ = 0.9) and grazing (cos θ =
-/// 0.05) from outside; for a transmitting BSDF of relative index η, from inside at θ = 0.5 and,
+/// 0.05) from outside; for a two-sided reflector, oblique and grazing from below; for a
+/// transmitting BSDF of relative index η, from inside at θ = 0.5 and,
 /// on the denser side, beyond the critical angle θc = asin(η_thin/η_dense) by a third of what is
 /// left to grazing (total internal reflection for every microfacet near the macro-normal).
 pub fn incidences(bsdf: &dyn Bsdf) -> Vec<Incidence> {
@@ -94,6 +98,10 @@ pub fn incidences(bsdf: &dyn Bsdf) -> Vec<Incidence> {
             theta.cos(),
             eta > 1.0,
         ));
+    } else if bsdf.two_sided() {
+        // A two-sided reflector is audited from its back side too.
+        out.push(Incidence::at("back_oblique", 0.9f64.cos(), true));
+        out.push(Incidence::at("back_grazing", 0.05, true));
     }
     out
 }
