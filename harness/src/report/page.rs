@@ -52,6 +52,15 @@ pub(crate) fn fmt_num(x: f64) -> String {
 
 /// The measured discrepancy against the tolerance, as one line of text.
 pub fn measured_text(r: &CheckRecord) -> String {
+    let text = measured_only(r);
+    match &r.region {
+        Some(region) => format!("{text}; {}", region.text),
+        None => text,
+    }
+}
+
+/// [`measured_text`] without the region.
+fn measured_only(r: &CheckRecord) -> String {
     let tol = r
         .tolerance
         .as_ref()

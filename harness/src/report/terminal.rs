@@ -66,6 +66,9 @@ pub fn render(report: &AuditReport, max_failures: usize) -> String {
                 r.measured,
                 r.verdict
             );
+            if let Some(region) = &r.region {
+                let _ = writeln!(o, "    region: {}", region.text);
+            }
             if let Some(note) = r.oracle.and_then(|o| o.noise_note()) {
                 let _ = writeln!(o, "    ({note})");
             }

@@ -11,6 +11,7 @@
 //! | `bsdf.reciprocity` | `reciprocity.rs` | f(wi, wo) against f(wo, wi) with the transport's η² |
 //! | `bsdf.stability` | `stability.rs` | finite, non-negative, sampled where valued, at the hard cases |
 //! | `bsdf.against` | `against.rs` | eval, pdf and sampled wo against a reference BSDF |
+//! | `bsdf.jacobian` | `jacobian.rs` | `pdf` against the density of `sample`'s map (u₁, u₂) ↦ wo, lobe by lobe, at a sweep of incidences (`check/regime.rs`) |
 //! | `bsdf.ndf_consistency` | `ndf.rs` | eval (and a visible-normal pdf) against Walter's eq 20/21 from the BSDF's own D and Λ |
 //!
 //! Incidences ([`incidences`]): normal, oblique and grazing (cos θi = 0.05) from outside; for a
@@ -22,6 +23,7 @@ mod against;
 mod albedo;
 mod chi2;
 mod consistency;
+pub mod jacobian;
 mod ndf;
 mod reciprocity;
 mod stability;
@@ -112,6 +114,7 @@ pub fn plan<'a>(
         out.extend(consistency::plan(subject, *inc, &shared, profile, why));
         out.extend(albedo::plan(subject, *inc, &shared, profile, why));
     }
+    out.extend(jacobian::plan(subject, why));
     out.push(reciprocity::plan(subject, why));
     out.extend(ndf::plan(subject, why));
     out.extend(stability::plan(subject, why));
