@@ -22,11 +22,12 @@
 
 use super::SOURCE as BSDF_SOURCE;
 use crate::check::regime::{self, AtIncidence, SweepPoint};
-use crate::check::Check;
-use crate::check::{applied, PlannedCheck};
+use crate::check::{applied, Check, PlannedCheck, Profile};
+use crate::oracle::chi2::Chi2Config;
+use crate::oracle::sphere_chi2::{chi2_masses, sphere_chi2_against};
 use crate::record::{Measured, RecordData, Verdict};
 use crate::subject::bsdf::BsdfSubject;
-use crate::tolerance::PDF_JACOBIAN;
+use crate::tolerance::{PDF_JACOBIAN, STATISTICAL_ALPHA};
 use mfh_reference::bsdf::{Bsdf, Directions};
 use mfh_reference::geometry::Vec3;
 use serde_json::json;
@@ -194,6 +195,28 @@ pub fn measure(
     out
 }
 
+/// The chi-square of the sampled directions against `pdf` over the whole sphere at `wi`
+/// (`bsdf.chi2`'s oracle, at the profile's samples), as the record's `chi2_at_worst`: its p-value,
+/// the samples and the pdf evaluations its masses cost.
+fn confirm(bsdf: &dyn Bsdf, wi: Vec3, profile: Profile, seed: u64) -> serde_json::Value {
+    let samples = profile.chi2_samples();
+    let masses = chi2_masses(&super::pdf_at(bsdf, wi), super::chi2::RESOLUTION, samples);
+    let evaluations = masses.upper.evaluations + masses.lower.evaluations;
+    let config = Chi2Config {
+        resolution: super::chi2::RESOLUTION,
+        samples,
+        seed,
+        alpha: STATISTICAL_ALPHA.value,
+    };
+    let result = sphere_chi2_against(
+        &|u: &[[f64; 3]], out: &mut Directions| bsdf.sample_wo_batch(wi, u, out),
+        masses,
+        &config,
+    );
+    json!({"wi": wi, "samples": samples, "p_value": result.p_value,
+           "sanity_failure": result.sanity_failure, "pdf_evaluations": evaluations})
+}
+
 /// The roughness the near-normal sweep stretches by: α (the smaller of αx, αy) of a reference
 /// BSDF's NDF; 0.3 for a BSDF that does not say (the sweep then covers tan θi from 3.3e-6 to
 /// 0.33, still a quarter decade apart).
@@ -217,7 +240,11 @@ fn alpha_of(subject: &BsdfSubject<'_>) -> f64 {
 }
 
 /// Plans `bsdf.jacobian` from outside and, for a transmitting BSDF, from inside.
-pub fn plan<'a>(subject: &Arc<BsdfSubject<'a>>, why: &str) -> Vec<PlannedCheck<'a>> {
+pub fn plan<'a>(
+    subject: &Arc<BsdfSubject<'a>>,
+    profile: Profile,
+    why: &str,
+) -> Vec<PlannedCheck<'a>> {
     let eta = subject.bsdf.eta();
     let sides: &[bool] = if eta.is_some() {
         &[false, true]
@@ -299,6 +326,20 @@ pub fn plan<'a>(subject: &Arc<BsdfSubject<'a>>, why: &str) -> Vec<PlannedCheck<'
                         x: at.iter().map(|a| a.theta).collect(),
                         y: at.iter().map(|a| a.worst).collect(),
                     });
+                    if worst.fails {
+                        // Where the deterministic check disagrees, the statistical one runs
+                        // at the profile's sample count (only then: a passing BSDF pays
+                        // nothing), its p-value recorded beside the Jacobian's verdict.
+                        let wi = SweepPoint {
+                            theta: worst.theta,
+                            phi,
+                            regime: "worst",
+                        };
+                        let confirm = confirm(bsdf, wi.direction(inside), profile, ctx.seed);
+                        if let serde_json::Value::Object(case) = &mut r.case {
+                            case.insert("chi2_at_worst".into(), confirm);
+                        }
+                    }
                     r.verdict = if resolved * 2 < measured {
                         Verdict::Error {
                             message: format!(

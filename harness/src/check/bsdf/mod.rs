@@ -114,7 +114,7 @@ pub fn plan<'a>(
         out.extend(consistency::plan(subject, *inc, &shared, profile, why));
         out.extend(albedo::plan(subject, *inc, &shared, profile, why));
     }
-    out.extend(jacobian::plan(subject, why));
+    out.extend(jacobian::plan(subject, profile, why));
     out.push(reciprocity::plan(subject, why));
     out.extend(ndf::plan(subject, why));
     out.extend(stability::plan(subject, why));
