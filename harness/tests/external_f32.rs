@@ -876,7 +876,11 @@ fn the_cpp_frame_switch_fails_the_visible_jacobian_near_the_normal() {
                 let g = r.region.expect("a failing sweep has a region");
                 assert!(g.to > 0.008 && g.to < 0.0155 && g.from < 0.01, "{}", g.text);
             } else {
-                assert!(!r.verdict.is_failure(), "{cmd} seed {seed}: {:?}", r.verdict);
+                assert!(
+                    !r.verdict.is_failure(),
+                    "{cmd} seed {seed}: {:?}",
+                    r.verdict
+                );
             }
         }
     }

@@ -136,7 +136,10 @@ fn total_internal_reflection_decided_early_fails_around_the_critical_angle() {
         // The chi-square ran where the Jacobian disagreed; its p-value is recorded.
         let chi2 = &inside.case["chi2_at_worst"];
         println!("seed {seed}: chi-square at the worst incidence {chi2}");
-        assert!(chi2["p_value"].is_number() || chi2["sanity_failure"] == true, "{chi2}");
+        assert!(
+            chi2["p_value"].is_number() || chi2["sanity_failure"] == true,
+            "{chi2}"
+        );
     }
 }
 
