@@ -245,6 +245,34 @@ pub struct CheckRecord {
     /// write it into artefact files and leave it out of `report.json` (which lists the paths).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub data: Option<RecordData>,
+    /// Where a check that sweeps incidences fails: the interval of θi its failure was narrowed
+    /// to by bisection (`check/regime.rs`); None for a check that does not sweep, or passes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub region: Option<Region>,
+}
+
+/// The region a failing sweep was narrowed to: "density off by up to 1.1 % for
+/// θi ∈ [0, 0.089] rad at α 0.05".
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Region {
+    /// The swept quantity (`theta_i`, radians).
+    pub quantity: String,
+    /// The region's ends: the failing incidences nearest the passing ones after bisection.
+    pub from: f64,
+    /// See `from`.
+    pub to: f64,
+    /// The largest error measured in the region.
+    #[serde(deserialize_with = "nullable_f64")]
+    pub worst: f64,
+    /// The incidence of the worst error among the sweep's.
+    pub at: f64,
+    /// How many of the sweep's incidences fail (the region holds the run around the worst;
+    /// others may fail elsewhere).
+    pub failing_incidences: usize,
+    /// How many incidences the sweep measured.
+    pub incidences: usize,
+    /// The region in words.
+    pub text: String,
 }
 
 /// The data a check measured beyond one number: what the sinks (`crate::report`) write as
@@ -366,6 +394,7 @@ impl CheckRecord {
             covers: Vec::new(),
             artefacts: Vec::new(),
             data: None,
+            region: None,
         }
     }
 

@@ -34,6 +34,7 @@ pub mod limits;
 pub mod moments;
 pub mod normalization;
 pub mod precise;
+pub mod regime;
 pub mod route_domain;
 pub mod route_stress;
 pub mod run;

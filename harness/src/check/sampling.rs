@@ -14,6 +14,7 @@ pub mod batch_agrees;
 mod ks;
 mod pseudo_vnis;
 mod visible;
+pub mod visible_jacobian;
 
 pub use pseudo_vnis::plan_pseudo_vnis;
 pub use visible::{plan_visible, terminator_azimuths, visible_kinks, VISIBLE_INCIDENCES};

@@ -136,12 +136,26 @@ pub(crate) fn data_plots(r: &CheckRecord) -> Result<String, PlotError> {
             Ok(img(&stacked_svg(&plot, &diff)?, &format!("{} KS", r.check)))
         }
         Some(RecordData::Curve { label, x, y }) => {
+            // A curve of positive values over decades (an error against incidence, swept
+            // log-spaced near the normal) on log axes.
+            let decades = |v: &[f64]| {
+                let (lo, hi) = v
+                    .iter()
+                    .filter(|v| v.is_finite())
+                    .fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
+                v.iter().all(|v| *v > 0.0) && hi > 100.0 * lo
+            };
             let plot = LinePlot {
                 title: format!("{label} · {title}"),
-                x_label: "x".into(),
+                x_label: if label.contains("θi") {
+                    "θi (rad)"
+                } else {
+                    "x"
+                }
+                .into(),
                 y_label: "y".into(),
-                x_log: false,
-                y_log: false,
+                x_log: decades(x),
+                y_log: decades(y),
                 series: vec![Series::new(
                     label.clone(),
                     x.iter().copied().zip(y.iter().copied()).collect(),

@@ -272,11 +272,15 @@ pub fn tolerance(r: &CheckRecord) -> Option<String> {
 /// The measured discrepancy against the tolerance, as one line: `relative error 3.2e-16
 /// against closed_form = 1e-10 relative`.
 pub fn measured_against(r: &CheckRecord) -> String {
-    match (r.measured.is_some(), tolerance(r)) {
+    let text = match (r.measured.is_some(), tolerance(r)) {
         (true, Some(t)) if !matches!(r.measured, Some(Measured::PValue { .. })) => {
             format!("{} against {t}", measured(r))
         }
         _ => measured(r),
+    };
+    match &r.region {
+        Some(region) => format!("{text}; {}", region.text),
+        None => text,
     }
 }
 
@@ -324,6 +328,9 @@ pub fn fields(r: &CheckRecord) -> Vec<(&'static str, String)> {
     }
     if r.measured.is_some() {
         out.push(("measured", measured(r)));
+    }
+    if let Some(region) = &r.region {
+        out.push(("region", region.text.clone()));
     }
     if let Some(t) = &r.tolerance {
         let shown = tolerance(r).unwrap_or_default();

@@ -40,11 +40,14 @@ pub enum BsdfDefect {
     NanAtDegenerateHalfVector,
     /// `eval` 2 % too large for reflection (a Fresnel or G2 factor off), `sample` unchanged.
     ReflectionValueOff,
+    /// `sample` decides total internal reflection 1e-3 rad before the critical angle (the
+    /// angle between wi and m above θc − 1e-3 reflects), `pdf` at the true θc.
+    TotalInternalReflectionEarly,
 }
 
 impl BsdfDefect {
     /// Every defect.
-    pub const ALL: [BsdfDefect; 13] = [
+    pub const ALL: [BsdfDefect; 14] = [
         BsdfDefect::WeightOff,
         BsdfDefect::ReflectionJacobianMissing,
         BsdfDefect::RefractionJacobianMissing,
@@ -58,6 +61,7 @@ impl BsdfDefect {
         BsdfDefect::ArgumentsSwapped,
         BsdfDefect::NanAtDegenerateHalfVector,
         BsdfDefect::ReflectionValueOff,
+        BsdfDefect::TotalInternalReflectionEarly,
     ];
 
     /// The mutant's id.
@@ -76,6 +80,7 @@ impl BsdfDefect {
             BsdfDefect::ArgumentsSwapped => "bsdf_arguments_swapped",
             BsdfDefect::NanAtDegenerateHalfVector => "bsdf_nan_at_degenerate_half_vector",
             BsdfDefect::ReflectionValueOff => "bsdf_reflection_value_off",
+            BsdfDefect::TotalInternalReflectionEarly => "bsdf_total_internal_reflection_early",
         }
     }
 
@@ -109,6 +114,7 @@ impl BsdfDefect {
             BsdfDefect::SideConditionLostInEval => &["bsdf.stability", "bsdf.albedo"],
             BsdfDefect::NanAtDegenerateHalfVector => &["bsdf.stability"],
             BsdfDefect::ReflectionValueOff => &["bsdf.albedo", "bsdf.sample_consistency"],
+            BsdfDefect::TotalInternalReflectionEarly => &["bsdf.jacobian"],
         }
     }
 }
@@ -169,6 +175,29 @@ impl MutatedBsdf {
             1.0 / self.eta()
         };
         fresnel::dielectric(c.abs(), eta).reflectance
+    }
+
+    /// [`BsdfDefect::TotalInternalReflectionEarly`]: a refracted sample whose normal m makes
+    /// an angle with wi above θc − 1e-3 (from the denser side) reflected about m instead.
+    fn reflected_early(&self, wi: Vec3, s: BsdfSample) -> Option<BsdfSample> {
+        let (ni, no) = self.indices(wi, s.wo);
+        if wi[2] * s.wo[2] > 0.0 || ni <= no {
+            return Some(s);
+        }
+        let h = self.half(wi, s.wo)?;
+        let c = dot(wi, h);
+        if c.abs().min(1.0).acos() <= (no / ni).asin() - 1e-3 {
+            return Some(s);
+        }
+        let wo = [
+            2.0 * c * h[0] - wi[0],
+            2.0 * c * h[1] - wi[1],
+            2.0 * c * h[2] - wi[2],
+        ];
+        if !(wo[2] * wi[2] > 0.0) {
+            return None;
+        }
+        BsdfSample::at(wo, (self.eval(wi, wo), self.pdf(wi, wo)))
     }
 
     /// The factor by which the mutant's pdf differs from the base's at (wi, wo).
@@ -259,6 +288,7 @@ impl Bsdf for MutatedBsdf {
                 (f < 1.0).then_some(s)
             }
             BsdfDefect::ReflectionValueOff => Some(s),
+            BsdfDefect::TotalInternalReflectionEarly => self.reflected_early(wi, s),
             BsdfDefect::SideConditionLostInEval | BsdfDefect::NanAtDegenerateHalfVector => Some(s),
             _ => {
                 // The sample's pdf and weight as this mutant's pdf and eval give them.

@@ -46,6 +46,8 @@ pub struct Entry {
 
 const GGX: &str = r#"{"family":"ggx","alpha":0.3}"#;
 const GGX_ANISO: &str = r#"{"family":"ggx","alpha_x":0.1,"alpha_y":0.4}"#;
+/// A smooth GGX: its near-normal regime (α tan θi < 4.5e-3) spans θi < 0.089 rad.
+const GGX_SMOOTH: &str = r#"{"family":"ggx","alpha":0.05}"#;
 const GGX_VIS: &str = r#"{"family":"ggx","alpha_x":0.2,"alpha_y":0.5}"#;
 const BECKMANN: &str = r#"{"family":"beckmann","alpha":0.3}"#;
 const BECKMANN_ANISO: &str = r#"{"family":"beckmann","alpha_x":0.3,"alpha_y":0.15}"#;
@@ -79,6 +81,9 @@ const G2: &[&str] = &["smith.g1_g2"];
 const STAT: &[&str] = &["sampling.chi2", "sampling.ks_marginals"];
 const PDF: &[&str] = &["sampling.pdf_jacobian", "sampling.pdf_consistency"];
 const VIS: &[&str] = &["sampling.chi2_visible"];
+/// The regime defects of a visible-normal sampler: local in the incidence or in u, seen by the
+/// Jacobian at the sweep's incidences.
+const VIS_JACOBIAN: &[&str] = &["sampling.visible_jacobian"];
 const VIS_PDF: &[&str] = &[
     "sampling.pdf_visible_normalization",
     "sampling.chi2_visible",
@@ -314,6 +319,24 @@ pub const CATALOG: &[Entry] = &[
         Defect::VisiblePdfScale { e: 5e-3 },
         VIS_PDF,
         true
+    ),
+    // Regime defects of the visible-normal sampler (GGX, Heitz 2018).
+    entry!(
+        "ggx_smooth.visible_frame_switch",
+        "visible-normal sampler switches its frame to (1, 0, 0) where V_h is within 1e-5 of \
+         the normal (≈ 1 % density error for θi < 0.089 rad at α 0.05)",
+        GGX_SMOOTH,
+        Defect::VisibleFrameSwitch { within: 1e-5 },
+        VIS_JACOBIAN,
+        false
+    ),
+    entry!(
+        "ggx.visible_height_clamp",
+        "visible-normal sampler clamps the stretched normal's height at 1e-2",
+        GGX,
+        Defect::VisibleHeightClamp { floor: 1e-2 },
+        VIS_JACOBIAN,
+        false
     ),
     // Beckmann α = 0.3.
     entry!(

@@ -87,6 +87,21 @@ pub enum Defect {
         /// The relative error of θi.
         e: f64,
     },
+    /// Heitz's GGX visible-normal sampler with its tangent frame switched to the fixed axis
+    /// T1 = (1, 0, 0) where the stretched incidence is within `within` of the normal
+    /// (V_h,z ≥ 1 − `within`, as a renderer shipped it: that axis is not orthogonal to V_h, so
+    /// the map's density departs from the stated pdf by ≈ V_h's tilt).
+    VisibleFrameSwitch {
+        /// How near the normal (1 − V_h,z) the frame switches.
+        within: f64,
+    },
+    /// Heitz's GGX visible-normal sampler with the stretched normal's height clamped at
+    /// `floor` (max(`floor`, N_h,z) where the listing has max(0, N_h,z)): the normals near the
+    /// stretched horizon are moved up, the pdf is not.
+    VisibleHeightClamp {
+        /// The clamp.
+        floor: f64,
+    },
     /// pdf_wm_visible multiplied by 1 + `e`.
     VisiblePdfScale {
         /// The relative error.
@@ -140,6 +155,42 @@ impl std::fmt::Debug for Mutated {
     }
 }
 
+/// Heitz's GGX visible-normal sampler (Heitz 2018, JCGT 7(4), Listing 1; u₀ the radius, u₁
+/// the angle, as mfh's reference) written out with two regime defects: the tangent frame
+/// T1 = (1, 0, 0) where 1 − V_h,z ≤ `within` (0: only at exactly normal incidence, the
+/// listing's `lensq > 0` test), and the stretched normal's height clamped at `floor` (0: the
+/// listing's max(0, ·)).
+fn heitz_visible((ax, ay): (f64, f64), wi: Vec3, u: [f64; 2], within: f64, floor: f64) -> Vec3 {
+    let norm = |v: Vec3| {
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        [v[0] / l, v[1] / l, v[2] / l]
+    };
+    let vh = norm([ax * wi[0], ay * wi[1], wi[2]]);
+    let lensq = vh[0] * vh[0] + vh[1] * vh[1];
+    let t1 = if lensq > 0.0 && 1.0 - vh[2] > within {
+        [-vh[1] / lensq.sqrt(), vh[0] / lensq.sqrt(), 0.0]
+    } else {
+        [1.0, 0.0, 0.0]
+    };
+    let t2 = [
+        vh[1] * t1[2] - vh[2] * t1[1],
+        vh[2] * t1[0] - vh[0] * t1[2],
+        vh[0] * t1[1] - vh[1] * t1[0],
+    ];
+    let r = u[0].sqrt();
+    let (sp, cp) = (std::f64::consts::TAU * u[1]).sin_cos();
+    let p1 = r * cp;
+    let s = 0.5 * (1.0 + vh[2]);
+    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sp;
+    let lift = (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
+    let nh = [
+        p1 * t1[0] + p2 * t2[0] + lift * vh[0],
+        p1 * t1[1] + p2 * t2[1] + lift * vh[1],
+        p1 * t1[2] + p2 * t2[2] + lift * vh[2],
+    ];
+    norm([ax * nh[0], ay * nh[1], nh[2].max(floor)])
+}
+
 /// θ of a direction (radians).
 fn theta_of(w: Vec3) -> f64 {
     w[0].hypot(w[1]).atan2(w[2])
@@ -161,6 +212,14 @@ impl Mutated {
     /// The defect.
     pub fn defect(&self) -> Defect {
         self.defect
+    }
+
+    /// (αx, αy) of the base spec (1, 1 where it has none).
+    fn alphas(&self) -> (f64, f64) {
+        let spec = serde_json::to_value(self.base.spec()).unwrap_or_default();
+        let get = |k: &str| spec.get(k).and_then(serde_json::Value::as_f64);
+        let a = get("alpha").unwrap_or(1.0);
+        (get("alpha_x").unwrap_or(a), get("alpha_y").unwrap_or(a))
     }
 
     fn base_smith(&self) -> Option<&dyn Smith> {
@@ -295,6 +354,10 @@ impl VisibleNormalSampler for Mutated {
                 let w = mfh_reference::geometry::from_spherical(theta, phi);
                 v.sample_wm_visible(w, u)
             }
+            Defect::VisibleFrameSwitch { within } => {
+                heitz_visible(self.alphas(), wi, u, within, 0.0)
+            }
+            Defect::VisibleHeightClamp { floor } => heitz_visible(self.alphas(), wi, u, 0.0, floor),
             _ => v.sample_wm_visible(wi, u),
         }
     }

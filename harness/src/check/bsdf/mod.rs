@@ -11,6 +11,7 @@
 //! | `bsdf.reciprocity` | `reciprocity.rs` | f(wi, wo) against f(wo, wi) with the transport's η² |
 //! | `bsdf.stability` | `stability.rs` | finite, non-negative, sampled where valued, at the hard cases |
 //! | `bsdf.against` | `against.rs` | eval and pdf against a reference BSDF on a grid and in its lobes, the samples' pdf and weight at their wo, the wo for the same u where the BSDF declares the reference map |
+//! | `bsdf.jacobian` | `jacobian.rs` | `pdf` against the density of `sample`'s map (u₁, u₂) ↦ wo, lobe by lobe, at a sweep of incidences (`check/regime.rs`) |
 //! | `bsdf.ndf_consistency` | `ndf.rs` | eval (and a visible-normal pdf) against Walter's eq 20/21 from the BSDF's own D and Λ |
 //!
 //! Incidences ([`incidences`]): normal, oblique and grazing (cos θi = 0.05) from outside; for a
@@ -24,6 +25,7 @@ mod against_tests;
 mod albedo;
 mod chi2;
 mod consistency;
+pub mod jacobian;
 mod ndf;
 mod reciprocity;
 mod stability;
@@ -120,6 +122,7 @@ pub fn plan<'a>(
         out.extend(consistency::plan(subject, *inc, &shared, profile, why));
         out.extend(albedo::plan(subject, *inc, &shared, profile, why));
     }
+    out.extend(jacobian::plan(subject, profile, why));
     out.push(reciprocity::plan(subject, why));
     out.extend(ndf::plan(subject, why));
     out.extend(stability::plan(subject, why));

@@ -170,6 +170,7 @@ mutant_tests! {
     arguments_swapped: ArgumentsSwapped,
     nan_at_degenerate_half_vector: NanAtDegenerateHalfVector,
     reflection_value_off: ReflectionValueOff,
+    total_internal_reflection_early: TotalInternalReflectionEarly,
 }
 
 #[test]

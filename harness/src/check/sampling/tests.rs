@@ -33,8 +33,9 @@ fn visible_samplers_pass_their_checks() {
     ] {
         let (_, m) = model(json);
         let records = run(&plan_visible(&m, Profile::Quick, "test"));
-        // chi-square and normalization per incidence, and one `sampling.batch_agrees`.
-        assert_eq!(records.len(), 2 * VISIBLE_INCIDENCES.len() + 1);
+        // chi-square and normalization per incidence, one `sampling.visible_jacobian` (its
+        // own sweep of incidences) and one `sampling.batch_agrees`.
+        assert_eq!(records.len(), 2 * VISIBLE_INCIDENCES.len() + 2);
         for r in &records {
             assert_eq!(r.verdict, Verdict::Pass, "{r:?}");
         }

@@ -131,6 +131,7 @@ pub fn plan_visible<'a>(
             }),
         );
     }
+    out.push(super::visible_jacobian::plan(subject, why));
     out.extend(super::batch_agrees::plan_visible(
         subject,
         &VISIBLE_INCIDENCES,

@@ -1,0 +1,409 @@
+//! Where samplers change regime, and how a failure is narrowed to a region: the incidences the
+//! Jacobian checks sweep (near normal, log-spaced in the stretched tilt α tan θi; around the
+//! critical angle on both sides; towards grazing; drawn per seed), the densities of a sampling
+//! map u ↦ direction by Richardson-extrapolated central differences at many points in one
+//! batch, and the bisection that narrows a failure found at some incidences to the interval of
+//! θi where it holds (the record's [`Region`]).
+//!
+//! A Jacobian check is deterministic, cheap (tens of sampler calls a point) and local: it sees
+//! a 1 % density error in a corner of the incidences that a chi-square over the whole sphere
+//! dilutes, so it runs at many incidences where the chi-square runs at a handful.
+
+use crate::precision::Precision;
+use crate::random::Stream;
+use crate::record::Region;
+use mfh_reference::geometry::Vec3;
+
+/// The stretched tilts t = α tan θi of the near-normal sweep: a quarter decade apart from 1e-6
+/// to 1e-1. A sampler that switches its frame or its branch at a tilt t₀ is seen at the tilts
+/// within its region; a quarter decade keeps one of them inside a region half a decade wide
+/// even where the lobe's α is only known to a factor 1.5.
+pub fn stretched_tilts() -> Vec<f64> {
+    (0..=20)
+        .map(|k| 10f64.powf(-6.0 + 0.25 * f64::from(k)))
+        .collect()
+}
+
+/// The offsets (radians) from the critical angle, on both sides, of the critical sweep.
+pub const CRITICAL_OFFSETS: [f64; 5] = [1e-4, 1e-3, 3e-3, 1e-2, 3e-2];
+
+/// The cosines of the grazing sweep.
+pub const GRAZING_COSINES: [f64; 3] = [0.1, 0.03, 0.01];
+
+/// The polar angles of the oblique incidences.
+pub const OBLIQUE_THETAS: [f64; 2] = [0.5, 1.0];
+
+/// The incidences drawn per seed.
+pub const DRAWN: usize = 4;
+
+/// The azimuth of the fixed incidences: off the axes of an anisotropic lobe and of the grid's
+/// column edges (as the BSDF checks' [`crate::check::bsdf::Incidence`]).
+pub const PHI: f64 = 0.3;
+
+/// One incidence of a sweep: its polar angle θi (from the side's normal), azimuth and what
+/// regime put it there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SweepPoint {
+    /// θi, radians, measured from the normal on the incidence's side.
+    pub theta: f64,
+    /// The azimuth.
+    pub phi: f64,
+    /// `near_normal`, `critical`, `oblique`, `grazing` or `drawn`.
+    pub regime: &'static str,
+}
+
+impl SweepPoint {
+    /// The direction, in the upper hemisphere (`inside`: mirrored below).
+    pub fn direction(&self, inside: bool) -> Vec3 {
+        let (s, c) = self.theta.sin_cos();
+        let z = if inside { -c } else { c };
+        [s * self.phi.cos(), s * self.phi.sin(), z]
+    }
+}
+
+/// The incidences of one side: near normal (tan θi = t/`alpha` over [`stretched_tilts`]),
+/// oblique, grazing, around `critical` (θc ± [`CRITICAL_OFFSETS`]) when the side has a critical
+/// angle, and [`DRAWN`] drawn from `seed` (θi uniform in cos θ ∈ (0.01, 1), φ uniform), sorted
+/// by θi.
+pub fn sweep(alpha: f64, critical: Option<f64>, seed: Option<u64>) -> Vec<SweepPoint> {
+    let mut out: Vec<SweepPoint> = stretched_tilts()
+        .into_iter()
+        .map(|t| SweepPoint {
+            theta: (t / alpha).atan(),
+            phi: PHI,
+            regime: "near_normal",
+        })
+        .collect();
+    for theta in OBLIQUE_THETAS {
+        out.push(SweepPoint {
+            theta,
+            phi: PHI,
+            regime: "oblique",
+        });
+    }
+    for c in GRAZING_COSINES {
+        out.push(SweepPoint {
+            theta: c.acos(),
+            phi: PHI,
+            regime: "grazing",
+        });
+    }
+    if let Some(tc) = critical {
+        for d in CRITICAL_OFFSETS {
+            for theta in [tc - d, tc + d] {
+                if theta > 0.0 && theta.cos() > GRAZING_COSINES[2] {
+                    out.push(SweepPoint {
+                        theta,
+                        phi: PHI,
+                        regime: "critical",
+                    });
+                }
+            }
+        }
+    }
+    if let Some(seed) = seed {
+        // Stream id: a constant of this sweep, so the draws depend on the seed alone.
+        let mut rng = Stream::new(seed, 0x5eed_5eee);
+        for _ in 0..DRAWN {
+            let [a, b] = rng.pair();
+            let c = 0.01 + 0.99 * a;
+            out.push(SweepPoint {
+                theta: c.acos(),
+                phi: std::f64::consts::TAU * b,
+                regime: "drawn",
+            });
+        }
+    }
+    out.sort_by(|a, b| a.theta.total_cmp(&b.theta));
+    out
+}
+
+/// The step in u of the central differences for a map computed in `precision`, and the
+/// relative disagreement between the step and half of it beyond which a point is unresolved
+/// (see `check/jacobian.rs` for the derivation: f64 steps 1e-4/5e-5, round-off ≈ 2e-12 and
+/// truncation O(h⁴) after extrapolation; f32 steps 4e-3/2e-3 at ε₃₂^(1/3)).
+pub fn stencil(precision: Precision) -> (f64, f64) {
+    match precision {
+        Precision::F64 => (1e-4, 1e-3),
+        Precision::F32 => (4e-3, 1e-2),
+    }
+}
+
+/// The quasi-random points (u₁, u₂) of a Jacobian check: a golden-ratio lattice of `n` points
+/// kept 2.5 steps from the square's edges (the stencil reaches 1 step out), so that the
+/// corners of u that map near the horizon of a warped disk are measured too.
+pub fn points(n: usize, step: f64) -> Vec<[f64; 2]> {
+    let margin = 2.5 * step;
+    let span = 1.0 - 2.0 * margin;
+    let golden = 0.618_033_988_749_894_9;
+    (0..n)
+        .map(|i| {
+            let i = i as f64;
+            [
+                margin + span * (i + 0.5) / n as f64,
+                margin + span * (i * golden).fract(),
+            ]
+        })
+        .collect()
+}
+
+/// The two central-difference densities 1/|∂w/∂u₁ × ∂w/∂u₂| at one point, with steps h and
+/// h/2; the Richardson extrapolation (4 fine − coarse)/3 cancels their h² error.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Density {
+    /// With step h.
+    pub coarse: f64,
+    /// With step h/2.
+    pub fine: f64,
+}
+
+impl Density {
+    /// The extrapolated density.
+    pub fn value(&self) -> f64 {
+        (4.0 * self.fine - self.coarse) / 3.0
+    }
+
+    /// |coarse − fine| / fine: the size of the extrapolated term, an upper bound on what the
+    /// extrapolation leaves where the map is smooth within the stencil.
+    pub fn spread(&self) -> f64 {
+        ((self.coarse - self.fine) / self.fine).abs()
+    }
+}
+
+/// The offsets of a point's stencil in (u₁, u₂), in steps: ±1 and ±½ along each.
+const STENCIL: [(f64, f64); 8] = [
+    (1.0, 0.0),
+    (-1.0, 0.0),
+    (0.0, 1.0),
+    (0.0, -1.0),
+    (0.5, 0.0),
+    (-0.5, 0.0),
+    (0.0, 0.5),
+    (0.0, -0.5),
+];
+
+/// A sampling map in batch: `out[k]` the direction of `u[k]` (u₀, u₁, u₂), None where it fails.
+pub type BatchMap<'m> = dyn FnMut(&[[f64; 3]], &mut [Option<Vec3>]) + 'm;
+
+/// The directions at `centres` (u₀ fixed, u₁ and u₂ the coordinates of the map) and, where the
+/// map is defined on the whole stencil and stays on the centre's side of the surface there,
+/// its density by central differences with step `h`. `map` is one batch call: `out[k]` the
+/// direction of `u[k]`, None where the map fails.
+pub fn densities(
+    centres: &[[f64; 3]],
+    h: f64,
+    map: &mut BatchMap<'_>,
+) -> Vec<(Option<Vec3>, Option<Density>)> {
+    let mut u = Vec::with_capacity(centres.len() * 9);
+    for c in centres {
+        u.push(*c);
+        for (a, b) in STENCIL {
+            u.push([c[0], c[1] + a * h, c[2] + b * h]);
+        }
+    }
+    let mut w = vec![None; u.len()];
+    map(&u, &mut w);
+    w.chunks(9)
+        .map(|w| {
+            let centre = w[0];
+            let Some(c) = centre else {
+                return (None, None);
+            };
+            let all: Option<Vec<Vec3>> = w[1..].iter().copied().collect();
+            let Some(s) = all.filter(|s| s.iter().all(|d| (d[2] > 0.0) == (c[2] > 0.0))) else {
+                return (centre, None);
+            };
+            let density = |k: usize, step: f64| {
+                let d = |p: Vec3, q: Vec3| {
+                    [
+                        (p[0] - q[0]) / (2.0 * step),
+                        (p[1] - q[1]) / (2.0 * step),
+                        (p[2] - q[2]) / (2.0 * step),
+                    ]
+                };
+                let a = d(s[k], s[k + 1]);
+                let b = d(s[k + 2], s[k + 3]);
+                let x = [
+                    a[1] * b[2] - a[2] * b[1],
+                    a[2] * b[0] - a[0] * b[2],
+                    a[0] * b[1] - a[1] * b[0],
+                ];
+                1.0 / (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
+            };
+            (
+                centre,
+                Some(Density {
+                    coarse: density(0, h),
+                    fine: density(4, h / 2.0),
+                }),
+            )
+        })
+        .collect()
+}
+
+/// What one incidence of a sweep measured: the worst relative error of the stated pdf against
+/// the map's density over the resolved points, in excess of the points' own allowance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AtIncidence {
+    /// θi.
+    pub theta: f64,
+    /// The worst |stated − density| / density over the resolved points.
+    pub worst: f64,
+    /// The worst error beyond the point's own extrapolation spread ([`Density::spread`]): what
+    /// is judged against the tolerance.
+    pub excess: f64,
+    /// Whether `excess` exceeds the tolerance (or a point is not a direction or a density).
+    pub fails: bool,
+    /// Points resolved / measured.
+    pub resolved: usize,
+    /// Points measured.
+    pub measured: usize,
+}
+
+/// Bisection steps of [`narrow`] on each side of a failing run.
+pub const NARROW_STEPS: usize = 8;
+
+/// Narrows the failures of a sweep (`at`, sorted by θ) to the region around the worst failing
+/// incidence: the run of failing incidences that contains it, each end refined by
+/// [`NARROW_STEPS`] bisections in θ towards the neighbouring passing incidence (`measure`
+/// re-measures at any θ). None when nothing fails. `what` and `context` word the sentence:
+/// "density off by up to 1.1 % for θi ∈ [0, 0.089] rad at α 0.05".
+pub fn narrow(
+    at: &[AtIncidence],
+    measure: &mut dyn FnMut(f64) -> AtIncidence,
+    what: &str,
+    context: &str,
+) -> Option<Region> {
+    let worst = at
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| a.fails)
+        .max_by(|a, b| a.1.worst.total_cmp(&b.1.worst))?
+        .0;
+    let mut lo = worst;
+    while lo > 0 && at[lo - 1].fails {
+        lo -= 1;
+    }
+    let mut hi = worst;
+    while hi + 1 < at.len() && at[hi + 1].fails {
+        hi += 1;
+    }
+    let mut largest = at[lo..=hi].iter().map(|a| a.worst).fold(0.0, f64::max);
+    let mut refine = |failing: f64, passing: f64, largest: &mut f64| {
+        let (mut f, mut p) = (failing, passing);
+        for _ in 0..NARROW_STEPS {
+            let mid = 0.5 * (f + p);
+            let m = measure(mid);
+            if m.fails {
+                f = mid;
+                *largest = largest.max(m.worst);
+            } else {
+                p = mid;
+            }
+        }
+        f
+    };
+    let from = if lo > 0 {
+        refine(at[lo].theta, at[lo - 1].theta, &mut largest)
+    } else {
+        at[lo].theta
+    };
+    let to = if hi + 1 < at.len() {
+        refine(at[hi].theta, at[hi + 1].theta, &mut largest)
+    } else {
+        at[hi].theta
+    };
+    let failing = at.iter().filter(|a| a.fails).count();
+    Some(Region {
+        quantity: "theta_i".into(),
+        from,
+        to,
+        worst: largest,
+        at: at[worst].theta,
+        failing_incidences: failing,
+        incidences: at.len(),
+        text: format!(
+            "{what} off by up to {} for θi ∈ [{from:.3e}, {to:.3e}] rad {context} \
+             ({failing} of {} incidences fail)",
+            percent(largest),
+            at.len()
+        ),
+    })
+}
+
+/// A relative error as a percentage with two significant digits.
+fn percent(e: f64) -> String {
+    if e.is_finite() {
+        format!("{:.2} %", 100.0 * e)
+    } else {
+        format!("{e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_near_normal_sweep_spans_the_stretched_tilts() {
+        let s = sweep(0.05, None, Some(7));
+        let near: Vec<_> = s.iter().filter(|p| p.regime == "near_normal").collect();
+        assert_eq!(near.len(), 21);
+        let t: Vec<f64> = near.iter().map(|p| 0.05 * p.theta.tan()).collect();
+        assert!((t[0] / 1e-6 - 1.0).abs() < 1e-12 && (t[20] / 1e-1 - 1.0).abs() < 1e-12);
+        assert!(s.windows(2).all(|w| w[0].theta <= w[1].theta));
+        assert_eq!(s.iter().filter(|p| p.regime == "drawn").count(), DRAWN);
+        // Drawn per seed: another seed, other incidences; the same seed, the same.
+        assert_eq!(s, sweep(0.05, None, Some(7)));
+        assert_ne!(s, sweep(0.05, None, Some(8)));
+    }
+
+    #[test]
+    fn the_critical_sweep_lies_on_both_sides() {
+        let tc = (1.0f64 / 1.5).asin();
+        let s = sweep(0.3, Some(tc), None);
+        let c: Vec<f64> = s
+            .iter()
+            .filter(|p| p.regime == "critical")
+            .map(|p| p.theta - tc)
+            .collect();
+        assert_eq!(c.len(), 10);
+        assert_eq!(c.iter().filter(|d| **d < 0.0).count(), 5);
+    }
+
+    #[test]
+    fn narrowing_finds_the_edge_of_a_failing_interval() {
+        // A defect for θ < 0.089: the region's end within 2⁻⁸ of the gap it was bracketed in.
+        let f = |theta: f64| AtIncidence {
+            theta,
+            worst: if theta < 0.089 { 0.011 } else { 1e-9 },
+            excess: if theta < 0.089 { 0.011 } else { 0.0 },
+            fails: theta < 0.089,
+            resolved: 1,
+            measured: 1,
+        };
+        let at: Vec<_> = [0.001, 0.01, 0.05, 0.1, 0.5].into_iter().map(f).collect();
+        let r = narrow(&at, &mut |t| f(t), "density", "at α 0.05").unwrap();
+        assert_eq!(r.from, 0.001);
+        assert!(r.to < 0.089 && r.to > 0.089 - 0.05 / 256.0, "{}", r.to);
+        assert!(r.text.contains("1.10 %"), "{}", r.text);
+        assert_eq!(r.failing_incidences, 3);
+        assert!(narrow(&at[3..], &mut |t| f(t), "density", "").is_none());
+    }
+
+    #[test]
+    fn the_densities_of_a_linear_map_are_exact() {
+        // u ↦ (u₁, 2u₂, 1) (not unit, but a map): density 1/2 everywhere.
+        let c = [[0.5, 0.3, 0.6]];
+        let d = densities(&c, 1e-3, &mut |u, out| {
+            for (o, u) in out.iter_mut().zip(u) {
+                *o = Some([u[1], 2.0 * u[2], 1.0]);
+            }
+        });
+        let density = d[0].1.unwrap();
+        assert!((density.value() - 0.5).abs() < 1e-9, "{density:?}");
+    }
+}
+
+#[cfg(test)]
+mod kill_tests;
