@@ -28,6 +28,7 @@ BSDFs, tools/mitsuba_bsdf_child.py and docs/gate.md):
 - Batches: llvm variants evaluate a whole batch as Dr.Jit arrays (one kernel a call); scalar
   variants, which have no arrays, one item at a time (slow: prefer an llvm variant).
 """
+import re
 import sys
 import threading
 
@@ -201,8 +202,8 @@ def audit_bsdf(bsdf, profile="ci", transport="radiance", eta=None, channel=0, ag
         precision = "f64" if model.double else "f32"
     if name is None:
         plugin = bsdf.id() or type(bsdf).__name__
-        if plugin in ("", "BSDF"):
-            plugin = str(bsdf).split("[", 1)[0].strip() or "BSDF"
+        if plugin in ("", "BSDF"):  # a built-in plugin: its to_string's class name
+            plugin = re.split(r"[\[:\n]", str(bsdf), maxsplit=1)[0].strip() or "BSDF"
         name = "mitsuba %s %s" % (plugin, variant)
     return mfh.audit_bsdf(
         eval=model.eval, pdf=model.pdf, sample=model.sample, eta=_eta(mi, bsdf, eta),

@@ -178,3 +178,20 @@ class Dielectric:
             ok &= pdf > 0.0
             return (np.where(ok[:, None], wo, [0.0, 0.0, 1.0]), np.where(ok, pdf, 0.0),
                     np.where(ok, value / pdf, 0.0))
+
+
+if __name__ == "__main__":
+    # The same model as a child of the external protocol, to time the in-process audit against
+    # it: mfh audit-external --profile ci --cmd "python3 python/tests/numpy_dielectric.py"
+    import os
+    import sys
+
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                    "examples", "external"))
+    import mfh_protocol
+
+    model = Dielectric()
+    mfh_protocol.serve(
+        "numpy_dielectric.py", {"ndf": {"family": "ggx", "alpha": model.alpha}, "eta": model.eta},
+        {"bsdf_eval": model.eval, "bsdf_pdf": model.pdf, "bsdf_sample": model.sample},
+        numpy=True, extra={"eta": model.eta, "transport": "radiance"})

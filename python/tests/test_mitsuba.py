@@ -77,3 +77,31 @@ def test_the_plugin_whose_weight_is_not_divided_by_the_pdf_fails(mi):
                                     name="python diffuse, weight not divided by the pdf")
     print(repr(report))
     assert "bsdf.sample_consistency" in report.failed_checks, report
+
+
+def roughdielectric(mi, sample_visible):
+    return mi.load_dict({"type": "roughdielectric", "distribution": "ggx", "alpha": 0.3,
+                         "int_ior": 1.5, "sample_visible": sample_visible})
+
+
+def test_roughdielectric_passes(mi):
+    report = mfh.mitsuba.audit_bsdf(roughdielectric(mi, True))
+    print(repr(report), "\ncalls, items:", report.calls)
+    report.assert_pass()
+    assert sum(r["check"] == "bsdf.chi2" for r in report.records) == 5
+
+
+def test_roughdielectric_without_visible_normals_has_weights_that_are_not_eval_over_pdf(mi):
+    """Mitsuba 3.9.1's roughdielectric with sample_visible false samples m with alpha scaled
+    by 1.2 - 0.2 sqrt|cos theta_i| (Walter's trick) and pdf() uses that scaled alpha too (the
+    chi-square passes), but sample()'s weight is G |wi.m| / (|cos theta_i| cos theta_m), the
+    weight of m drawn from the unscaled D: it lacks D(m) / D_scaled(m), so the weight is not
+    eval / pdf except at normal incidence (scale 1), and the mean weight is not the albedo."""
+    report = mfh.mitsuba.audit_bsdf(roughdielectric(mi, False))
+    print(repr(report))
+    assert "bsdf.sample_consistency" in report.failed_checks, report
+    assert set(report.failed_checks) <= {"bsdf.sample_consistency", "bsdf.albedo"}, report
+    consistency = {r["case"]["incidence"]: r for r in report.records
+                   if r["check"] == "bsdf.sample_consistency"}
+    assert consistency["normal"]["verdict"] == "pass"
+    assert all(consistency[i]["verdict"] == "fail" for i in ("oblique", "grazing", "inside"))
