@@ -10,7 +10,7 @@
 use crate::caller::Caller;
 use crate::model::{PyBsdf, PyNdf};
 use crate::report::Report;
-use mfh_harness::check::Profile;
+use mfh_harness::check::{PlannedCheck, Profile};
 use mfh_harness::cli::progress::{Bar, Lines};
 use mfh_harness::record::{CheckRecord, Verdict};
 use mfh_harness::run::{
@@ -293,7 +293,11 @@ fn run<'a>(
 
 /// The audit's plan, the checks `s.checks` keeps of it, run with progress on stderr; the report
 /// with the `python.call` record of the first error the callables met.
-fn plan_and_run(audit: Audit<'_>, caller: &Caller, s: &Settings) -> Result<AuditReport, String> {
+fn plan_and_run(
+    audit: Audit<'_>,
+    caller: &Arc<Caller>,
+    s: &Settings,
+) -> Result<AuditReport, String> {
     let t = Instant::now();
     let audit = audit.profile(s.profile).seed(s.seed).precision(s.precision);
     let audit = match &s.against {
@@ -321,6 +325,10 @@ fn plan_and_run(audit: Audit<'_>, caller: &Caller, s: &Settings) -> Result<Audit
                 .collect()
         }
     };
+    let plan: Vec<_> = plan
+        .into_iter()
+        .map(|p| not_after_a_stop(p, caller.clone()))
+        .collect();
     let lines = Lines::start(s.label, s.quiet).map(Arc::new);
     let l = lines.clone();
     let on_check = CheckEventFn(Arc::new(move |event: CheckEvent<'_>| {
@@ -382,4 +390,35 @@ fn plan_and_run(audit: Audit<'_>, caller: &Caller, s: &Settings) -> Result<Audit
         (k, alpha),
         t.elapsed().as_secs_f64(),
     ))
+}
+
+/// `planned`, which once the calls have stopped (an error, Ctrl-C) is not started: its record
+/// is an error that says why, so an interrupted or broken audit ends with the checks running.
+fn not_after_a_stop<'a>(mut planned: PlannedCheck<'a>, caller: Arc<Caller>) -> PlannedCheck<'a> {
+    let run = std::mem::replace(&mut planned.run, Box::new(|_| unreachable_record()));
+    let (check, model, case) = (
+        planned.check.clone(),
+        planned.model.clone(),
+        planned.case.clone(),
+    );
+    planned.run = Box::new(move |ctx| match caller.stop_reason() {
+        None => run(ctx),
+        Some(reason) => {
+            let mut r = CheckRecord::new(&check, model.clone(), case.clone(), "");
+            r.verdict = Verdict::Error {
+                message: reason.into(),
+            };
+            r
+        }
+    });
+    planned
+}
+
+/// The placeholder runner while a planned check's runner is wrapped (never run).
+fn unreachable_record() -> CheckRecord {
+    let mut r = CheckRecord::new("python.call", json!(null), json!({}), "");
+    r.verdict = Verdict::Error {
+        message: "a placeholder runner ran".into(),
+    };
+    r
 }

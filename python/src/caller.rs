@@ -21,6 +21,7 @@ pub struct Caller {
     format_error: PyObject,
     first_error: Mutex<Option<String>>,
     stop: AtomicBool,
+    interrupted: AtomicBool,
     calls: AtomicU64,
     items: AtomicU64,
 }
@@ -38,6 +39,7 @@ impl Caller {
             format_error: module.getattr("format_error")?.unbind(),
             first_error: Mutex::new(None),
             stop: AtomicBool::new(false),
+            interrupted: AtomicBool::new(false),
             calls: AtomicU64::new(0),
             items: AtomicU64::new(0),
         })
@@ -50,7 +52,20 @@ impl Caller {
 
     /// Stops every later call (Ctrl-C).
     pub fn interrupt(&self) {
+        self.interrupted.store(true, Relaxed);
         self.stop.store(true, Relaxed);
+    }
+
+    /// Why calls have stopped, for the records of the checks not run since: None while they
+    /// go on.
+    pub fn stop_reason(&self) -> Option<&'static str> {
+        if !self.stopped() {
+            None
+        } else if self.interrupted.load(Relaxed) {
+            Some("not run: the audit was interrupted (Ctrl-C)")
+        } else {
+            Some("not run: a call of the Python functions had failed (the python.call record)")
+        }
     }
 
     /// The first error met, if any.
