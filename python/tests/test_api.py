@@ -94,6 +94,9 @@ def test_ctrl_c_stops_the_audit_and_raises_keyboard_interrupt():
         sys.path.insert(0, %r)
         import mfh
         from numpy_dielectric import Dielectric
+        # Python's own Ctrl-C handler, as in a terminal: a process started in the background
+        # by a non-interactive shell inherits SIGINT ignored, and Python then keeps ignoring it.
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         m = Dielectric()
         calls = []
         def slow_eval(wi, wo):
