@@ -163,7 +163,6 @@ fn microfacet(
             reason,
         });
     }
-    check_anisotropy(ndf)?;
     if sampling == Sampling::PseudoVnis {
         return match ndf {
             ModelSpec::Std(s) if s.gamma.is_finite() => {
@@ -224,12 +223,15 @@ impl BsdfSpec {
                 // The numbers first, so that an error names the first bad field as written.
                 super::conductor::check_nk(s.n, s.k)?;
                 let mf = microfacet(&s.ndf, s.masking, s.sampling)?;
+                check_anisotropy(&s.ndf)?;
                 Arc::new(Conductor::new(s.n, s.k, s.fresnel, mf)?)
             }
             BsdfSpec::Dielectric(s) => {
                 super::dielectric::check_eta(s.eta)?;
-                check_transmission_width(s.eta, &s.ndf)?;
                 let mf = microfacet(&s.ndf, s.masking, s.sampling)?;
+                // After the NDF's own limits, so that a bad α is named as such.
+                check_anisotropy(&s.ndf)?;
+                check_transmission_width(s.eta, &s.ndf)?;
                 Arc::new(Dielectric::new(s.eta, mf, s.transport)?)
             }
         })
