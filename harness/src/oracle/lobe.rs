@@ -47,8 +47,32 @@ pub const FALLBACK_WIDTH: f64 = 0.3;
 /// The multiples of a scale at which the polar integrals are cut (as the former fixed cuts
 /// width × {10⁻³ … 10²}).
 const SCALE_MULTIPLES: [f64; 9] = [1e-3, 1e-2, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0];
-/// Multiples of a mode's half-width at which the integrals are cut on either side of it.
+/// Multiples of a mode's half-width at which the integrals are cut on either side of it;
+/// beyond the last, cuts every factor [`TAIL_RATIO`] out to the hemisphere's extent, so that a
+/// near-delta lobe's power-law tail (GGX at α 1e-7: 2.4e-4 of its mass beyond 64 widths) is
+/// integrated in pieces over which it varies by a bounded factor.
 const MODE_MULTIPLES: [f64; 7] = [0.3, 1.0, 2.0, 4.0, 8.0, 16.0, 64.0];
+/// The ratio of successive tail cuts beyond [`MODE_MULTIPLES`].
+const TAIL_RATIO: f64 = 4.0;
+/// The smallest half-width probed about a mode (radians): below the transmission lobe of
+/// η = 1 ± 5e-5 at α = 1e-7 (≈ α·|η − 1| = 5e-12).
+const WIDTH_PROBE_MIN: f64 = 1e-14;
+/// The most further modes a measurement keeps ([`Lobe::extra_modes`]), the highest first.
+pub const MAX_EXTRA_MODES: usize = 4;
+/// The smallest cut spacing kept about a mode, as a fraction of its half-width.
+const MODE_GAP: f64 = 0.1;
+
+/// The multiples of a mode's half-width at which it is cut: [`MODE_MULTIPLES`], then every
+/// [`TAIL_RATIO`] up to `extent` / width.
+fn mode_multiples(width: f64, extent: f64) -> Vec<f64> {
+    let mut out = MODE_MULTIPLES.to_vec();
+    let mut k = MODE_MULTIPLES[MODE_MULTIPLES.len() - 1];
+    while width > 0.0 && k * width < extent {
+        k *= TAIL_RATIO;
+        out.push(k);
+    }
+    out
+}
 
 /// An off-axis mode of the density and its angular half-widths.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -81,6 +105,11 @@ pub struct Lobe {
     pub widest_azimuth: f64,
     /// The mode of the density when it is away from the pole.
     pub mode: Option<Mode>,
+    /// Further off-axis modes, climbed to from the seeds ([`Options::seeds`]) that lead
+    /// elsewhere than `mode` (a BSDF's ring of directions refracted through near-horizontal
+    /// microfacets beside its refraction lobe, a lobe whose density is below the other's):
+    /// the integrals are cut about each as about `mode`. At most [`MAX_EXTRA_MODES`].
+    pub extra_modes: Vec<Mode>,
     /// Density evaluations spent.
     pub evaluations: u64,
 }
@@ -293,10 +322,43 @@ fn survey(
     if best.0 > 0.0 {
         let (found, spent) = climb(p, best, narrowest.0);
         evaluations += spent;
-        if found.1 > 0.1 * narrowest.0 {
-            let (m, spent) = widths(p, found);
-            evaluations += spent;
+        let (m, spent) = widths(p, found);
+        evaluations += spent;
+        if off_pole(&m, narrowest.0) {
             mode = Some(m);
+        }
+    }
+    // The seeds that climb elsewhere: further modes.
+    let mut extra_modes: Vec<Mode> = Vec::new();
+    let mut starts: Vec<(f64, f64, f64)> = Vec::new();
+    for &m in seeds {
+        if m.iter().all(|c| c.is_finite()) && m[2] >= 0.0 {
+            let (t, phi) = angles(m);
+            let v = clean(p, t, phi);
+            evaluations += 1;
+            if v > 0.0 {
+                starts.push((v, t, phi));
+            }
+        }
+    }
+    starts.sort_by(|a, b| b.0.total_cmp(&a.0));
+    for start in starts {
+        if extra_modes.len() >= MAX_EXTRA_MODES {
+            break;
+        }
+        let (found, spent) = climb(p, start, narrowest.0);
+        evaluations += spent;
+        let known = mode
+            .iter()
+            .chain(&extra_modes)
+            .any(|k| same_mode(k, found.1, found.2));
+        if known {
+            continue;
+        }
+        let (m, spent) = widths(p, found);
+        evaluations += spent;
+        if off_pole(&m, narrowest.0) {
+            extra_modes.push(m);
         }
     }
     Lobe {
@@ -307,8 +369,25 @@ fn survey(
         widest: widest.0,
         widest_azimuth: widest.1,
         mode,
+        extra_modes,
         evaluations,
     }
+}
+
+/// Whether a mode is off the pole: by a tenth of the narrowest scale `scale`, or by more than
+/// twice its own θ half-width (a lobe 2e-7 wide at θ 1e-3, where the survey saw nothing and
+/// the scale is the fallback's; the half-width towards the pole is at most θ, so a climb that
+/// stops near the pole of a lobe centred there is not a mode).
+fn off_pole(m: &Mode, scale: f64) -> bool {
+    m.theta > 0.1 * scale || m.theta > 2.0 * m.width_theta
+}
+
+/// Whether (θ, φ) lies within the half-widths of the mode `k` (twice its widths, so that two
+/// climbs to one mode that stop a step apart are one mode).
+fn same_mode(k: &Mode, theta: f64, phi: f64) -> bool {
+    let d_phi = (phi - k.phi).rem_euclid(TAU);
+    let d_phi = d_phi.min(TAU - d_phi);
+    (theta - k.theta).abs() <= 2.0 * k.width_theta && d_phi * k.theta.sin() <= 2.0 * k.width_arc
 }
 
 /// Compass search for the mode of p from `start` = (p, θ, φ): moves to the best of the four
@@ -357,14 +436,15 @@ fn climb(
 }
 
 /// The half-widths of the mode `at` = (p, θ, φ): along ±θ and ±arc, where p falls below
-/// e^{−1/2}·p(mode), probed geometrically from 1e-10 then bisected in ln width 8 times.
+/// e^{−1/2}·p(mode), probed geometrically from [`WIDTH_PROBE_MIN`] then bisected in ln width 8
+/// times.
 fn widths(p: &(dyn Fn(Vec3) -> f64 + Sync), at: (f64, f64, f64)) -> (Mode, u64) {
     let (v, theta, phi) = at;
     let level = v * (-0.5f64).exp();
     let mut spent = 0u64;
     let sin = theta.sin().max(1e-300);
     let mut half = |along: &dyn Fn(f64) -> f64| {
-        let mut below = 1e-10;
+        let mut below = WIDTH_PROBE_MIN;
         let mut above;
         loop {
             above = below * PROBE_FACTOR;
@@ -423,6 +503,7 @@ impl Lobe {
             widest: width,
             widest_azimuth: 0.0,
             mode: None,
+            extra_modes: Vec::new(),
             evaluations: 0,
         }
     }
@@ -465,14 +546,16 @@ impl Lobe {
                 .filter(|&&k| k >= 1.0)
                 .map(|k| k * self.widest),
         );
-        if let Some(m) = self.mode {
+        let mut finest = f64::INFINITY;
+        for m in self.mode.iter().chain(&self.extra_modes) {
             cuts.push(m.theta);
-            for k in MODE_MULTIPLES {
+            for k in mode_multiples(m.width_theta, theta_max) {
                 cuts.push(m.theta - k * m.width_theta);
                 cuts.push(m.theta + k * m.width_theta);
             }
+            finest = finest.min(MODE_GAP * m.width_theta);
         }
-        tidy(cuts, 0.0, theta_max)
+        tidy(cuts, 0.0, theta_max, finest)
     }
 
     /// [`Lobe::polar_cuts`] with the polar angles `kinks` strictly inside (0, `theta_max`)
@@ -509,27 +592,31 @@ impl Lobe {
             cuts.push(self.narrowest_azimuth);
             cuts.push(self.narrowest_azimuth + PI);
         }
-        if let Some(m) = self.mode {
+        let mut finest = f64::INFINITY;
+        for m in self.mode.iter().chain(&self.extra_modes) {
             let half = m.width_arc / m.theta.sin().max(1e-300);
             cuts.push(m.phi);
-            for k in MODE_MULTIPLES {
+            for k in mode_multiples(half, PI) {
                 if k * half < PI {
                     cuts.push(m.phi - k * half);
                     cuts.push(m.phi + k * half);
                 }
             }
+            finest = finest.min(MODE_GAP * half);
         }
         let wrapped = cuts
             .into_iter()
             .map(|c| if c == TAU { c } else { c.rem_euclid(TAU) })
             .collect();
-        tidy(wrapped, 0.0, TAU)
+        tidy(wrapped, 0.0, TAU, finest)
     }
 }
 
 /// Sorts `cuts`, keeps those in [lo, hi] (the ends included), and drops points closer than
-/// 1e-3 relative (or 1e-15 absolute) to the one kept before them.
-fn tidy(mut cuts: Vec<f64>, lo: f64, hi: f64) -> Vec<f64> {
+/// 1e-3 relative, or `finest` if that is smaller (a mode's cuts are as fine as its width:
+/// a lobe 2e-7 wide at θ 0.9 fell between cuts 1e-3 apart), to the one kept before them, with
+/// a floor of 1e-15 absolute.
+fn tidy(mut cuts: Vec<f64>, lo: f64, hi: f64, finest: f64) -> Vec<f64> {
     cuts.retain(|c| c.is_finite() && *c > lo && *c < hi);
     cuts.push(lo);
     cuts.push(hi);
@@ -537,7 +624,7 @@ fn tidy(mut cuts: Vec<f64>, lo: f64, hi: f64) -> Vec<f64> {
     let mut out: Vec<f64> = Vec::with_capacity(cuts.len());
     for c in cuts {
         match out.last() {
-            Some(&last) if c - last <= (1e-3 * c.abs()).max(1e-15) => {
+            Some(&last) if c - last <= (1e-3 * c.abs()).min(finest).max(1e-15) => {
                 if c == hi {
                     *out.last_mut().expect("not empty") = hi;
                 }

@@ -36,6 +36,7 @@ mod edge_table;
 pub mod gtr;
 pub mod ks;
 pub mod lobe;
+pub mod lobe_centres;
 pub mod monte_carlo;
 pub mod precise;
 pub mod quadrature;

@@ -41,7 +41,8 @@
 //! 3. **Sanity failures first** (no p-value): a sampled direction that is non-finite or not of
 //!    unit length, a non-finite or negative cell mass, a total mass above 1 by more than
 //!    [`MASS_TOLERANCE`] (a pdf of a sampler that cannot fail integrates to at most 1), samples
-//!    in a cell whose expected mass is 0, no successful sample.
+//!    in a cell whose expected mass is 0. No successful sample is judged by its probability
+//!    under the pdf's mass, (1 − m)^N (`no_success`).
 //! 4. **The test is conditional on success.** The successful samples are compared with the
 //!    masses normalized by the total mass (the sampler's distribution given that it returned a
 //!    direction). Whether the *rate* of failures equals 1 − ∫ pdf is a separate test
@@ -441,6 +442,7 @@ pub fn noncentrality_weights(e: &Expected, samples: u64) -> Vec<f64> {
 /// evaluations ([`expected_mass_global_until`]), or until `enough` holds of the masses; the
 /// cells are `cells`'s (a given grid, or R rows and 2R columns placed at the quantiles of the
 /// hemisphere's marginals by [`cells::layout`]), returned with the masses.
+#[allow(clippy::too_many_arguments)]
 fn expected_hemisphere_until(
     pdf: &SpherePdf<'_>,
     cells: Cells,
@@ -448,6 +450,7 @@ fn expected_hemisphere_until(
     target: f64,
     enough: &dyn Fn(&Expected) -> bool,
     weights: &dyn Fn(&Expected) -> Option<Vec<f64>>,
+    centres: &[Vec3],
 ) -> (HemisphereGrid, Expected) {
     let mirrored = |w: &[Vec3], out: &mut [f64]| {
         if lower {
@@ -457,7 +460,17 @@ fn expected_hemisphere_until(
             pdf(w, out);
         }
     };
-    let lobe = lobe::measure_with_batch(&mirrored, &lobe::Options::default());
+    // The lobe centres on this side, in its (mirrored) frame: where the mode search starts.
+    let seeds: Vec<Vec3> = centres
+        .iter()
+        .filter(|c| (c[2] < 0.0) == lower)
+        .map(|c| [c[0], c[1], c[2].abs()])
+        .collect();
+    let options = lobe::Options {
+        hint: None,
+        seeds: &seeds,
+    };
+    let lobe = lobe::measure_with_batch(&mirrored, &options);
     let (grid, placed) = match cells {
         Cells::Given(grid) => (grid, 0),
         Cells::FollowLobe(resolution) => {
@@ -497,9 +510,28 @@ pub fn expected_hemisphere(
     lower: bool,
     target: f64,
 ) -> Expected {
-    expected_hemisphere_until(pdf, Cells::Given(grid), lower, target, &|_| false, &|_| {
-        None
-    })
+    expected_hemisphere_about(pdf, grid, lower, target, &[])
+}
+
+/// [`expected_hemisphere`] with the lobe measurement started at `centres` (directions over
+/// the whole sphere, e.g. [`crate::oracle::lobe_centres::lobe_centres`]; those on the other
+/// side are ignored).
+pub fn expected_hemisphere_about(
+    pdf: &SpherePdf<'_>,
+    grid: HemisphereGrid,
+    lower: bool,
+    target: f64,
+    centres: &[Vec3],
+) -> Expected {
+    expected_hemisphere_until(
+        pdf,
+        Cells::Given(grid),
+        lower,
+        target,
+        &|_| false,
+        &|_| None,
+        centres,
+    )
     .1
 }
 
@@ -510,9 +542,19 @@ pub fn expected_sphere(
     grid: HemisphereGrid,
     target: f64,
 ) -> (Expected, Expected) {
+    expected_sphere_about(pdf, grid, target, &[])
+}
+
+/// [`expected_sphere`] with each hemisphere's lobe measurement started at `centres`.
+pub fn expected_sphere_about(
+    pdf: &SpherePdf<'_>,
+    grid: HemisphereGrid,
+    target: f64,
+    centres: &[Vec3],
+) -> (Expected, Expected) {
     (
-        expected_hemisphere(pdf, grid.clone(), false, target),
-        expected_hemisphere(pdf, grid, true, target),
+        expected_hemisphere_about(pdf, grid.clone(), false, target, centres),
+        expected_hemisphere_about(pdf, grid, true, target, centres),
     )
 }
 
@@ -534,18 +576,47 @@ pub struct SphereMasses {
 /// samples (step 2): each refined until its [`mass_noncentrality`] is at most half of
 /// [`MASS_NONCENTRALITY`], or to the summed error [`mass_target`].
 pub fn chi2_masses(pdf: &SpherePdf<'_>, resolution: usize, samples: u64) -> SphereMasses {
-    chi2_masses_on(pdf, Cells::FollowLobe(resolution.max(1)), samples)
+    chi2_masses_about(pdf, resolution, samples, &[])
+}
+
+/// [`chi2_masses`] with each hemisphere's lobe measurement started at `centres` (the mirror
+/// and refracted directions of the incidence: [`crate::oracle::lobe_centres::lobe_centres`]),
+/// so that a lobe too narrow for the survey is found and cut about.
+pub fn chi2_masses_about(
+    pdf: &SpherePdf<'_>,
+    resolution: usize,
+    samples: u64,
+    centres: &[Vec3],
+) -> SphereMasses {
+    chi2_masses_on_about(pdf, Cells::FollowLobe(resolution.max(1)), samples, centres)
 }
 
 /// [`chi2_masses`] with both hemispheres' cells given by `cells` (e.g. the equal-area grid).
 pub fn chi2_masses_on(pdf: &SpherePdf<'_>, cells: Cells, samples: u64) -> SphereMasses {
+    chi2_masses_on_about(pdf, cells, samples, &[])
+}
+
+/// [`chi2_masses_on`] with the lobe measurement started at `centres`.
+pub fn chi2_masses_on_about(
+    pdf: &SpherePdf<'_>,
+    cells: Cells,
+    samples: u64,
+    centres: &[Vec3],
+) -> SphereMasses {
     let target = mass_target(samples);
     let enough = |e: &Expected| mass_noncentrality(e, samples) <= 0.5 * MASS_NONCENTRALITY;
     let weights = |e: &Expected| Some(noncentrality_weights(e, samples));
-    let (upper_grid, upper) =
-        expected_hemisphere_until(pdf, cells.clone(), false, target, &enough, &weights);
+    let (upper_grid, upper) = expected_hemisphere_until(
+        pdf,
+        cells.clone(),
+        false,
+        target,
+        &enough,
+        &weights,
+        centres,
+    );
     let (lower_grid, lower) =
-        expected_hemisphere_until(pdf, cells, true, target, &enough, &weights);
+        expected_hemisphere_until(pdf, cells, true, target, &enough, &weights, centres);
     SphereMasses {
         upper_grid,
         upper,
@@ -561,8 +632,18 @@ pub fn sphere_chi2(
     pdf: &SpherePdf<'_>,
     config: &Chi2Config,
 ) -> SphereChi2Result {
+    sphere_chi2_about(sample, pdf, config, &[])
+}
+
+/// [`sphere_chi2`] with the lobe measurement started at `centres` ([`chi2_masses_about`]).
+pub fn sphere_chi2_about(
+    sample: &SphereSampler<'_>,
+    pdf: &SpherePdf<'_>,
+    config: &Chi2Config,
+    centres: &[Vec3],
+) -> SphereChi2Result {
     let t = Instant::now();
-    let masses = chi2_masses(pdf, config.resolution, config.samples);
+    let masses = chi2_masses_about(pdf, config.resolution, config.samples, centres);
     let integration_seconds = t.elapsed().as_secs_f64();
     let mut r = sphere_chi2_against(sample, masses, config);
     r.integration_seconds = integration_seconds;
@@ -616,6 +697,10 @@ pub fn sphere_chi2_against(
         result.reason = Some(reason);
         return result;
     }
+    if result.observed.binned() == 0 {
+        no_success(&mut result);
+        return result;
+    }
     let observed: Vec<u64> = result
         .observed
         .upper
@@ -625,9 +710,15 @@ pub fn sphere_chi2_against(
         .collect();
     let (statistic, bins, _) = pooled_statistic(&observed, &result.expected_counts());
     if bins < 2 {
-        result.reason = Some(format!(
-            "only {bins} bin(s) after pooling; more samples or a finer grid are needed"
-        ));
+        // Too few successful samples for two bins (a BSDF whose pdf holds 10⁻⁶–10⁻⁴ of mass
+        // at this incidence, every other sample failing): conditional on success the one bin
+        // holds them all whatever the sampler, so the statistic is 0 and p is 1. Samples
+        // where the pdf is 0 failed above; their number is `bsdf.failure_rate`'s to judge.
+        result.sanity_failure = false;
+        result.statistic = 0.0;
+        result.dof = 0;
+        result.p_value = 1.0;
+        result.verdict = Verdict::Pass;
         return result;
     }
     result.sanity_failure = false;
@@ -677,6 +768,32 @@ fn along_cos_theta(r: &SphereChi2Result, columns: usize) -> (Vec<u64>, Vec<f64>)
     (table, counts)
 }
 
+/// The test when no sample succeeded (step 3): the chance of that under the pdf's mass m is
+/// (1 − m)^N, the p-value (m at the low end of its bound: the doubt goes to the sampler). A
+/// BSDF whose pdf has almost no mass at this incidence (GGX α 1e4 at normal incidence: mass
+/// 1.8e-9, every reflected direction below the horizon) fails every sample and passes; one
+/// whose pdf holds 10⁻⁵ or more of mass fails at 10⁶ samples (p ≤ e⁻¹⁰).
+fn no_success(r: &mut SphereChi2Result) {
+    let m = (r.mass() - r.mass_error_bound()).clamp(0.0, 1.0);
+    let p = (r.samples as f64 * (-m).ln_1p()).exp();
+    r.sanity_failure = false;
+    r.statistic = 0.0;
+    r.dof = 0;
+    r.p_value = p;
+    if p >= r.alpha {
+        r.verdict = Verdict::Pass;
+    } else {
+        r.reason = Some(format!(
+            "every one of {} samples failed against a pdf mass of {:.3e} (± {:.1e}): p {p:.3e} \
+             below α = {:.3e}",
+            r.samples,
+            r.mass(),
+            r.mass_error_bound(),
+            r.alpha
+        ));
+    }
+}
+
 /// The sanity failures of step 3, in order.
 fn sanity(r: &SphereChi2Result) -> Option<String> {
     let o = &r.observed;
@@ -702,12 +819,6 @@ fn sanity(r: &SphereChi2Result) -> Option<String> {
             r.mass_error_bound()
         ));
     }
-    if o.binned() == 0 {
-        return Some(format!(
-            "every one of {} samples failed (pdf mass {mass})",
-            r.samples
-        ));
-    }
     let cells = r.expected_upper.mass.len();
     let observed = o.upper.iter().chain(&o.lower);
     let expected = r.expected_upper.mass.iter().chain(&r.expected_lower.mass);
@@ -724,6 +835,10 @@ fn sanity(r: &SphereChi2Result) -> Option<String> {
             format!("{n} samples in cell {cell} of the {side} hemisphere, where the pdf is zero")
         })
 }
+
+#[cfg(test)]
+#[path = "sphere_mass_tests.rs"]
+mod sphere_mass_tests;
 
 #[cfg(test)]
 mod tests {

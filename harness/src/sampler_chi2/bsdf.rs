@@ -7,7 +7,7 @@
 use super::{finite_or_null, MIN_RESOLUTION};
 use super::{min_samples, out_of_range, Chi2InputError, MAX_RESOLUTION, MAX_SAMPLES};
 use crate::oracle::chi2::Chi2Config;
-use crate::oracle::sphere_chi2::{sphere_chi2, SphereChi2Result};
+use crate::oracle::sphere_chi2::{sphere_chi2_about, SphereChi2Result};
 use crate::record::RecordData;
 use crate::tolerance::MIN_EXPECTED;
 use mfh_reference::bsdf::{Bsdf, BsdfSpec, Directions};
@@ -146,13 +146,14 @@ pub fn validate(request: &BsdfChi2Request) -> Result<BsdfChi2Plan, Chi2InputErro
 pub fn run(plan: &BsdfChi2Plan) -> SphereChi2Result {
     let bsdf = plan.bsdf.as_ref();
     let wi = plan.wi;
-    sphere_chi2(
+    sphere_chi2_about(
         &|u: &[[f64; 3]], out: &mut Directions| bsdf.sample_wo_batch(wi, u, out),
         &|wo: &[Vec3], out: &mut [f64]| {
             let wis = vec![wi; wo.len()];
             bsdf.pdf_batch(&wis, wo, out);
         },
         &plan.config,
+        &crate::oracle::lobe_centres::lobe_centres(wi, bsdf.eta()),
     )
 }
 

@@ -554,6 +554,8 @@ fn spec_parses_validates_and_round_trips() {
         (r#"{"bsdf":"dielectric","eta":1.0,"ndf":{"family":"ggx","alpha":0.3}}"#.into(), "eta", "5e-5"),
         (r#"{"bsdf":"dielectric","eta":1.00001,"ndf":{"family":"ggx","alpha":0.3}}"#.into(), "eta", "5e-5"),
         (r#"{"bsdf":"dielectric","eta":20,"ndf":{"family":"ggx","alpha":0.3}}"#.into(), "eta", "[0.1, 10]"),
+        (r#"{"bsdf":"dielectric","eta":1.0001,"ndf":{"family":"ggx","alpha":1e-7}}"#.into(), "eta", "1e-10/alpha"),
+        (r#"{"bsdf":"conductor","n":1,"k":3,"ndf":{"family":"beckmann","alpha_x":0.5,"alpha_y":1e-3}}"#.into(), "ndf.alpha_x", "factor of 100"),
         (r#"{"bsdf":"dielectric","eta":-1.5,"ndf":{"family":"ggx","alpha":0.3}}"#.into(), "eta", "[0.1, 10]"),
         (r#"{"bsdf":"conductor","n":-1,"k":3,"ndf":{"family":"ggx","alpha":0.3}}"#.into(), "n", "[1e-3, 100]"),
         (r#"{"bsdf":"conductor","n":1,"k":300,"ndf":{"family":"ggx","alpha":0.3}}"#.into(), "k", "[0, 100]"),

@@ -7,7 +7,7 @@
 //! | `bsdf.sample_consistency` | `consistency.rs` | the sample's pdf and weight against `pdf` and `eval/pdf` at its wo |
 //! | `bsdf.failure_rate` | `consistency.rs` | the rate of failed samples against 1 − ∫ pdf (cubature) |
 //! | `bsdf.albedo` | `albedo.rs` | ∫ eval by cubature against the mean sampled weight (Monte Carlo) |
-//! | `bsdf.energy` | `albedo.rs` | ∫ eval ≤ 1 where the transport makes that a law |
+//! | `bsdf.energy` | `albedo.rs` | ∫ eval ≤ 1 in the importance transport (radiance converted), at every incidence |
 //! | `bsdf.reciprocity` | `reciprocity.rs` | f(wi, wo) against f(wo, wi) with the transport's η² |
 //! | `bsdf.stability` | `stability.rs` | finite, non-negative, sampled where valued, at the hard cases |
 //! | `bsdf.against` | `against.rs` | eval and pdf against a reference BSDF on a grid and in its lobes, the samples' pdf and weight at their wo, the wo for the same u where the BSDF declares the reference map |
@@ -36,7 +36,10 @@ pub use chi2::{table as chi2_table, RESOLUTION as CHI2_RESOLUTION};
 use super::{PlannedCheck, Profile};
 use crate::oracle::chi2::Expected;
 use crate::oracle::domain::HemisphereGrid;
-use crate::oracle::sphere_chi2::{chi2_masses, draw_chunks, expected_sphere, SphereMasses};
+use crate::oracle::lobe_centres::lobe_centres;
+use crate::oracle::sphere_chi2::{
+    chi2_masses_about, draw_chunks, expected_sphere_about, SphereMasses,
+};
 use crate::oracle::Estimate;
 use crate::subject::bsdf::BsdfSubject;
 use mfh_reference::bsdf::{Bsdf, BsdfSample};
@@ -182,7 +185,12 @@ impl Integrals {
     /// evaluations they cost.
     pub fn pdf_masses(&self, bsdf: &dyn Bsdf) -> (&SphereMasses, u64) {
         let masses = self.pdf.get_or_init(|| {
-            let e = chi2_masses(&pdf_at(bsdf, self.wi), chi2::RESOLUTION, self.samples);
+            let e = chi2_masses_about(
+                &pdf_at(bsdf, self.wi),
+                chi2::RESOLUTION,
+                self.samples,
+                &lobe_centres(self.wi, bsdf.eta()),
+            );
             let spent = e.upper.evaluations + e.lower.evaluations;
             (e, spent)
         });
@@ -216,7 +224,8 @@ impl Integrals {
         *self.eval.get_or_init(|| {
             let grid = HemisphereGrid::new(chi2::RESOLUTION).expect("R ≥ 1");
             let target = albedo_target(self.samples);
-            let (u, l) = expected_sphere(&eval_at(bsdf, self.wi), grid, target);
+            let centres = lobe_centres(self.wi, bsdf.eta());
+            let (u, l) = expected_sphere_about(&eval_at(bsdf, self.wi), grid, target, &centres);
             let side = |e: &Expected| Estimate {
                 value: e.total,
                 error_bound: e.error_bound,
@@ -242,6 +251,12 @@ pub fn albedo_target(samples: u64) -> f64 {
     (10.0 / samples.max(1) as f64).max(1e-9)
 }
 
+/// The largest summed error bound of ∫ eval dωo (both hemispheres) with which `bsdf.albedo`
+/// and `bsdf.energy` give a verdict: past it (the evaluation budget spent on a lobe the
+/// cubature cannot resolve) the record is an error, for a bound that large would hide an
+/// energy gain or an eval error of that size. 100× the ci profile's target ([`albedo_target`]).
+pub const ALBEDO_CERTIFIED_BOUND: f64 = 1e-3;
+
 /// `bsdf.pdf_batch` at one incidence, as a batch density over wo.
 pub fn pdf_at<'b>(bsdf: &'b dyn Bsdf, wi: Vec3) -> impl Fn(&[Vec3], &mut [f64]) + Sync + 'b {
     move |wo: &[Vec3], out: &mut [f64]| {
@@ -260,3 +275,6 @@ pub fn eval_at<'b>(bsdf: &'b dyn Bsdf, wi: Vec3) -> impl Fn(&[Vec3], &mut [f64])
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod corner_tests;
