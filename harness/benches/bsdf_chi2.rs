@@ -1,4 +1,4 @@
-//! Criterion benchmark of the BSDF chi-square's sampling and binning (issue 25's target: the
+//! Criterion benchmark of the BSDF chi-square's sampling and binning (the target: the
 //! BSDF chi-square of the reference GGX dielectric, visible normals, within 2× of the NDF
 //! chi-square's samples/s): samples/s of
 //!

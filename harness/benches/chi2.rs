@@ -1,4 +1,4 @@
-//! Criterion benchmark of the chi-square oracle's observed counts (issues 15 and 26's
+//! Criterion benchmark of the chi-square oracle's observed counts (the
 //! harness-overhead target: sampling + binning ≤ 1.15 × the bare sampler loop): samples/s of
 //! GGX α = 0.3 normal sampling binned by `observe_batch` into the 128 × 64 cells (φ × cos θ)
 //! that `mfh chi2 --resolution 64` bins into (rows at the lobe's cos θ quantiles,

@@ -10,7 +10,7 @@
 //! ```
 //!
 //! LAYOUT is `lobe` (the default: cells at the pdf's marginal quantiles) or `equal` (the
-//! equal-area grid, the layout before issue 26: the "before" column of the table).
+//! equal-area grid, the layout before the lobe-quantile cells: the "before" column of the table).
 //!
 //! Prints a Markdown table (docs/chi2.md, "Detection power"): per α and distortion kind, the
 //! smallest error caught at all seeds (with every larger one tried also caught), and the

@@ -1,4 +1,4 @@
-//! The power of the `ci` profile for a float32 model (issue 27): GGX α = 0.3 computed in f32
+//! The power of the `ci` profile for a float32 model: GGX α = 0.3 computed in f32
 //! arithmetic the way a renderer writes it (D, Λ, the normal sampler and its pdf: the model of
 //! `harness/tests/float32.rs` without its visible-normal sampler, and with Λ written without
 //! its cancellation near the normal, which an f64 build needs), declared `Precision::F32`, with

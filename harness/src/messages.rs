@@ -1,5 +1,5 @@
 //! Messages for users: serde_json's errors and our own, without 300-digit numbers or Rust type
-//! names (issue 12, "Bad input").
+//! names ("Bad input").
 
 /// A serde_json error as a message for a user: serde's text (which names the key and the
 /// position) with long numbers shortened ([`compact_numbers`]).

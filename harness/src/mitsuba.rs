@@ -1,6 +1,6 @@
 //! Mitsuba 3 XML scenes → an mfh [`Scene`]: the microfacet BSDFs a Mitsuba scene already uses
 //! become materials with their NDF, masking and sampling; every other plugin is listed as not
-//! audited, with the reason (issue 13, "Scenes a renderer already has").
+//! audited, with the reason ("Scenes a renderer already has").
 //!
 //! What is read, and from where in Mitsuba 3 (src/bsdfs/*.cpp, include/mitsuba/render/
 //! microfacet.h, as documented in each plugin's parameter table):
@@ -12,7 +12,7 @@
 //! | `principled`, `principledthin` | GGX | `roughness` (0.5), `anisotropic` (0): α = max(10⁻³, r²/a), max(10⁻³, r²·a), a = √(1 − 0.9·anisotropic) (principledhelpers.h `calc_dist_params`) | visible normals (the `MicrofacetDistribution` default) |
 //! | `principled` clearcoat (when `clearcoat` ≠ 0) | GTR1 = GTR γ = 1 | α = lerp(0.1, 0.001, `clearcoat_gloss` (0)) | normals (`GTR1Isotropic::sample`) |
 //!
-//! `roughconductor` and `roughdielectric` also name a reference BSDF (issue 25), whose BSDF
+//! `roughconductor` and `roughdielectric` also name a reference BSDF, whose BSDF
 //! checks are planned besides the NDF's: a roughdielectric's η = `int_ior`/`ext_ior` (floats;
 //! absent: bk7 1.5046 / air 1.000277; named IORs are refused, mfh has no table), a
 //! roughconductor's n + ik = `eta` + i`k` (floats; absent or spectral: 0.2 + 3i, and a spectral

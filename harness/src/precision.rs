@@ -1,4 +1,4 @@
-//! The working precision of an implementation under audit (issue 27): a renderer computing its
+//! The working precision of an implementation under audit: a renderer computing its
 //! model in float32 answers with float32 rounding noise, and every value tolerance and every
 //! oracle's rounding floor is a function of it (`tolerance::Tolerance::at`,
 //! `oracle::quadrature::Accuracy::at`).

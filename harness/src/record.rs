@@ -80,7 +80,7 @@ pub struct OracleValue {
     /// The rounding floor the oracle stopped at, where the implementation's declared precision
     /// set it above the accuracy the oracle was asked for (a float32 model): its uncertainty is
     /// then what that floor allows, not what the target asked. Absent for an f64 model and in
-    /// reports written before it (issue 27).
+    /// reports written before it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub noise_floor: Option<NoiseFloor>,
 }
@@ -231,7 +231,7 @@ pub struct CheckRecord {
     /// The seed of the check's random stream (statistical checks).
     pub seed: Option<u64>,
     /// The precision the implementation was judged at (its value tolerances and the oracles'
-    /// rounding floors; `f64` in reports written before issue 27).
+    /// rounding floors; `f64` in reports written before float32 support).
     #[serde(default)]
     pub precision: crate::precision::Precision,
     /// The source: document and equation.
@@ -283,7 +283,7 @@ pub enum RecordData {
     /// The observed and expected counts of a chi-square test over the (φ, cos θ) grid of the
     /// upper hemisphere: `rows` cos θ-rows (row 0 at the horizon, cos θ ∈ [z_i, z_{i+1})) ×
     /// `columns` = 2R φ-columns (φ ∈ [φ_j, φ_{j+1})), row-major; the edges are `z_edges` and
-    /// `phi_edges` (empty in records written before issue 26: the equal-area i/R and 2πj/2R).
+    /// `phi_edges` (empty in records written before the lobe-quantile cells: the equal-area i/R and 2πj/2R).
     Chi2Table {
         /// cos θ-rows R.
         rows: usize,

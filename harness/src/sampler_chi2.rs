@@ -27,7 +27,7 @@ pub const MAX_SAMPLES: u64 = 1 << 32;
 /// The smallest grid resolution R. The statistic has dof = bins − 1 and needs two bins of
 /// expected count ≥ [`MIN_EXPECTED`] (cells below it are pooled). At R = 1 the grid is two
 /// φ-halves: both must expect ≥ 5, which at the least sample count 10 is an exact equality that
-/// the cubature's round-off breaks (4.999… pools both cells into one bin: issue 27 measured
+/// the cubature's round-off breaks (4.999… pools both cells into one bin: measured
 /// `--resolution 1 --samples 10` on GGX as FAIL with χ² NaN and dof 0). R = 2 gives 8 cells,
 /// 4 of them (one per φ-quarter) in the upper cos θ-row where every reference lobe peaks.
 pub const MIN_RESOLUTION: usize = 2;

@@ -67,7 +67,7 @@ impl Tolerance {
 ///
 /// 0.5: the slack a pass may take from the oracle is then at most half the tolerance, so a
 /// pass certifies the true error within 1.5× the stated tolerance (without the rule a user D
-/// scaled by 1e308 passed `smith.white_furnace`, issue 27). The oracles ask their quadrature
+/// scaled by 1e308 passed `smith.white_furnace`). The oracles ask their quadrature
 /// for a hundredth of the tolerance they serve (the Λ oracle 1e-12 against `CLOSED_FORM`'s
 /// 1e-10), so a converged oracle sits 50× inside the fraction; in the default quick audit the
 /// largest bound of a passing record is 0.056 of its tolerance (`smith.white_furnace`).
@@ -79,14 +79,14 @@ pub const CLOSED_FORM: Tolerance = Tolerance {
     value: 1e-10,
     reason: "a well-conditioned closed form in double precision is good to ~1e-14; the oracle \
              (adaptive double-exponential quadrature) is asked for 1e-12; 1e-10 leaves room for \
-             conditioning near grazing incidence (issue 2: ≤ 1e-10 where well conditioned)",
+             conditioning near grazing incidence (≤ 1e-10 where well conditioned)",
 };
 
 /// Closed forms against the double-double reference (`oracle::precise`, certified to ~1e-24).
 pub const PRECISE: Tolerance = Tolerance {
     name: "precise",
     value: 1e-14,
-    reason: "the closed forms of seed 001 are built for ~1e-14 where well conditioned (issue 2: \
+    reason: "the closed forms of seed 001 are built for ~1e-14 where well conditioned (\
              1e-14 for ₂F₁, the Student Λ measured ≤ 4.4e-15 × condition against mpmath); the \
              reference is certified to 1e-24, and the check adds 8εκ for the rounding of the \
              f64 input (κ = d ln Λ / d ln cot θ or d ln D / d ln tan²θ)",

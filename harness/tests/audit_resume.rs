@@ -1,4 +1,4 @@
-//! Audits that never go silent and never lose work (issue 27): every finished record is in
+//! Audits that never go silent and never lose work: every finished record is in
 //! `report.jsonl` when an audit is killed, `--resume` finishes it with the records of an
 //! uninterrupted run, `--max-time` ends it with a failing report naming what did not run, and a
 //! non-terminal standard error gets progress lines.

@@ -248,7 +248,7 @@ fn chi2_cmd_without_the_capability_is_bad_input() {
     assert!(stderr.contains("sample_wm_visible"), "{stderr}");
 }
 
-/// Issue 27: a malformed or invalid `--against` is bad input found before anything runs: exit
+/// A malformed or invalid `--against` is bad input found before anything runs: exit
 /// 2 at once, naming `--against`, and the child is never started (its command would create a
 /// marker file).
 #[test]

@@ -1,4 +1,4 @@
-//! The float32 examples of the external protocol (issue 27): the C++ GGX of
+//! The float32 examples of the external protocol: the C++ GGX of
 //! `examples/external/cpp/` (`ggx_float.cpp` on the header-only helper `mfh_protocol.hpp`,
 //! built here with the machine's g++) and the float32 numpy GGX (`ggx_f32_numpy.py`).
 //!
@@ -713,7 +713,7 @@ fn checks(report: &Value) -> Vec<&str> {
 }
 
 /// The C++ float32 GGX passes the ci audit with `"precision":"f32"`: D, Λ, G1, both samplers
-/// and the values against the reference (issue 27's target: within 1 min on 2 cores).
+/// and the values against the reference (the target: within 1 min on 2 cores).
 #[test]
 #[cfg_attr(
     not(has_gxx),
@@ -762,7 +762,7 @@ fn the_cpp_vndf_pdf_without_g1_fails_the_visible_pdf_normalization() {
     }
 }
 
-/// The float32 numpy GGX passes the ci audit with `"precision":"f32"` (issue 27's target:
+/// The float32 numpy GGX passes the ci audit with `"precision":"f32"` (the target:
 /// within 2 min on 2 cores).
 #[test]
 #[cfg_attr(

@@ -1,4 +1,4 @@
-//! A float32 implementation under audit (issue 27): GGX computed in f32 arithmetic the way a
+//! A float32 implementation under audit: GGX computed in f32 arithmetic the way a
 //! renderer writes it (D, Λ, the normal and visible-normal samplers and their pdfs), handed
 //! over as f64. Declared `Precision::F32`, it passes the `ci` profile with no false alarm;
 //! audited as f64, the report says it is a float32 model; a planted defect fails on its named
@@ -31,7 +31,7 @@ fn a_float32_ggx_declared_f32_passes_the_ci_profile() {
     assert!(report.passed(), "{:#?}", failing(&report));
     assert!(report.records.iter().all(|r| r.precision == Precision::F32));
     // The oracles that integrate the model's values stopped at its rounding floor, and the
-    // records say so (issue 27: "integrand noise 1e-7 relative, bound …").
+    // records say so ("integrand noise 1e-7 relative, bound …").
     for check in [
         "normalization.projected_area",
         "smith.lambda_route",
@@ -123,7 +123,7 @@ fn a_float32_visible_pdf_without_g1_fails_its_check() {
 }
 
 /// GGX (f64) whose D oscillates: D·(1 + ½ sin(10⁴(7.3x + 3.1y))), sampled by GGX's sampler
-/// (issue 27: its chi-square expected masses grew to 20 GB).
+/// (its chi-square expected masses grew to 20 GB).
 struct Oscillating(mfh_reference::ndf::Ggx);
 
 impl Ndf for Oscillating {
@@ -148,7 +148,7 @@ impl NormalSampler for Oscillating {
     }
 }
 
-/// A piecewise-constant tabulated D: GGX at the centres of 32 θ bins (issue 27: its
+/// A piecewise-constant tabulated D: GGX at the centres of 32 θ bins (its
 /// `smith.lambda_route` records took 125 s each).
 struct Tabulated {
     table: [f64; 32],
@@ -252,7 +252,7 @@ impl NormalSampler for OscillatingPdf {
 
 /// A chi-square whose expected-mass cubature runs out of rectangles is an `error` naming the
 /// budget, with the bound it reached against its target — never a pass on masses that missed
-/// their bound (issue 27).
+/// their bound.
 #[test]
 fn a_chi2_cubature_out_of_rectangles_is_an_error_naming_its_budget() {
     let m = OscillatingPdf(mfh_reference::ndf::Ggx::new(0.3, 0.3).unwrap());

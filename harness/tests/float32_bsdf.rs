@@ -1,4 +1,4 @@
-//! float32 BSDFs under audit (issues 25 and 27): a rough GGX dielectric written as pbrt-v4's
+//! float32 BSDFs under audit: a rough GGX dielectric written as pbrt-v4's
 //! `DielectricBxDF` writes it and a rough GGX conductor with Schlick's Fresnel, both in f32
 //! arithmetic, handed over as f64. Declared `Precision::F32` they pass the `ci` profile with
 //! `.against` their reference spec and `.ndf` their own float32 GGX (no false alarm from

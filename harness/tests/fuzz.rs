@@ -1,4 +1,4 @@
-//! Fuzzing every parser of user input with proptest (issue 12, "Bad input"): scene JSON, eval
+//! Fuzzing every parser of user input with proptest ("Bad input"): scene JSON, eval
 //! lines (one at a time and as a byte stream), and `mfh chi2`'s arguments as the library
 //! validates them. Each answers a value or a typed error, never panics, and respects its stated
 //! size limits. 10⁴ cases per parser here (seconds at the test profile's opt-level 2);

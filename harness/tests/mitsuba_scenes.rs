@@ -1,6 +1,6 @@
 //! The Mitsuba 3 example scenes under `examples/scenes/` plan what they should: which
 //! materials (NDF, masking, sampling), which checks for each, which plugins are not audited
-//! and why; malformed XML is an error at file:line:column (issue 13).
+//! and why; malformed XML is an error at file:line:column.
 
 use mfh_harness::check::Profile;
 use mfh_harness::cli::run;
@@ -57,7 +57,7 @@ const EVERY_MATERIAL: &[&str] = &[
     "stability.extremes",
     "stability.incidence",
 ];
-/// The checks of a reference BSDF (roughconductor and roughdielectric name one, issue 25).
+/// The checks of a reference BSDF (roughconductor and roughdielectric name one).
 const BSDF_CHECKS: &[&str] = &[
     "bsdf.albedo",
     "bsdf.chi2",
@@ -361,7 +361,7 @@ fn mfh_plan(path: &std::path::Path) -> (i32, String, String) {
     )
 }
 
-/// Issue 25: a JSON material's `bsdf` and a Mitsuba roughdielectric plan the BSDF checks
+/// A JSON material's `bsdf` and a Mitsuba roughdielectric plan the BSDF checks
 /// (`bsdf.chi2` and the rest) through `mfh plan`; bad values exit 2 naming the field.
 #[test]
 fn json_and_mitsuba_bsdf_materials_plan_the_bsdf_checks() {

@@ -1,4 +1,4 @@
-//! Sharded-then-merged equals unsharded (issue 13, "Beyond one machine"): the audit of a small
+//! Sharded-then-merged equals unsharded ("Beyond one machine"): the audit of a small
 //! scene run whole, and run as n = 1, 3, 7 shards by `examples/ci/shard.sh` and merged by
 //! `examples/ci/merge.sh` — the scripts the GitHub Actions and Slurm examples call — gives the
 //! same report.json, timings and artefact folders aside. Also: merge refuses a missing shard,
@@ -248,7 +248,7 @@ fn sharded_then_merged_equals_unsharded_for_1_3_7_shards() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Issue 27: merge re-judges every stored verdict from the record's numbers. A shard whose
+/// Merge re-judges every stored verdict from the record's numbers. A shard whose
 /// passing record was edited to a measured error of 1.0 against a tolerance of 1e-10 (a failure
 /// with its verdict left at pass) merges as a fail, exit 1, and merge says how many verdicts it
 /// corrected; the unedited shard merges with no correction.

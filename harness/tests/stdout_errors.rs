@@ -1,4 +1,4 @@
-//! An output that does not arrive is not a success (issue 27): `mfh plan` and `mfh audit
+//! An output that does not arrive is not a success: `mfh plan` and `mfh audit
 //! --json` with standard output on /dev/full (every write fails with ENOSPC) or on a pipe whose
 //! reader has gone exit 2 with "cannot write standard output" on standard error, as `mfh eval`
 //! and `mfh chi2` do.

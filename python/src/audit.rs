@@ -239,7 +239,16 @@ pub fn audit_ndf(
         caller: caller.clone(),
     };
     let build = || {
-        let mut audit = Audit::of(&ndf).name(&s.name);
+        // A call crosses into Python: checks whose oracle accuracy is a cost trade-off take the
+        // looser of their two stated tolerances, as for a child of the external protocol.
+        let mut audit = Audit::of(&ndf).name(&s.name).remote();
+        if ndf.sample_wm.is_none()
+            && ndf.lambda.is_none()
+            && ndf.sample_wm_visible.is_none()
+        {
+            // The callables given are the capabilities: `d=` alone states that D is all.
+            audit = audit.d_only();
+        }
         if let Some(m) = masking {
             audit = audit.masking(m);
         }

@@ -192,11 +192,6 @@ impl Ndf for PyNdf {
     fn d(&self, m: Vec3) -> f64 {
         self.one("d", &self.d, m)
     }
-    /// A call crosses into Python: checks whose oracle accuracy is a cost trade-off take the
-    /// looser of their two stated tolerances, as for a child of the external protocol.
-    fn is_remote(&self) -> bool {
-        true
-    }
     fn d_batch(&self, m: &[Vec3], out: &mut [f64]) {
         self.directions("d", &self.d, m, out)
     }

@@ -1,4 +1,4 @@
-//! End to end: `mfh audit` and `mfh plan` (issue 4, ARCHITECTURE.md "Checks and records", "Scenes"),
+//! End to end: `mfh audit` and `mfh plan` (ARCHITECTURE.md "Checks and records", "Scenes"),
 //! driven through `mfh_harness::cli::run` as the binary calls it, and the coverage registry:
 //! every closed form of `reference/` is covered by a planned check of the default scene.
 

@@ -874,3 +874,71 @@ fn the_checker_catches_missing_files_and_identifiers() {
     // `Cargo.lock` is neither a source extension nor under a folder: not checked.
     assert_eq!((paths, identifiers), (6 + 4, 8 + 7));
 }
+
+/// The places in `text` that cite a tracker issue by number ("issue 27", "Issues 15 and 26"):
+/// the repository holds no tracker, so a reason is written out, never referred to by number.
+fn issue_numbers(text: &str) -> Vec<usize> {
+    let mut lines = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let lower = line.to_lowercase();
+        let cites = ["issue ", "issues "].iter().any(|word| {
+            lower.match_indices(word).any(|(at, w)| {
+                let before_ok = at == 0
+                    || !lower[..at]
+                        .chars()
+                        .next_back()
+                        .is_some_and(|c| c.is_alphanumeric() || c == '_');
+                before_ok
+                    && lower[at + w.len()..]
+                        .chars()
+                        .next()
+                        .is_some_and(|c| c.is_ascii_digit())
+            })
+        });
+        if cites {
+            lines.push(i + 1);
+        }
+    }
+    lines
+}
+
+#[test]
+fn no_rust_source_cites_a_tracker_issue_by_number() {
+    let root = root();
+    let mut found = Vec::new();
+    let mut scanned = 0;
+    let mut stack = vec![
+        root.join("reference"),
+        root.join("harness"),
+        root.join("tests"),
+        root.join("python/src"),
+    ];
+    while let Some(dir) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for e in entries {
+            let path = e.expect("entry").path();
+            if path.is_dir() {
+                if !path.ends_with("target") {
+                    stack.push(path);
+                }
+            } else if path.extension().is_some_and(|x| x == "rs") {
+                scanned += 1;
+                // This file's own examples below are deliberate.
+                if path.ends_with("tests/docs.rs") {
+                    continue;
+                }
+                for line in issue_numbers(&read(&path)) {
+                    found.push(format!("{}:{line}", path.display()));
+                }
+            }
+        }
+    }
+    assert!(scanned > 100, "only {scanned} Rust files scanned");
+    assert!(found.is_empty(), "tracker issue numbers cited:\n{}", found.join("\n"));
+    assert_eq!(
+        issue_numbers("a (issue 27)\nthe_issue_example\nIssues 15 and 26\nissue tracker"),
+        [1, 3]
+    );
+}

@@ -1,4 +1,4 @@
-//! End to end: `mfh audit --out DIR` writes a self-contained `report.html` (issue 14, "The
+//! End to end: `mfh audit --out DIR` writes a self-contained `report.html` ("The
 //! HTML report") that headless Chromium opens without console or resource errors, every image
 //! with a non-zero natural size; a screenshot goes to `target/tmp/mfh-html-report/`. Without
 //! Chromium the browser test is ignored (listed as such), unless `CI=true` (then it must run).
@@ -185,7 +185,7 @@ fn the_audit_writes_a_self_contained_report_html() {
     for debug in ["Some(", "None,", "PValue {"] {
         assert!(!html.contains(debug), "report.html contains {debug}");
     }
-    // A size a browser opens at once (issue 14: report.html of the default scene's quick audit
+    // A size a browser opens at once (report.html of the default scene's quick audit
     // was 19 MB; plots now only for failures, expected failures and one per check family,
     // decimated paths, heat maps as embedded bitmaps): the bound 3 MB, and no image over
     // 200 kB of data URI.
@@ -383,7 +383,7 @@ fn fmt_num(x: f64) -> String {
     mfh_harness::report::text::num(x)
 }
 
-/// Issue 25: the BSDF section of a dielectric's audit — both hemispheres' observed / expected /
+/// The BSDF section of a dielectric's audit — both hemispheres' observed / expected /
 /// residual maps at each of the five incidences, the albedo plot, and the albedo, consistency
 /// and reciprocity tables holding the records' numbers (read back from report.json).
 #[test]

@@ -1,4 +1,4 @@
-//! The `audit.precision` record: whether a model's answers are all float32 values (issue 27).
+//! The `audit.precision` record: whether a model's answers are all float32 values.
 //! A float32 implementation audited as f64 would have its rounding noise judged against f64
 //! tolerances and chased by the oracles; this probe notices it from the answers themselves —
 //! every D, Λ and pdf on a fixed set of directions exactly representable in float32 — and says
@@ -153,7 +153,7 @@ pub fn record(model: &serde_json::Value, declared: Precision, seen: Seen) -> Che
             "answers": seen.nontrivial,
             "float32_answers": seen.float32,
         }),
-        "issue 27: precision is a property of the implementation",
+        "precision is a property of the implementation",
     );
     r.verdict = if declared == Precision::F64 && seen.is_float32() {
         Verdict::Error {

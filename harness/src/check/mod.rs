@@ -120,7 +120,7 @@ impl Profile {
             Profile::Ci => 1_000_000,
             Profile::Quick => 200_000,
             Profile::Standard => 2_000_000,
-            // 10⁸: a distortion √5 smaller than at 2·10⁷ is caught (issue 15's target: the
+            // 10⁸: a distortion √5 smaller than at 2·10⁷ is caught (the target: the
             // default scene's thorough audit within 10 minutes on 2 cores; docs/performance.md).
             Profile::Thorough => 100_000_000,
         }
@@ -680,7 +680,7 @@ mod tests {
         }
     }
 
-    /// Issue 27: a D scaled by 1e308 made the white furnace's quadrature bound as large as
+    /// A D scaled by 1e308 made the white furnace's quadrature bound as large as
     /// the error, and the record passed with a relative error of 1.6e308. The oracle cannot
     /// judge it: the verdict is an error, never a pass.
     #[test]

@@ -1,4 +1,4 @@
-//! Stress cases for the Λ routes of the Student family (issue 12): every route at γ ∈ {20, 50,
+//! Stress cases for the Λ routes of the Student family: every route at γ ∈ {20, 50,
 //! 90, 171.8, 10³, 10⁶} and θ near normal incidence, at the two incidences of the issue's
 //! defects (0.5, 1.2) and near grazing (π/2 − 10⁻⁶), against the oracle the Smith checks use
 //! (`oracle::smith_lambda::lambda_oracle`: quadrature of (q − μ)P2, or the Student-t partial expectation).
@@ -25,7 +25,7 @@ use serde_json::{json, Value};
 use std::f64::consts::FRAC_PI_2;
 use std::sync::{Arc, OnceLock};
 
-/// The shapes of issue 12's stress cases.
+/// The shapes of the stress cases.
 pub const STRESS_GAMMAS: [f64; 6] = [20.0, 50.0, 90.0, 171.8, 1e3, 1e6];
 
 /// The incidences: near normal, the issue's two defects, near grazing.
@@ -36,7 +36,7 @@ pub const STRESS_THETAS: [f64; 4] = [1e-6, 0.5, 1.2, FRAC_PI_2 - 1e-6];
 pub const LOSS_DEMONSTRATED_FROM: f64 = 1e-6;
 
 const SOURCE: &str = "seed 001 eq 5 (Λ = (1/μ)∫_μ^∞ (q − μ) P2(q) dq), eq 21, 29–30, 36–37, \
-                      Table 1, §8 Algorithm 2; issue 12 (stress cases)";
+                      Table 1, §8 Algorithm 2; stress cases (γ ∈ {20, 50, 90})";
 
 /// The shape key of a Student-family spec (`c` for the general member, else `gamma`).
 fn shape_key(spec: &Value) -> Option<&'static str> {

@@ -206,7 +206,7 @@ pub fn plan(spec: &ModelSpec, why: &str) -> Vec<Planned> {
                 "stability.extremes",
                 variant,
                 case,
-                "issue 2 / ARCHITECTURE.md: finite and accurate for γ ∈ (1.5, 1e8], \
+                "ARCHITECTURE.md: finite and accurate for γ ∈ (1.5, 1e8], \
                              α ∈ [1e-4, 10], θ ∈ [0, π/2]",
             )
             .why(format!("{why}: hard case {label}"))

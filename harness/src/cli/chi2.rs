@@ -499,7 +499,7 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
     }
 
-    /// Issue 12's measured bad inputs: each is exit 2 with a message naming the option and
+    /// The measured bad inputs: each is exit 2 with a message naming the option and
     /// its limit, before any allocation or sampling.
     #[test]
     fn chi2_cli_bad_input_names_the_option_and_the_limit() {
@@ -545,7 +545,7 @@ mod tests {
         assert!(err.contains("--samples"), "{err}");
     }
 
-    /// Issue 27: `--resolution 1 --samples 10` reported a correct sampler as FAIL (χ² NaN,
+    /// `--resolution 1 --samples 10` reported a correct sampler as FAIL (χ² NaN,
     /// dof 0); too few cells or samples for a degree of freedom are bad input, exit 2, naming
     /// the option and its limit. The least accepted run has degrees of freedom and passes.
     #[test]
@@ -627,7 +627,7 @@ mod tests {
 
     const GLASS: &str = r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.4}}"#;
 
-    /// Issue 25: `--bsdf` runs the whole-sphere chi-square of a reference BSDF, from inside
+    /// `--bsdf` runs the whole-sphere chi-square of a reference BSDF, from inside
     /// with `--inside`, and writes both hemispheres' tables and heat maps with `--out`.
     #[test]
     fn chi2_cli_bsdf_over_the_sphere_with_tables() {

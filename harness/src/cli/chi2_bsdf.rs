@@ -1,5 +1,5 @@
 //! `mfh chi2 --bsdf SPEC`: the whole-sphere chi-square of a reference BSDF's sampling at one
-//! incidence, by hand (issue 25; [`crate::sampler_chi2::bsdf`] validates and runs it), with the
+//! incidence, by hand ([`crate::sampler_chi2::bsdf`] validates and runs it), with the
 //! text or JSON summary of the NDF path and, with `--out`, the observed/expected tables and
 //! heat maps of both hemispheres (the files a `bsdf.chi2` record of `mfh audit` gets).
 

@@ -1,4 +1,4 @@
-//! `mfh eval` for reference BSDFs (issue 25): the quantities `bsdf_eval`, `bsdf_pdf` and
+//! `mfh eval` for reference BSDFs: the quantities `bsdf_eval`, `bsdf_pdf` and
 //! `bsdf_sample` of a BSDF spec given as `"bsdf"` (a `mfh_reference::bsdf::BsdfSpec`, e.g.
 //! `{"bsdf": "dielectric", "eta": 1.5, "ndf": {"family": "ggx", "alpha": 0.3}}`). These
 //! queries carry no `"model"`.

@@ -1,4 +1,4 @@
-//! The reference BSDF a Mitsuba 3 `roughconductor` or `roughdielectric` names (issue 25): its
+//! The reference BSDF a Mitsuba 3 `roughconductor` or `roughdielectric` names: its
 //! relative index or complex index, Mitsuba's separable masking and its sampling, as a
 //! [`BsdfSpec`] whose BSDF checks are planned beside the NDF's (see the parent module's table).
 

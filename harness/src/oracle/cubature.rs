@@ -2,7 +2,7 @@
 //! Gauss–Kronrod G7/K15 pair, bisected into quadrants until the estimate meets the tolerance.
 
 // The G7/K15 pair written here, not imported from `mfh_reference::special::gauss_kronrod`:
-// an oracle owes nothing to the code it checks (issue 11). Values: QUADPACK's `dqk15`
+// an oracle owes nothing to the code it checks. Values: QUADPACK's `dqk15`
 // (Piessens, de Doncker-Kapenga, Überhuber, Kahaner 1983, "QUADPACK", Springer, §2.2;
 // the netlib source lists them to 33 digits), rounded to f64. `tests::rule_degrees` checks them
 // by the degrees they integrate exactly (K15: 22, G7: 13) and by the known moments.
@@ -46,7 +46,7 @@ pub const MAX_DEPTH: u32 = 10;
 /// (honest) error estimates. A correct model's chi-square masses at the `ci` profile create
 /// ~10³–10⁴; a density that oscillates faster than any cell (GGX × (1 + ½ sin(10⁴ x))) or is
 /// rounding noise asked for 1e-9 (a float32 pdf) would create 4¹⁰ per piece: the tree grew to
-/// 20 GB (issue 27).
+/// 20 GB.
 pub const MAX_RECTANGLES: usize = 1 << 18;
 
 pub use super::Estimate;

@@ -22,7 +22,7 @@ pub const MAX_PIECES: usize = 400;
 /// ([`Accuracy::noise`]): 32 of them of the summed magnitudes of the pieces. For an f64
 /// integrand 32 ulps; for a float32 implementation 32 ε₃₂ = 3.8e-6: below it, refinement of a
 /// noisy integrand only trades one rounding error for another (a float32 GGX's normalization
-/// passed 2·10⁸ evaluations chasing 1e-11, issue 27).
+/// passed 2·10⁸ evaluations chasing 1e-11).
 const ROUNDOFF: f64 = 32.0;
 
 /// How much rounding of the nodes themselves magnifies round-off on [lo, hi]: a node next to
@@ -44,8 +44,7 @@ fn node_noise(lo: f64, hi: f64) -> f64 {
 /// `oracle::sweep_tests`), ~5 s of a closed-form D.
 /// Past it the inner integrals are no longer computed and the estimate is NaN with an infinite
 /// bound and `evaluations` ≥ the budget, which `check::compare` reports as an `error` naming
-/// the budget: a piecewise-constant D's `smith.lambda_route` took 125 s per record without it
-/// (issue 27).
+/// the budget: a piecewise-constant D's `smith.lambda_route` took 125 s per record without it.
 pub const EVALUATION_BUDGET: u64 = 100_000_000;
 
 /// The estimate of a nested quadrature that ran out of [`EVALUATION_BUDGET`].

@@ -1,4 +1,4 @@
-//! The α sweep of issue 10: correct samplers pass chi-square and KS, and D integrates to 1
+//! The α sweep: correct samplers pass chi-square and KS, and D integrates to 1
 //! within 1e-9, for α from 1e-4 to 2 (GGX, Beckmann, STD γ = 2.5), isotropic and at
 //! anisotropy 1:100, with the oracles placing their cuts from the lobe measured from D alone
 //! ([`lobe::measure`]); a sampler of α off by 5 % still fails. The CI subset is the extremes

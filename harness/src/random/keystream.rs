@@ -13,7 +13,7 @@
 //! shift pair for 12 and 7) — then the transposition of words into blocks by shuffles, all
 //! through `pulp`'s safe wrappers of the intrinsics (no `unsafe`).
 //!
-//! A pair of uniforms now takes 8 bytes (two 32-bit words, issue 26): 1.2 ns a pair with the
+//! A pair of uniforms now takes 8 bytes (two 32-bit words): 1.2 ns a pair with the
 //! conversion to doubles on an AMD EPYC Zen 4 (AVX-512, `chi2_stages/uniforms`, load ~4).
 //! Before, per pair of 53-bit uniforms (16 bytes), against `rand_chacha`: 1.2 ns against 4.7 on an AMD EPYC
 //! Zen 5 (AVX-512, keystream alone); 4.1 ns against 5.8 on an AMD EPYC Zen 3 (AVX2, with the

@@ -13,7 +13,7 @@
 //! **Uniforms.** The i-th 32-bit word of a stream (ChaCha's words in order, as
 //! `rand_chacha`'s `next_u32` gives them) gives the i-th uniform ([`to_unit32`]: the word times
 //! 2⁻³², in [0, 1) on the grid k·2⁻³²); the i-th pair `u = [u₀, u₁]` is uniforms 2i and 2i + 1.
-//! 32 bits, not 53 (issue 26): the samplers' u needs no finer grid (the smallest u > 0 is
+//! 32 bits, not 53: the samplers' u needs no finer grid (the smallest u > 0 is
 //! 2.3e-10, far below any chi-square cell or KS step at 10⁹ samples), and a sample then costs
 //! 8 keystream bytes instead of 16. Generating in blocks ([`Stream::fill_pairs`]) and one at a
 //! time ([`Stream::uniform`], [`uniform`]) give the same numbers (a test), so scalar and batch

@@ -1,4 +1,4 @@
-//! The BSDF section of `report.html` (issue 25), per BSDF audited: the `bsdf.chi2` heat maps of
+//! The BSDF section of `report.html`, per BSDF audited: the `bsdf.chi2` heat maps of
 //! both hemispheres — reflection (wo on wi's side) and transmission, observed / expected /
 //! (O − E)/√E — grouped by incidence; the albedo against incidence (`bsdf.albedo`: the
 //! quadrature with its bound, the Monte Carlo mean weight with its standard error, reflected,

@@ -1,5 +1,5 @@
 //! Running one whole-sphere chi-square test of a reference BSDF's sampler, as `mfh chi2 --bsdf`
-//! asks for it (issue 25): the request (validated against the limits of the NDF path, with
+//! asks for it: the request (validated against the limits of the NDF path, with
 //! typed errors naming the option and the limit), the run ([`crate::oracle::sphere_chi2`]), the
 //! record (a JSON object) and its observed/expected tables ([`RecordData::SphereChi2Table`],
 //! which the report sinks draw). No exit codes and no file writing here.

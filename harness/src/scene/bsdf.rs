@@ -1,4 +1,4 @@
-//! A material's BSDF in mfh's JSON scenes (issue 25): `"bsdf": {"type": "conductor" |
+//! A material's BSDF in mfh's JSON scenes: `"bsdf": {"type": "conductor" |
 //! "dielectric", …}` with the fields of a reference BSDF spec
 //! ([`mfh_reference::bsdf::BsdfSpec`], whose own tag is `"bsdf"`; in a scene the tag is `"type"`
 //! so that the material's key can be `"bsdf"`).

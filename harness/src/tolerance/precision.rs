@@ -1,4 +1,4 @@
-//! The value tolerances of a float32 implementation (issue 27): each an error budget in units
+//! The value tolerances of a float32 implementation: each an error budget in units
 //! of ε₃₂ = 2⁻²³ ≈ 1.19e-7 with its reason. The f64 tolerances of `tolerance.rs` hold for
 //! `Precision::F64`; [`super::Tolerance::at`] picks the row of the declared precision.
 //! Statistical tolerances (α) and the claims of the documents do not depend on the precision of
@@ -108,7 +108,7 @@ pub const F32_TABLE: &[(&str, Tolerance)] = &[
 /// in `precision`: `f64_value` (the tolerance of `tolerance/chi2.rs`) or, above f64, at least
 /// 64 ε of the format (7.6e-6 for float32): the G7/K15 difference of a cell whose density is
 /// rounded to ε relative is ~ε × its mass, so a smaller target bisects rounding noise to the
-/// depth limit (2·10⁸ evaluations for a float32 GGX, issue 27). The masses stay far inside
+/// depth limit (2·10⁸ evaluations for a float32 GGX). The masses stay far inside
 /// the statistical resolution (1/√(N·p) ≈ 2e-2 per cell at 10⁶ samples).
 pub fn cell_relative_tolerance(f64_value: f64, precision: crate::precision::Precision) -> f64 {
     match precision {

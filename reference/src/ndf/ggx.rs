@@ -114,7 +114,7 @@ impl NormalSampler for Ggx {
 
     /// `sample_wm` over a batch, vectorized (the radius u₂/(1 − u₂) too); bit for bit the
     /// scalar result (`ndf::batch`). A form by reciprocal square roots (f32 start, two Newton
-    /// steps), within 8 ulps, was tried for issue 26 and removed: slower on every dispatch path
+    /// steps), within 8 ulps, was tried and removed: slower on every dispatch path
     /// of the Zen 4 it was measured on (a block of 256: 1.12 against 0.99 µs under AVX-512,
     /// 1.57 against 1.28 under AVX2, 3.46 against 3.17 on the baseline).
     fn sample_wm_batch(&self, u: &[[f64; 2]], out: &mut [Vec3]) {

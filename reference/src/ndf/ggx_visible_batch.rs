@@ -1,4 +1,4 @@
-//! GGX's batch visible-normal sampler (issue 25): `Ggx::sample_wm_visible` (Heitz 2018, see
+//! GGX's batch visible-normal sampler: `Ggx::sample_wm_visible` (Heitz 2018, see
 //! `ndf::ggx_visible`) over a block at one incidence, normalized by one reciprocal instead of
 //! three divisions, within [`MAX_ULPS`] of the scalar sampler and the same bits on every
 //! dispatch path.
@@ -27,14 +27,14 @@
 //! reduction) are the scalar sampler's; v·v = 0 (a normal on the horizon at α → 0) is NaN on
 //! both paths (0/0 and 0·∞), so no range guard is needed.
 //!
-//! **Cost.** On the machine of issue 25 (AMD EPYC Zen 4, 2 cores, shared; one block of 256 at
+//! **Cost.** On a 2-core machine (AMD EPYC Zen 4, 2 cores, shared; one block of 256 at
 //! GGX α = 0.3, θi = 1 rad: the bench `chi2_stages/ggx_visible_sampler`, `--quick`) this form
 //! takes 1.23–1.30 µs a block on the AVX-512 path against the three divisions' 1.39–1.58 µs.
 //! The AVX2 and baseline paths are a little slower there (1.84 against 1.77 µs and 4.16
 //! against 4.08 µs, best of 30 in a timing loop): a Zen 4 divides four lanes cheaply.
 //!
 //! **Why not reciprocal square roots by Newton steps** (f32's 1/√a, then two in f64; tried for
-//! GGX's normal batch in issue 26 and removed, `Ggx::sample_wm_batch`).
+//! GGX's normal batch and removed, `Ggx::sample_wm_batch`).
 //! In that timing loop on the AVX-512 path, normalizing by it took 1.40 µs a block against the
 //! exact form's 1.37 (this form: 1.23): the f32 start (conversions, `vsqrtps`, `vdivps`) and
 //! the Newton products cost more than an f64 √ and ÷ on that divider. And the other three

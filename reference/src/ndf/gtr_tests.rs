@@ -730,7 +730,7 @@ fn stable_at_the_edges_of_the_domain() {
     }
 }
 
-/// The accuracy table of seed 004 (issue 3): for every route, the max relative error
+/// The accuracy table of seed 004: for every route, the max relative error
 /// against an independent numerical integral over a grid of γ (columns), α and θ.
 ///
 /// Oracles: Λ from its definition (eq 48*), (1/μ)∫_μ^∞ (q − μ) P2(q) dq by

@@ -921,7 +921,7 @@ fn eq34_display_is_i11_not_i1() {
     assert!((right - exact).abs() < 1e-13);
 }
 
-/// The accuracy table of seed 000 (issue 3): for each closed form and route, the max error
+/// The accuracy table of seed 000: for each closed form and route, the max error
 /// against an independent numerical integral of its definition, per model (columns), over
 /// θ_o ∈ {1e-6, 1e-3, 0.05, 0.3, 0.8, 1.2, 1.5, 1.57, π/2 − 1e-6}, φ_o ∈ {0, 0.7, π/2}
 /// (Λ, G1) and ξ ∈ {1e-9, 0.1, 0.37, 0.5, 0.81, 1 − 1e-9} (samplers).

@@ -839,7 +839,7 @@ mod tests {
     }
 }
 
-/// The accuracy table of the closing note of issue 2: the max relative error of each Λ route
+/// The accuracy table: the max relative error of each Λ route
 /// against the defining integral (test quadrature), over γ, α ∈ {0.05, 0.3, 1} and θ from 0 to
 /// π/2. Run: `MFH_EXTENSIVE=1 cargo test -p mfh-reference --release accuracy_table -- --nocapture`.
 #[cfg(test)]

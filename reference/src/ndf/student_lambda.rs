@@ -534,7 +534,7 @@ mod tests {
             );
             assert!(worst_ratio <= 1.0, "{name}: {worst_ratio}");
         }
-        // The defects of issue 12: the integer route at γ = 90 (θ = 1.2, α = 0.3) refuses.
+        // The stress-case defects: the integer route at γ = 90 (θ = 1.2, α = 0.3) refuses.
         let x = 1.0 / (1.2f64.tan() * 0.3 * 89f64.sqrt());
         let e = route_domain("integer", 90.0, x).unwrap_err();
         assert!(e.to_string().contains("defined where"), "{e}");

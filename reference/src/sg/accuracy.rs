@@ -1,4 +1,4 @@
-//! The accuracy table of seed 003 (issue 3): every SG, ASG and circular-Gaussian closed form,
+//! The accuracy table of seed 003: every SG, ASG and circular-Gaussian closed form,
 //! approximation and `_exact` route against an independent numerical integral (the test
 //! oracle `sg::oracle`, double-exponential quadrature), over sharpness 1e-3 … 1e4.
 //!

@@ -832,7 +832,7 @@ fn corrected_pseudocode_fails_far_below_the_cut() {
     }
 }
 
-/// The accuracy table of seed 002 (issue 3): for every route to the moments of D_s, the max
+/// The accuracy table of seed 002: for every route to the moments of D_s, the max
 /// error (`moment_error`: the mean in units of max(|s̄ᵢ|, σᵢ), variances relative, the
 /// covariance as a correlation) against 2-D quadrature of the definition (`oracle`), per case
 /// (columns: the regular and near-singular cases above), over θ ∈ {0, 1e-6, 0.3, 0.8, 1.2,

@@ -598,7 +598,7 @@ mod tests {
     }
 
     /// The corrected Algorithm 2 against the stable route (itself ≤ 2e-14 against mpmath) at
-    /// the stress shapes of issue 12, over θ from 1e-6 to π/2 − 1e-6 and three roughnesses.
+    /// the stress shapes (γ ∈ {20, 50, 90}), over θ from 1e-6 to π/2 − 1e-6 and three roughnesses.
     #[test]
     fn algorithm2_corrected_at_the_stress_gammas() {
         use crate::special::student_tail::student_lambda;
@@ -633,7 +633,7 @@ mod tests {
             );
             overall = overall.max(worst.0);
         }
-        // The two defects of issue 12: γ = 50, θ = 0.5 and γ = 90 (STD, α = 0.3).
+        // The two stress-case defects: γ = 50, θ = 0.5 and γ = 90 (STD, α = 0.3).
         for &(c, theta) in &[(50.0, 0.5), (90.0, 0.5), (90.0, 1.2)] {
             let x = 1.0 / (f64::tan(theta) * 0.3 * (c - 1.0f64).sqrt());
             let (got, want) = (lambda_algorithm2_corrected(c, x), student_lambda(c, x));

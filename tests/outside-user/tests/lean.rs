@@ -1,5 +1,5 @@
 //! A renderer that gates its models with mfh gets the audit API and report.json without the
-//! CLI's, the HTML report's or the Mitsuba reader's dependencies (issue 24): this crate's build
+//! CLI's, the HTML report's or the Mitsuba reader's dependencies: this crate's build
 //! (its dependencies and dev-dependencies, mfh-harness with `default-features = false`) holds
 //! none of clap, indicatif, plotters or roxmltree.
 

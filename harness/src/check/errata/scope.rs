@@ -1,4 +1,4 @@
-//! What a scene uses, for planning only the errata and claims that concern it (issue 13, "a
+//! What a scene uses, for planning only the errata and claims that concern it ("a
 //! scene plans only what its materials call for"): the model families of its materials and
 //! the effects it exercises (built from a scene by the planner, `plan::errata_scope`: checks
 //! know nothing of scenes). Each erratum and claim declares a [`Concern`]; it is planned when

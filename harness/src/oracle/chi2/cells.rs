@@ -1,6 +1,6 @@
 //! The chi-square's cell layout: rows at the quantiles of the density's own cos θ marginal and,
 //! for an anisotropic or off-axis lobe, columns at the quantiles of its φ marginal, so that every
-//! cell expects about the same count (issue 26). On the equal-area grid a peaked lobe (GGX α =
+//! cell expects about the same count. On the equal-area grid a peaked lobe (GGX α =
 //! 0.3) puts nearly every sample into the top one or two of 16 rows, and the test spreads its
 //! degrees of freedom over cells that expect almost nothing.
 //!
@@ -36,7 +36,7 @@ pub const ANISOTROPIC: f64 = 1.5;
 /// How the chi-square's cells are placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Layout {
-    /// The equal-area grid: rows of equal cos θ, columns of equal φ (the layout before issue 26).
+    /// The equal-area grid: rows of equal cos θ, columns of equal φ (the layout before the lobe-quantile cells).
     EqualArea,
     /// Rows at the density's cos θ-marginal quantiles, columns at its φ-marginal quantiles for
     /// an anisotropic or off-axis lobe.

@@ -1,6 +1,6 @@
 //! The chi-square statistic of a table split into two independent parts, so that the few
 //! degrees of freedom where the common sampler errors live are not diluted by the many where
-//! they do not (issue 26: a roughness error moves only the cos θ marginal, and a 16 × 32
+//! they do not (a roughness error moves only the cos θ marginal, and a 16 × 32
 //! table's 511 degrees of freedom spread its non-centrality over 496 azimuthal cells that
 //! carry no signal).
 //!

@@ -59,7 +59,7 @@ fn chi2_std_anisotropic_passes() {
 
 #[test]
 fn chi2_narrow_lobes_pass() {
-    // Issue 10: the expected-count integration once found a mass of ~1e-113 for Beckmann
+    // The expected-count integration once found a mass of ~1e-113 for Beckmann
     // α = 1e-3 (it missed the lobe); the `mfh chi2` path (no lobe given: measured from the
     // pdf) at resolution 16.
     for json in [

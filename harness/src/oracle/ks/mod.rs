@@ -94,15 +94,14 @@ pub const INNER_ACCURACY: Accuracy = Accuracy {
 /// within this many roundings of its mass. For f64 it never binds (16 ε ≈ 3.6e-15 of a span's
 /// mass against shares ≥ 1e-10); for a float32 pdf (16 ε₃₂ ≈ 1.9e-6 of the span's mass,
 /// summing to ≤ 1.9e-6 of the CDF) it stops the bisection of rounding noise, which ran every
-/// initial interval to [`MAX_SPANS`] (issue 27). The table's error bound still sums the
+/// initial interval to [`MAX_SPANS`]. The table's error bound still sums the
 /// accepted |S₂ − S₁|, so the bound stays honest and `TABLE_FRACTION` still judges it.
 pub(crate) const SIMPSON_NOISE_FLOOR: f64 = 16.0;
 /// The most density evaluations one KS table spends (the inner integrals included): 5·10⁷,
 /// ~50× a smooth model's table at the `thorough` profile. Past it the spans still open are
 /// accepted with an infinite error, so the test refuses to judge
 /// ([`Failure::TableInaccurate`], an `error` record) instead of refining for ever: the table
-/// of a D that oscillates faster than any span (GGX × (1 + ½ sin(10⁴ x))) ran for minutes
-/// (issue 27).
+/// of a D that oscillates faster than any span (GGX × (1 + ½ sin(10⁴ x))) ran for minutes.
 pub const KS_EVALUATION_BUDGET: u64 = 50_000_000;
 /// Initial intervals per piece between cuts, before adaptive bisection.
 pub(crate) const INITIAL_PER_PIECE: usize = 8;
