@@ -27,17 +27,9 @@ pub const MAX_MATERIALS: usize = 256;
 /// planned check), so this bounds planning to ≈ 300 MB.
 pub const MAX_PLAN_CHECKS: usize = 50_000;
 
-/// How a material samples.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Sampling {
-    /// Normals from D(m)(m·n): `sample_wm`.
-    Normals,
-    /// Visible normals D_wi(m).
-    VisibleNormals,
-    /// The pseudo-VNIS of seed 001 §7.2 (normals, weighted by G/G1).
-    PseudoVnis,
-}
+/// How a material samples: the reference crate's one definition (`normals`, `visible_normals`,
+/// `pseudo_vnis`), which its BSDFs use too.
+pub use mfh_reference::bsdf::Sampling;
 
 /// One material: an NDF (`model`, with what the renderer evaluates of it: `masking`,
 /// `sampling`), a reference BSDF (`bsdf`), or both (the Mitsuba reader's rough BSDFs). A
