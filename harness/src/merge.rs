@@ -11,12 +11,17 @@
 //! corrections are listed ([`Merged::corrected`]) for the CLI to print.
 //!
 //! Refused, with the shard folder named: a missing or duplicated shard, shards of different
-//! plans (fingerprint), seeds, profiles, scenes or mfh versions, another schema version.
+//! plans (fingerprint), seeds, profiles, scenes or mfh versions, another schema version; a
+//! record that is not the check planned at its index (`record_trust::identity_mismatch`:
+//! another check id, model or case — a renamed check, an edited case, records moved), and
+//! planned checks that do not make up the plan's fingerprint (indices swapped in a
+//! `shard.json`).
 
 use crate::readback::{read_report, ReadError};
-use crate::record::{CheckRecord, Verdict, SCHEMA_VERSION};
+use crate::record::{CheckRecord, SCHEMA_VERSION};
+use crate::record_trust::{identity_mismatch, Identity};
 use crate::run::{judge_statistical, summarize, AuditReport};
-use crate::shard::{ShardInfo, SHARD_FILE};
+use crate::shard::{fingerprint_of, ShardInfo, SHARD_FILE};
 use std::path::{Path, PathBuf};
 
 /// Why shard reports could not be merged.
@@ -59,24 +64,12 @@ pub struct Merged {
     pub corrected: Vec<String>,
 }
 
-/// Re-judges a record read from `dir` at plan index `index`: a verdict its numbers contradict
-/// becomes `fail`; returns the line that says so.
+/// Re-judges a record read from `dir` at plan index `index` (`record_trust::rejudge`: a
+/// verdict its numbers contradict becomes `fail`); returns the line that says so.
 fn rejudge(record: &mut CheckRecord, dir: &Path, index: usize) -> Option<String> {
-    if !record.verdict_contradicts_measurement() {
-        return None;
-    }
-    let error = record.measured.and_then(|m| m.error()).unwrap_or(f64::NAN);
-    let tolerance = record.tolerance.as_ref().map_or(f64::NAN, |t| t.value);
-    let slack = crate::record::allowed_error(0.0, record.oracle.as_ref());
-    let line = format!(
-        "{}: plan index {index} ({}): stored verdict {} contradicts measured error {error:e} \
-         against tolerance {tolerance:e} + oracle slack {slack:e}; re-judged as fail",
-        dir.display(),
-        record.check,
-        record.verdict.name(),
-    );
-    record.verdict = Verdict::Fail;
-    Some(line)
+    let check = record.check.clone();
+    crate::record_trust::rejudge(record)
+        .map(|line| format!("{}: plan index {index} ({check}): {line}", dir.display()))
 }
 
 /// Reads `dir/report.json` and `dir/shard.json`.
@@ -100,10 +93,11 @@ pub fn read_shard(dir: &Path) -> Result<ShardReport, MergeError> {
             info.schema_version
         )));
     }
-    if info.indices.len() != report.records.len() {
+    if info.indices.len() != report.records.len() || info.planned.len() != info.indices.len() {
         return Err(shard_error(format!(
-            "lists {} plan indices but report.json has {} records",
+            "lists {} plan indices and {} planned checks but report.json has {} records",
             info.indices.len(),
+            info.planned.len(),
             report.records.len()
         )));
     }
@@ -197,16 +191,26 @@ pub fn merge(shards: Vec<ShardReport>) -> Result<Merged, MergeError> {
         return bad(format!("missing shard(s) {}", missing.join(", ")));
     }
     let mut slots: Vec<Option<CheckRecord>> = vec![None; plan_checks];
+    let mut identities: Vec<Option<&Identity>> = vec![None; plan_checks];
     let mut wall: f64 = 0.0;
     let mut corrected = Vec::new();
     for s in &shards {
         wall = wall.max(s.report.summary.wall_seconds);
-        for (&i, r) in s.info.indices.iter().zip(&s.report.records) {
+        let listed = s.info.indices.iter().zip(&s.info.planned);
+        for ((&i, planned), r) in listed.zip(&s.report.records) {
             match slots.get_mut(i) {
                 Some(slot @ None) => {
+                    if let Some(why) = identity_mismatch(planned, r) {
+                        return bad(format!(
+                            "{}: the record at plan index {i} is not the planned check's \
+                             ({why}): report.json or shard.json was edited",
+                            s.dir.display()
+                        ));
+                    }
                     let mut r = r.clone();
                     corrected.extend(rejudge(&mut r, &s.dir, i));
                     *slot = Some(r);
+                    identities[i] = Some(planned);
                 }
                 _ => {
                     return bad(format!(
@@ -215,6 +219,19 @@ pub fn merge(shards: Vec<ShardReport>) -> Result<Merged, MergeError> {
                     ))
                 }
             }
+        }
+    }
+    // The planned checks, in plan order, must be the plan the shards name: indices moved
+    // between records, or a planned check edited in a shard.json, change the fingerprint.
+    if identities.iter().all(Option::is_some) {
+        let made = fingerprint_of(identities.iter().flatten().map(|i| (*i).clone()));
+        if made != first.info.plan_fingerprint {
+            return bad(format!(
+                "the planned checks listed in the shard.json files, in plan-index order, have \
+                 the fingerprint {made}, not the plan's {}: a shard.json was edited (indices \
+                 or planned checks)",
+                first.info.plan_fingerprint
+            ));
         }
     }
     let mut records: Vec<CheckRecord> = Vec::with_capacity(plan_checks);

@@ -31,6 +31,7 @@
 //! the file, line and column.
 
 mod bsdf;
+mod position;
 
 use crate::scene::{Material, NotAudited, Sampling, Scene, SceneError};
 use mfh_reference::{Masking, ModelSpec};
@@ -66,6 +67,11 @@ const PLUGIN_TAGS: &[&str] = &[
     "phase",
     "volume",
 ];
+
+/// The most plugin elements ([`PLUGIN_TAGS`]) a scene may have: every one that is not audited
+/// is listed in the report and its summary, and a Mitsuba scene that mfh audits names a few
+/// hundred (the 1 MiB size limit held 61 000 empty `<shape/>`s, a 3 MB not-audited list).
+pub const MAX_PLUGINS: usize = 10_000;
 
 /// BSDFs that only wrap others.
 const WRAPPERS: &[&str] = &["twosided", "blendbsdf", "mask", "bumpmap", "normalmap"];
@@ -161,7 +167,7 @@ pub fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
         }
     })?;
     let mut reader = Reader {
-        doc: &doc,
+        positions: position::Positions::new(text),
         origin,
         defaults: BTreeMap::new(),
         ids: BTreeSet::new(),
@@ -175,6 +181,19 @@ pub fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
             format!(
                 "the root element is <{}>, a Mitsuba scene's is <scene>",
                 root.tag_name().name()
+            ),
+        ));
+    }
+    let plugins = root
+        .descendants()
+        .filter(|n| n.is_element() && PLUGIN_TAGS.contains(&n.tag_name().name()))
+        .count();
+    if plugins > MAX_PLUGINS {
+        return Err(reader.error(
+            root,
+            format!(
+                "{plugins} plugin elements (<shape>, <bsdf>, <emitter>, …) exceed the limit of \
+                 {MAX_PLUGINS} (each one not audited is listed in the report)"
             ),
         ));
     }
@@ -219,7 +238,7 @@ pub fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
 
 /// The walk over one document.
 struct Reader<'a, 'input> {
-    doc: &'a Document<'input>,
+    positions: position::Positions<'input>,
     origin: &'a str,
     defaults: BTreeMap<String, String>,
     ids: BTreeSet<String>,
@@ -241,11 +260,11 @@ enum Prop {
 
 impl<'input> Reader<'_, 'input> {
     fn error(&self, node: Node, message: String) -> SceneError {
-        let pos = self.doc.text_pos_at(node.range().start);
+        let (line, column) = self.positions.at(node.range().start);
         SceneError::Syntax {
             origin: self.origin.to_string(),
-            line: pos.row as usize,
-            column: pos.col as usize,
+            line,
+            column,
             message,
         }
     }
@@ -286,8 +305,8 @@ impl<'input> Reader<'_, 'input> {
         Ok(match self.attr(node, "id")? {
             Some(id) => id,
             None => {
-                let pos = self.doc.text_pos_at(node.range().start);
-                format!("{kind}@{}:{}", pos.row, pos.col)
+                let (line, column) = self.positions.at(node.range().start);
+                format!("{kind}@{line}:{column}")
             }
         })
     }

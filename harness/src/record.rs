@@ -421,19 +421,54 @@ impl CheckRecord {
     }
 
     /// Whether the stored verdict contradicts the record's own numbers
-    /// ([`CheckRecord::meets_tolerance`]): a pass or a skip whose measured error exceeds the
-    /// tolerance plus the oracle's slack (a failure called something else), or an expected
-    /// failure whose error is within it (nothing failed). A failure, an unexpected pass and an
-    /// error fail the audit whatever the numbers say, and a record without an error and
-    /// tolerance has nothing to contradict.
+    /// ([`CheckRecord::contradiction`]).
     pub fn verdict_contradicts_measurement(&self) -> bool {
-        let Some(meets) = self.meets_tolerance() else {
-            return false;
+        self.contradiction().is_some()
+    }
+
+    /// How the stored verdict contradicts the rest of the record, if it does (what `mfh merge`
+    /// and `--resume` re-judge a record read back from a file by, `record_trust::rejudge`):
+    /// - a pass whose measured error exceeds the tolerance plus the oracle's slack
+    ///   ([`CheckRecord::meets_tolerance`]), or whose check set a tolerance and measured
+    ///   nothing against it (a chi-square that failed its sanity checks fails outright, with
+    ///   no p-value), or whose case names a sanity failure;
+    /// - a skip with anything measured (a skipped check runs nothing);
+    /// - an expected failure whose error is within the tolerance (nothing failed).
+    ///
+    /// A failure, an unexpected pass and an error fail the audit whatever the numbers say, so a
+    /// failure with no numbers to re-judge cannot be turned into a pass or a skip.
+    pub fn contradiction(&self) -> Option<String> {
+        let numbers = || {
+            let error = self.measured.and_then(|m| m.error()).unwrap_or(f64::NAN);
+            let tolerance = self.tolerance.as_ref().map_or(f64::NAN, |t| t.value);
+            let slack = allowed_error(0.0, self.oracle.as_ref());
+            format!(
+                "measured error {error:e} against tolerance {tolerance:e} + oracle slack {slack:e}"
+            )
         };
+        let sanity = self.case.get("sanity_failure").is_some();
         match self.verdict {
-            Verdict::Pass | Verdict::Skipped { .. } => !meets,
-            Verdict::ExpectedFailure { .. } => meets,
-            Verdict::Fail | Verdict::UnexpectedPass { .. } | Verdict::Error { .. } => false,
+            Verdict::Pass if self.meets_tolerance() == Some(false) => {
+                Some(format!("contradicts {}", numbers()))
+            }
+            Verdict::Pass if self.tolerance.is_some() && self.measured.is_none() => Some(
+                "has a tolerance but nothing measured against it (a check that measured \
+                 nothing earned no pass)"
+                    .into(),
+            ),
+            Verdict::Pass | Verdict::Skipped { .. } if sanity => Some(format!(
+                "contradicts the sanity failure its case names ({})",
+                self.case["sanity_failure"]
+            )),
+            Verdict::Skipped { .. }
+                if self.measured.is_some() || self.tolerance.is_some() || self.value.is_some() =>
+            {
+                Some("has measurements, but a skipped check runs nothing".into())
+            }
+            Verdict::ExpectedFailure { .. } if self.meets_tolerance() == Some(true) => {
+                Some(format!("contradicts {} (nothing failed)", numbers()))
+            }
+            _ => None,
         }
     }
 }
@@ -491,7 +526,11 @@ mod tests {
         assert!(record(f64::NAN, 1e-10, 0.0, Verdict::Pass).verdict_contradicts_measurement());
         let skipped = Verdict::Skipped { reason: "s".into() };
         assert!(record(1.0, 1e-10, 0.0, skipped.clone()).verdict_contradicts_measurement());
-        assert!(!record(0.0, 1e-10, 0.0, skipped).verdict_contradicts_measurement());
+        // A skip runs nothing: any measurement contradicts it, a bare skip does not.
+        assert!(record(0.0, 1e-10, 0.0, skipped.clone()).verdict_contradicts_measurement());
+        let mut bare = CheckRecord::new("x.y", Value::Null, Value::Null, "");
+        bare.verdict = skipped;
+        assert!(!bare.verdict_contradicts_measurement());
         let expected = Verdict::ExpectedFailure { reason: "e".into() };
         assert!(record(0.0, 1e-10, 0.0, expected.clone()).verdict_contradicts_measurement());
         assert!(!record(1.0, 1e-10, 0.0, expected).verdict_contradicts_measurement());
@@ -505,5 +544,23 @@ mod tests {
             alpha: 1e-4,
         });
         assert_eq!(p.meets_tolerance(), None);
+    }
+
+    /// A failure without numbers (a chi-square's sanity failure: a tolerance, no p-value, the
+    /// reason in its case) cannot be turned into a pass or a skip.
+    #[test]
+    fn a_numberless_failure_cannot_become_a_pass_or_a_skip() {
+        let mut r = record(0.0, 1e-4, 0.0, Verdict::Fail);
+        r.measured = None;
+        r.case = serde_json::json!({"theta": 0.5, "sanity_failure": "pdf mass 0.9"});
+        assert_eq!(r.contradiction(), None);
+        r.verdict = Verdict::Pass;
+        let why = r.contradiction().unwrap();
+        assert!(why.contains("nothing measured"), "{why}");
+        r.tolerance = None;
+        let why = r.contradiction().unwrap();
+        assert!(why.contains("sanity failure"), "{why}");
+        r.verdict = Verdict::Skipped { reason: "s".into() };
+        assert!(r.contradiction().unwrap().contains("sanity failure"));
     }
 }

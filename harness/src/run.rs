@@ -10,7 +10,7 @@
 //! (with its record) to a callback, takes the records of an interrupted run (by [`plan_key`])
 //! and stops starting checks after a time limit; this module writes no file.
 
-use crate::check::{PlannedCheck, Profile, RunContext};
+use crate::check::{budget, PlannedCheck, Profile, RunContext};
 use crate::plan::plan;
 use crate::random::splitmix64;
 use crate::record::{CheckRecord, Measured, Verdict, SCHEMA_VERSION};
@@ -77,12 +77,19 @@ pub struct RunControl {
     /// not run again, its record is taken. Records do not depend on the order or the thread a
     /// check runs on ([`check_seed`]), so a resumed audit has the records of an uninterrupted
     /// one. (The key is the planned check's, not the record's identity: some checks refine
-    /// the case they record.)
+    /// the case they record.) The file can be edited, so a record is taken only if it is the
+    /// planned check's (`record_trust::identity_mismatch`: else the check runs again), and
+    /// re-judged from its numbers as `mfh merge` re-judges (`record_trust::rejudge`); each
+    /// is told in [`CheckEvent::Plan`]'s `distrusted`.
     pub resume: Option<Arc<std::collections::HashMap<String, CheckRecord>>>,
     /// The wall-time limit from the start of [`run_plan`]: a check not started when it has
     /// passed is not run and gets an `error` record naming the limit ([`not_run_message`]);
     /// checks already running finish (a check cannot be cancelled midway).
     pub max_time: Option<Duration>,
+    /// The wall-clock budget of each record (`None`: the profile's,
+    /// [`crate::check::budget::record_budget`]): a check that runs past it ends as an `error`
+    /// record naming the budget ([`crate::check::budget`]).
+    pub record_budget: Option<Duration>,
 }
 
 /// What happened to one planned check ([`RunControl::on_check`]).
@@ -95,6 +102,10 @@ pub enum CheckEvent<'e> {
         checks: usize,
         /// Checks whose records were taken from the earlier run.
         resumed: usize,
+        /// One line per resumed record not taken as it was stored: a record that is not its
+        /// plan key's planned check's (not taken: the check runs again), or whose verdict its
+        /// numbers contradict (taken re-judged as `fail`) — [`crate::record_trust`].
+        distrusted: &'e [String],
     },
     /// Check `index` of the plan has started.
     Started {
@@ -363,21 +374,43 @@ pub fn run_plan(
     let control = &options.control;
     let deadline = control.max_time.map(|limit| start + limit);
     let trace = std::env::var_os("MFH_TRACE").is_some();
+    let record_budget = control
+        .record_budget
+        .unwrap_or_else(|| budget::record_budget(options.profile));
     let slots: Vec<std::sync::OnceLock<CheckRecord>> =
         plan.iter().map(|_| std::sync::OnceLock::new()).collect();
     let mut resumed = 0;
+    let mut distrusted = Vec::new();
     if let Some(previous) = &control.resume {
-        for (slot, p) in slots.iter().zip(plan) {
-            if let Some(r) = previous.get(&plan_key(p)) {
-                let _ = slot.set(r.clone());
-                resumed += 1;
+        for (index, (slot, p)) in slots.iter().zip(plan).enumerate() {
+            let key = plan_key(p);
+            let Some(r) = previous.get(&key) else {
+                continue;
+            };
+            let identity = crate::record_trust::Identity::of(p);
+            if let Some(why) = crate::record_trust::identity_mismatch(&identity, r) {
+                distrusted.push(format!(
+                    "the record under plan key {key} (plan index {index}) is not that planned \
+                     check's: {why}; not taken, the check runs again"
+                ));
+                continue;
             }
+            let mut r = r.clone();
+            if let Some(line) = crate::record_trust::rejudge(&mut r) {
+                distrusted.push(format!(
+                    "plan key {key} (plan index {index}, {}): {line}",
+                    r.check
+                ));
+            }
+            let _ = slot.set(r);
+            resumed += 1;
         }
     }
     if let Some(f) = &control.on_check {
         (f.0)(CheckEvent::Plan {
             checks: plan.len(),
             resumed,
+            distrusted: &distrusted,
         });
     }
     let (done, failures) = (AtomicUsize::new(resumed), AtomicUsize::new(0));
@@ -397,22 +430,38 @@ pub fn run_plan(
         let ctx = RunContext {
             seed: check_seed(options.seed, p),
         };
-        let mut r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| (p.run)(&ctx)))
-            .unwrap_or_else(|e| {
-                let mut r = CheckRecord::new(&p.check, p.model.clone(), p.case.clone(), "");
+        let started = Instant::now();
+        let error = |message: String| {
+            let mut r = CheckRecord::new(&p.check, p.model.clone(), p.case.clone(), "");
+            r.verdict = Verdict::Error { message };
+            r.cost.wall_seconds = started.elapsed().as_secs_f64();
+            r
+        };
+        let over_budget = || {
+            error(budget::over_budget_message(
+                record_budget,
+                started.elapsed().as_secs_f64(),
+            ))
+        };
+        let mut r = match budget::run_within(Some(record_budget), started, || (p.run)(&ctx)) {
+            budget::Outcome::Done(_) if started.elapsed() > record_budget => over_budget(),
+            budget::Outcome::Done(r) => r,
+            budget::Outcome::OverBudget => over_budget(),
+            budget::Outcome::Panicked(e) => {
                 let message = e
                     .downcast_ref::<String>()
                     .cloned()
                     .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
                     .unwrap_or_default();
-                r.verdict = Verdict::Error {
-                    message: format!("a panic inside the check or the model's methods: {message}"),
-                };
-                r
-            });
+                error(format!(
+                    "a panic inside the check or the model's methods: {message}"
+                ))
+            }
+        };
         if r.covers.is_empty() {
             r.covers = p.covers.clone();
         }
+        crate::record_trust::keep_planned_case(&mut r.case, &p.case);
         if trace {
             eprintln!(
                 "done {:.3}s {} {} {} {}",

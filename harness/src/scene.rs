@@ -338,7 +338,18 @@ impl Scene {
         let scene = self;
         let origin = origin.to_string();
         if scene.materials.is_empty() && !scene.not_audited.is_empty() {
-            let list: Vec<String> = scene.not_audited.iter().map(|n| n.to_string()).collect();
+            // The first few only: an error is one short line, whatever the scene holds.
+            const SHOWN: usize = 10;
+            let n = scene.not_audited.len();
+            let mut list: Vec<String> = scene
+                .not_audited
+                .iter()
+                .take(SHOWN)
+                .map(|n| n.to_string())
+                .collect();
+            if n > SHOWN {
+                list.push(format!("… and {} more, {n} in all", n - SHOWN));
+            }
             return Err(SceneError::NothingToAudit {
                 origin,
                 not_audited: list.join("; "),

@@ -18,6 +18,7 @@ use crate::check::Planned;
 use crate::estimate::estimated_cost;
 use crate::plan::plan;
 use crate::record::SCHEMA_VERSION;
+use crate::record_trust::Identity;
 use crate::run::sidak_alpha;
 use crate::run::{
     fnv1a, judge_at, reproduce_command, run_plan, summarize, AuditOptions, AuditReport,
@@ -81,6 +82,10 @@ pub struct ShardInfo {
     pub plan_fingerprint: String,
     /// The plan indices this shard ran, ascending (its records are in this order).
     pub indices: Vec<usize>,
+    /// The planned check at each of those indices: `mfh merge` checks that they make up the
+    /// plan's fingerprint and that each record is its planned check's
+    /// (`record_trust::identity_mismatch`).
+    pub planned: Vec<crate::record_trust::Identity>,
     /// The shard's estimated cost (seconds, [`estimated_cost`]).
     pub estimated_seconds: f64,
     /// The command that reproduces the unsharded audit.
@@ -116,10 +121,12 @@ pub fn assign(plan: &[Planned], count: usize) -> Vec<usize> {
 
 /// The fingerprint of a plan (hex FNV-1a of its `check|model|case` lines).
 pub fn fingerprint(plan: &[Planned]) -> String {
-    let text: Vec<String> = plan
-        .iter()
-        .map(|p| format!("{}|{}|{}", p.check, p.model, p.case))
-        .collect();
+    fingerprint_of(plan.iter().map(Identity::of))
+}
+
+/// The fingerprint of the planned checks `identities`, in plan order ([`fingerprint`]).
+pub fn fingerprint_of(identities: impl Iterator<Item = Identity>) -> String {
+    let text: Vec<String> = identities.map(|i| i.line()).collect();
     format!("{:016x}", fnv1a(&text.join("\n")))
 }
 
@@ -139,11 +146,13 @@ pub fn audit_shard(
     let shard_of = assign(&planned, spec.count);
     let mut estimated_seconds = 0.0;
     let mut indices = Vec::new();
+    let mut identities = Vec::new();
     let mut mine = Vec::new();
     for (i, p) in planned.into_iter().enumerate() {
         if shard_of[i] == spec.index - 1 {
             estimated_seconds += estimated_cost(&p);
             indices.push(i);
+            identities.push(Identity::of(&p));
             mine.push(p);
         }
     }
@@ -170,6 +179,7 @@ pub fn audit_shard(
         plan_checks,
         plan_fingerprint,
         indices,
+        planned: identities,
         estimated_seconds,
         unsharded_command,
     };

@@ -416,3 +416,86 @@ fn the_api_streams_records_and_resumes_from_them() {
     );
     assert_eq!(again.records, first.records);
 }
+
+/// A report.jsonl can be edited: `--resume` re-judges every stored verdict from the record's
+/// numbers (as `mfh merge` does) and takes a record only under the plan key of the check that
+/// made it. Each tampering below starts from the complete report.jsonl of the tiny audit.
+#[test]
+fn resume_rejudges_or_refuses_every_tampered_record() {
+    let dir = temp("tamper");
+    let scene = tiny_scene(&dir);
+    let whole = dir.join("whole");
+    let (code, _, err) = mfh(&tiny_args(&scene, whole.to_str().unwrap()));
+    assert_eq!(code, 0, "{err}");
+    let expected = read(&whole.join("report.json"));
+    let (header, lines) = jsonl(&whole.join("report.jsonl"));
+    let passing = lines
+        .iter()
+        .position(|r| r["verdict"] == "pass" && r["measured"]["error"].is_number())
+        .expect("a passing record with a measured error");
+    let other = lines
+        .iter()
+        .position(|r| r["check"] != lines[passing]["check"])
+        .expect("a record of another check");
+    // Resumes `edited` (the record lines) in a fresh folder: (exit code, stderr, report).
+    let resume = |name: &str, edited: &[Value]| {
+        let out = dir.join(name);
+        std::fs::create_dir_all(&out).unwrap();
+        let mut text = format!("{header}\n");
+        for l in edited {
+            text.push_str(&format!("{l}\n"));
+        }
+        std::fs::write(out.join("report.jsonl"), text).unwrap();
+        let mut args = tiny_args(&scene, out.to_str().unwrap());
+        args.extend(["--resume", out.to_str().unwrap()]);
+        let (code, _, err) = mfh(&args);
+        (code, err, read(&out.join("report.json")), out)
+    };
+
+    // An expected failure (error 1.0) edited to pass, and a pass edited to an error of 0.5
+    // against a tolerance of 1e-9: re-judged as the failures their numbers say, exit 1.
+    for (name, error, verdict) in [("xfail", 1.0, "expected_failure"), ("error", 0.5, "pass")] {
+        let mut edited = lines.clone();
+        let r = &mut edited[passing];
+        r["measured"]["error"] = Value::from(error);
+        r["tolerance"]["value"] = Value::from(1e-9);
+        if verdict == "expected_failure" {
+            // The stored record of an expected failure, then its verdict edited to pass.
+            r["reason"] = Value::from("erratum");
+        }
+        r["verdict"] = Value::from("pass");
+        let (code, err, report, _) = resume(name, &edited);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(
+            err.contains("were not taken as written")
+                && err.contains("stored verdict pass contradicts measured error"),
+            "{name}: {err}"
+        );
+        assert_eq!(report["summary"]["counts"]["fail"], 1, "{name}");
+    }
+
+    // A record of a nonexistent check under a real plan key, and two records' keys swapped:
+    // not taken, their checks run again, and the report is the uninterrupted one.
+    let mut renamed = lines.clone();
+    renamed[passing]["check"] = Value::from("smith.no_such_check");
+    let mut swapped = lines.clone();
+    let key = swapped[passing]["planned"].clone();
+    swapped[passing]["planned"] = swapped[other]["planned"].clone();
+    swapped[other]["planned"] = key;
+    for (name, edited, refused) in [("renamed", renamed, 1), ("swapped", swapped, 2)] {
+        let (code, err, report, out) = resume(name, &edited);
+        assert_eq!(code, 0, "{name}: {err}");
+        assert_eq!(
+            err.matches("is not that planned check's").count(),
+            refused,
+            "{name}: {err}"
+        );
+        assert!(err.contains("the check runs again"), "{name}: {err}");
+        assert_eq!(
+            normalized_records(&report, &out),
+            normalized_records(&expected, &whole),
+            "{name}: the report of the uninterrupted audit"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -359,3 +359,45 @@ fn an_invalid_bsdf_against_is_bad_input_before_the_child_starts() {
         "{stderr}"
     );
 }
+
+/// An `--against` spec of a kind the child does not offer (an NDF spec for the BSDF-only
+/// dielectric, a BSDF spec for the NDF-only GGX) is bad input, exit 2 as soon as the child has
+/// described itself: no check runs, no report is written (it used to be a failing record after
+/// the whole audit, exit 1 after a minute). The time is printed, not asserted.
+#[test]
+fn an_against_spec_of_the_wrong_kind_is_exit_2_before_the_audit() {
+    for (file, against, kind) in [
+        ("dielectric.py", r#"{"family":"ggx","alpha":0.3}"#, "an NDF"),
+        (
+            "ggx.py",
+            r#"{"bsdf":"dielectric","eta":1.5,"ndf":{"family":"ggx","alpha":0.3}}"#,
+            "a BSDF",
+        ),
+    ] {
+        let out = temp(&format!("wrong-kind-{file}"));
+        let cmd = example(file, "");
+        let t = Instant::now();
+        let (code, _, err) = run(&[
+            "audit-external",
+            "--cmd",
+            &cmd,
+            "--profile",
+            "ci",
+            "--against",
+            against,
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        eprintln!("{file}: exit {code} in {:.2} s", t.elapsed().as_secs_f64());
+        assert_eq!(code, 2, "{file}: {err}");
+        assert!(
+            err.contains(&format!(
+                "the spec is of {kind}, which the child does not offer"
+            )),
+            "{file}: {err}"
+        );
+        assert!(!out.join("report.json").exists(), "{file}: no audit ran");
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}

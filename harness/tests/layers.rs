@@ -33,6 +33,7 @@ const LAYERS: &[(u32, &[&str])] = &[
             "external",
             "shard",
             "merge",
+            "record_trust",
             "baseline",
             "cost",
             "sampler_chi2",

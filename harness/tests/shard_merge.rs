@@ -322,3 +322,148 @@ fn merge_rejudges_a_verdict_its_numbers_contradict() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// An edit of shard folders read back: (report.json, shard.json) of each shard.
+type Edit<'a> = dyn Fn(&mut [(Value, Value)]) + 'a;
+
+/// Shard folders can be edited: merge takes a record only at the plan index of the check that
+/// made it (its check, model and case are the planned check's, and the planned checks make up
+/// the plan's fingerprint), and a failure with no numbers to re-judge cannot become a pass or
+/// a skip. Each tampering starts from the same two shards of a tiny audit.
+#[test]
+fn merge_refuses_or_rejudges_every_tampered_shard() {
+    let dir = temp("tamper");
+    let scene = dir.join("scene.json");
+    std::fs::write(
+        &scene,
+        r#"{"name": "tiny", "materials": [{"name": "a", "model": {"family": "ggx", "alpha": 0.3}, "sampling": "normals"}]}"#,
+    )
+    .unwrap();
+    for i in 1..=2 {
+        let out = dir.join(format!("shard-{i}"));
+        let shard = format!("{i}/2");
+        let (code, text) = mfh(&[
+            "audit",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--profile",
+            "ci",
+            "--seed",
+            "5",
+            "--shard",
+            &shard,
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{text}");
+    }
+    let original: Vec<(Value, Value)> = (1..=2)
+        .map(|i| {
+            let d = dir.join(format!("shard-{i}"));
+            (read(&d.join("report.json")), read(&d.join("shard.json")))
+        })
+        .collect();
+    // Merges the shards as `edit` leaves them: (exit code, output, merged report.json).
+    let merge = |name: &str, edit: &Edit<'_>| {
+        let mut shards = original.clone();
+        edit(&mut shards);
+        let mut dirs = Vec::new();
+        for (i, (report, info)) in shards.iter().enumerate() {
+            let d = dir.join(name).join(format!("shard-{}", i + 1));
+            std::fs::create_dir_all(&d).unwrap();
+            std::fs::write(d.join("report.json"), report.to_string()).unwrap();
+            std::fs::write(d.join("shard.json"), info.to_string()).unwrap();
+            dirs.push(d.display().to_string());
+        }
+        let out = dir.join(name).join("merged");
+        let mut args = vec!["merge", "--out", out.to_str().unwrap()];
+        args.extend(dirs.iter().map(String::as_str));
+        let (code, text) = mfh(&args);
+        let merged = std::fs::read_to_string(out.join("report.json"))
+            .ok()
+            .map(|t| serde_json::from_str::<Value>(&t).unwrap());
+        (code, text, merged)
+    };
+    let (code, text, _) = merge("untouched", &|_| {});
+    assert_eq!(code, 0, "{text}");
+
+    // A chi-square that failed its sanity checks, as the check writes it (its tolerance, no
+    // p-value, the reason in its case), edited to pass or to skipped: re-judged as a fail.
+    for verdict in ["pass", "skipped"] {
+        let (code, text, merged) = merge(verdict, &|s| {
+            let records = s[0].0["records"].as_array_mut().unwrap();
+            let r = records
+                .iter_mut()
+                .find(|r| r["measured"]["kind"] == "p_value")
+                .expect("a chi-square record");
+            r["measured"] = Value::Null;
+            r["case"]["sanity_failure"] = Value::from("pdf mass 0.9 ≠ 1");
+            r["verdict"] = Value::from(verdict);
+            r["reason"] = Value::from("edited");
+        });
+        assert_eq!(code, 1, "{verdict}: {text}");
+        assert!(
+            text.contains(&format!("stored verdict {verdict}"))
+                && text.contains("re-judged as fail"),
+            "{verdict}: {text}"
+        );
+        assert_eq!(merged.unwrap()["summary"]["counts"]["fail"], 1, "{verdict}");
+    }
+
+    // Refused, exit 2, with the shard and what is wrong: indices swapped in a shard.json (with
+    // and without their planned checks), a renamed check, an edited case.
+    let cases: [(&str, &Edit<'_>, &str); 4] = [
+        (
+            "indices",
+            &|s| {
+                let idx = s[0].1["indices"].as_array_mut().unwrap();
+                idx.swap(0, 1);
+            },
+            "a shard.json was edited",
+        ),
+        (
+            "indices-and-planned",
+            &|s| {
+                s[0].1["indices"].as_array_mut().unwrap().swap(0, 1);
+                s[0].1["planned"].as_array_mut().unwrap().swap(0, 1);
+                s[0].0["records"].as_array_mut().unwrap().swap(0, 1);
+                // Moved together, they merge as before; a planned check edited with its
+                // record is not the plan's.
+                s[0].1["planned"][0]["case"]["edited"] = Value::from(true);
+                s[0].0["records"][0]["case"]["edited"] = Value::from(true);
+            },
+            "a shard.json was edited",
+        ),
+        (
+            "renamed",
+            &|s| s[1].0["records"][0]["check"] = Value::from("smith.no_such_check"),
+            "its check is `smith.no_such_check`",
+        ),
+        (
+            "case",
+            &|s| {
+                let records = s[1].0["records"].as_array_mut().unwrap();
+                let r = records
+                    .iter_mut()
+                    .find(|r| r["case"].as_object().is_some_and(|c| !c.is_empty()))
+                    .expect("a record with a case");
+                let key = r["case"]
+                    .as_object()
+                    .unwrap()
+                    .keys()
+                    .next()
+                    .unwrap()
+                    .clone();
+                r["case"][&key] = Value::from("edited");
+            },
+            "does not hold the planned case",
+        ),
+    ];
+    for (name, edit, says) in cases {
+        let (code, text, _) = merge(name, edit);
+        assert_eq!(code, 2, "{name}: {text}");
+        assert!(text.contains(says), "{name}: {text}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

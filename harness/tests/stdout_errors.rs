@@ -110,3 +110,70 @@ fn plan_to_a_closed_pipe_exits_two_and_to_a_reader_passes() {
     assert_eq!(out.status.code(), Some(0));
     assert!(!out.stdout.is_empty());
 }
+
+/// `mfh selftest`, `mfh cost`, `mfh eval`, `mfh merge`, `--help` and `--version` with their output on
+/// /dev/full exit 2 naming the lost output (selftest and cost exited 0, their summaries lost).
+#[test]
+fn every_command_to_a_full_disk_exits_two() {
+    let out = out_dir("full");
+    let selftest = [
+        "selftest",
+        "--calibrate",
+        "1",
+        "--profile",
+        "ci",
+        "--only",
+        "ggx",
+        "--quiet",
+        "--out",
+        &out,
+    ];
+    assert_write_error("selftest", to_dev_full(&selftest));
+    let scene = tiny_scene();
+    let scene = scene.to_str().unwrap();
+    let cost = [
+        "cost",
+        "--quick",
+        "--no-time",
+        "--scene",
+        scene,
+        "--quiet",
+        "--out",
+        &out,
+    ];
+    assert_write_error("cost", to_dev_full(&cost));
+    let mut json = cost.to_vec();
+    json.push("--json");
+    assert_write_error("cost", to_dev_full(&json));
+    for flag in ["--help", "--version"] {
+        assert_write_error("--help/--version", to_dev_full(&[flag]));
+    }
+    assert_write_error("--help/--version", to_dev_full(&["audit", "--help"]));
+    let queries =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/queries.jsonl");
+    let (code, err) = to_dev_full(&["eval", "--input", queries.to_str().unwrap()]);
+    assert_eq!(code, Some(2), "eval: {err}");
+    let shard = format!("{out}/shard");
+    let args = [
+        "audit",
+        "--scene",
+        scene,
+        "--profile",
+        "ci",
+        "--shard",
+        "1/1",
+        "--quiet",
+        "--out",
+        &shard,
+    ];
+    let status = Command::new(env!("CARGO_BIN_EXE_mfh"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert_eq!(status.code(), Some(0));
+    let merged = format!("{out}/merged");
+    assert_write_error("merge", to_dev_full(&["merge", &shard, "--out", &merged]));
+    let _ = std::fs::remove_dir_all(&out);
+}

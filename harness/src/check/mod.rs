@@ -26,6 +26,7 @@
 
 pub mod against;
 pub mod bsdf;
+pub mod budget;
 pub mod claims;
 pub mod ds;
 pub mod errata;

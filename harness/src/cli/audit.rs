@@ -119,7 +119,7 @@ pub fn run(args: AuditArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i
             return EXIT_BAD_INPUT;
         }
     };
-    if let Err(e) = args.stream.max_time() {
+    if let Err(e) = args.stream.max_time().and(args.stream.record_budget()) {
         let _ = writeln!(stderr, "mfh audit: {e}");
         return EXIT_BAD_INPUT;
     }

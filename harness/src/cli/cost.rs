@@ -115,15 +115,16 @@ pub fn run(args: CostArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
             }
         },
     };
-    if args.json {
-        let _ = writeln!(
-            stdout,
-            "{}",
-            serde_json::to_string(&report).expect("a cost report serializes")
-        );
-    } else {
-        let _ = write!(stdout, "{}", crate::report::cost::terminal(&report));
-        let _ = writeln!(
+    let printed = super::write_stdout("cost", stdout, stderr, |stdout| {
+        if args.json {
+            return writeln!(
+                stdout,
+                "{}",
+                serde_json::to_string(&report).expect("a cost report serializes")
+            );
+        }
+        write!(stdout, "{}", crate::report::cost::terminal(&report))?;
+        writeln!(
             stdout,
             "wrote {} files into {} (cost.json, cost/*.svg, cost.html){}",
             written.len(),
@@ -131,7 +132,10 @@ pub fn run(args: CostArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
             markdown
                 .map(|p| format!(" and {}", p.display()))
                 .unwrap_or_default()
-        );
+        )
+    });
+    match printed {
+        Ok(()) => EXIT_PASS,
+        Err(code) => code,
     }
-    EXIT_PASS
 }

@@ -68,7 +68,7 @@ pub fn run(args: ExternalArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
             return EXIT_BAD_INPUT;
         }
     }
-    if let Err(e) = args.stream.max_time() {
+    if let Err(e) = args.stream.max_time().and(args.stream.record_budget()) {
         let _ = writeln!(stderr, "mfh audit-external: {e}");
         return EXIT_BAD_INPUT;
     }

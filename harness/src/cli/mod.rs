@@ -170,14 +170,18 @@ where
     let cli = match Cli::try_parse_from(args) {
         Ok(cli) => cli,
         Err(e) => {
-            let code = if e.use_stderr() { EXIT_BAD_INPUT } else { 0 };
             let text = e.render().to_string();
-            let _ = if e.use_stderr() {
-                stderr.write_all(text.as_bytes())
-            } else {
+            if e.use_stderr() {
+                let _ = stderr.write_all(text.as_bytes());
+                return EXIT_BAD_INPUT;
+            }
+            // --help, --version: their text is the output, and it must arrive.
+            return match write_stdout("--help/--version", stdout, stderr, |stdout| {
                 stdout.write_all(text.as_bytes())
+            }) {
+                Ok(()) => EXIT_PASS,
+                Err(code) => code,
             };
-            return code;
         }
     };
     match cli.command {

@@ -162,7 +162,11 @@ pub fn run(args: SelftestArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
         }
         None => selftest::run(&options, Some(&progress)),
     };
-    let _ = write!(stdout, "{}", summary(&report));
+    // The summary is the output: if it cannot be written the run does not succeed (the files
+    // below are still written, then exit 2).
+    let printed = super::write_stdout("selftest", stdout, stderr, |stdout| {
+        write!(stdout, "{}", summary(&report))
+    });
     if let Err(e) = std::fs::create_dir_all(&args.out) {
         let _ = writeln!(
             stderr,
@@ -196,7 +200,12 @@ pub fn run(args: SelftestArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
             return EXIT_BAD_INPUT;
         }
     }
-    let _ = writeln!(stdout, "wrote {} and {}", json.display(), html.display());
+    let wrote = super::write_stdout("selftest", stdout, stderr, |stdout| {
+        writeln!(stdout, "wrote {} and {}", json.display(), html.display())
+    });
+    if let Err(code) = printed.and(wrote) {
+        return code;
+    }
     if report.passed() {
         EXIT_PASS
     } else {

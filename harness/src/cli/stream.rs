@@ -28,6 +28,11 @@ pub struct StreamArgs {
     /// is written; `--resume` runs the rest later.
     #[arg(long, value_name = "S")]
     pub max_time: Option<f64>,
+    /// The wall-clock budget of each record, seconds (> 0; default: the profile's, 120 s at
+    /// ci, 300 quick, 900 standard, 3600 thorough): a check that runs past it is an error
+    /// record naming the budget (not a verdict on the model; `--resume` runs it again).
+    #[arg(long, value_name = "S")]
+    pub record_budget: Option<f64>,
 }
 
 impl StreamArgs {
@@ -39,20 +44,33 @@ impl StreamArgs {
 
     /// The time limit, if valid: a finite number of seconds > 0 that a duration can hold.
     pub fn max_time(&self) -> Result<Option<Duration>, String> {
-        match self.max_time {
-            None => Ok(None),
-            Some(s) if s > 0.0 && s.is_finite() => Duration::try_from_secs_f64(s)
-                .map(Some)
-                .map_err(|_| format!("--max-time {s}: too large (at most 1.8e19 seconds)")),
-            Some(s) => Err(format!(
-                "--max-time {s}: must be a finite number of seconds > 0"
-            )),
-        }
+        seconds("--max-time", self.max_time)
+    }
+
+    /// The record budget, if valid (as [`StreamArgs::max_time`]).
+    pub fn record_budget(&self) -> Result<Option<Duration>, String> {
+        seconds("--record-budget", self.record_budget)
+    }
+}
+
+/// The duration of the option `flag` if given and valid: a finite number of seconds > 0 that a
+/// duration can hold.
+fn seconds(flag: &str, value: Option<f64>) -> Result<Option<Duration>, String> {
+    match value {
+        None => Ok(None),
+        Some(s) if s > 0.0 && s.is_finite() => Duration::try_from_secs_f64(s)
+            .map(Some)
+            .map_err(|_| format!("{flag} {s}: too large (at most 1.8e19 seconds)")),
+        Some(s) => Err(format!(
+            "{flag} {s}: must be a finite number of seconds > 0"
+        )),
     }
 }
 
 /// A run's streaming: the open `report.jsonl` and the progress lines.
 pub struct Streaming {
+    /// The resumed records not taken as stored ([`CheckEvent::Plan`]'s `distrusted`).
+    distrusted: Arc<std::sync::Mutex<Vec<String>>>,
     sink: Arc<Sink>,
     lines: Option<Arc<Lines>>,
     max_time: Option<Duration>,
@@ -72,6 +90,7 @@ pub fn prepare(
     stderr: &mut dyn Write,
 ) -> Result<(RunControl, Streaming), String> {
     let max_time = args.max_time()?;
+    let record_budget = args.record_budget()?;
     let (resume, kept) = match &args.resume {
         None => (None, Vec::new()),
         Some(dir) => {
@@ -100,8 +119,17 @@ pub fn prepare(
     let sink = Arc::new(Sink::create(out, &header, &kept).map_err(|e| e.to_string())?);
     let lines = Lines::start(command, quiet).map(Arc::new);
     let (s, l) = (sink.clone(), lines.clone());
+    let distrusted = Arc::new(std::sync::Mutex::new(Vec::new()));
+    let dist = distrusted.clone();
     let on_check = CheckEventFn(Arc::new(move |event: CheckEvent<'_>| match event {
-        CheckEvent::Plan { checks, resumed } => {
+        CheckEvent::Plan {
+            checks,
+            resumed,
+            distrusted,
+        } => {
+            if let Ok(mut d) = dist.lock() {
+                d.extend(distrusted.iter().cloned());
+            }
             if let Some(l) = &l {
                 l.plan(checks, resumed);
             }
@@ -116,7 +144,10 @@ pub fn prepare(
             planned,
             record,
         } => {
-            s.append(&crate::run::plan_key(planned), record);
+            // A record stopped by its budget is not kept: `--resume` runs its check again.
+            if !crate::check::budget::is_over_budget(&record.verdict) {
+                s.append(&crate::run::plan_key(planned), record);
+            }
             if let Some(l) = &l {
                 l.finished(index, record.verdict.is_failure());
             }
@@ -126,8 +157,10 @@ pub fn prepare(
         on_check: Some(on_check),
         resume,
         max_time,
+        record_budget,
     };
     let streaming = Streaming {
+        distrusted,
         sink,
         lines,
         max_time,
@@ -138,11 +171,28 @@ pub fn prepare(
 
 impl Streaming {
     /// Ends the streaming after the run: stops the progress lines, says on `stderr` which
-    /// checks the time limit left unrun; Err: a record could not be appended to
+    /// resumed records were re-judged or not taken, and which checks the time limit left unrun; Err: a record could not be appended to
     /// `report.jsonl` (the message of an exit 2).
     pub fn finish(&self, report: &AuditReport, stderr: &mut dyn Write) -> Result<(), String> {
         if let Some(l) = &self.lines {
             l.finish();
+        }
+        let distrusted = self
+            .distrusted
+            .lock()
+            .map(|d| d.clone())
+            .unwrap_or_default();
+        if !distrusted.is_empty() {
+            let _ = writeln!(
+                stderr,
+                "mfh {}: --resume: {} stored record(s) of {} were not taken as written:",
+                self.command,
+                distrusted.len(),
+                jsonl::FILE
+            );
+            for line in &distrusted {
+                let _ = writeln!(stderr, "  {line}");
+            }
         }
         if let Some(limit) = self.max_time {
             let message = not_run_message(limit);

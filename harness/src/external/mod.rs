@@ -60,6 +60,12 @@ pub fn audit(request: &ExternalAudit) -> Result<AuditReport, ExternalError> {
     let t = Instant::now();
     let model = ExternalModel::start(&request.command, request.timeout)?;
     let description = model.description().clone();
+    // A reference of a kind the child does not offer is bad input, refused before any check
+    // runs (as a failing record it was found only once the whole audit had run).
+    if let Some(why) = against_not_offered(request.against.as_deref(), &description) {
+        model.shutdown();
+        return Err(ExternalError::Describe(why));
+    }
     let name = description
         .name
         .clone()
@@ -154,27 +160,17 @@ pub fn plan<'a>(
         plan.extend(p);
         errors.extend(e);
     }
-    let offered = |a: &Against| match a {
-        Against::Ndf(_) => description.has_ndf(),
-        Against::Bsdf(_) => description.has_bsdf(),
-    };
     match &against {
         Some(Err(e)) => errors.push(error_record(
             "audit.configuration",
             label,
             format!("against: {e}"),
         )),
-        Some(Ok(spec)) if !offered(spec) => errors.push(error_record(
-            "audit.configuration",
-            label,
-            format!(
-                "against: the spec is of {}, which the child does not offer (its \
-                 capabilities: {})",
-                spec.kind(),
-                description.capabilities.join(", ")
-            ),
-        )),
-        _ => {}
+        Some(Ok(_)) => errors.extend(
+            against_not_offered(request.against.as_deref(), description)
+                .map(|why| error_record("audit.configuration", label, why)),
+        ),
+        None => {}
     }
     (plan, errors)
 }
@@ -206,6 +202,27 @@ pub fn nan_record(label: &serde_json::Value, n: &model::NanAnswers) -> CheckReco
     r.value = Some(n.count as f64);
     r.verdict = Verdict::Fail;
     r
+}
+
+/// Why the reference `against` (valid) is of a kind the child does not offer — an NDF spec for
+/// a child that offers only a BSDF, or the reverse — or None.
+fn against_not_offered(
+    against: Option<&str>,
+    description: &protocol::Description,
+) -> Option<String> {
+    let spec = Against::parse(against?).ok()?;
+    let offered = match spec {
+        Against::Ndf(_) => description.has_ndf(),
+        Against::Bsdf(_) => description.has_bsdf(),
+    };
+    (!offered).then(|| {
+        format!(
+            "against: the spec is of {}, which the child does not offer (its capabilities: \
+             {})",
+            spec.kind(),
+            description.capabilities.join(", ")
+        )
+    })
 }
 
 /// A record of `check` that errs with `message`.

@@ -138,10 +138,17 @@ impl ExternalModel {
     }
 
     pub(super) fn call(&self, request: &Request<'_>) -> Result<Answer, ExternalError> {
+        // A check past its wall-clock budget stops here, before the session's lock is taken
+        // and once it has waited its turn for it (the lock released first).
+        crate::check::budget::checkpoint();
         let mut session = self
             .session
             .lock()
             .unwrap_or_else(|poisoned| poisoned.into_inner());
+        if crate::check::budget::passed() {
+            drop(session);
+            crate::check::budget::stop();
+        }
         let result = session.call(request);
         if let Err(e) = &result {
             if let Ok(mut first) = self.first_error.lock() {
