@@ -35,6 +35,7 @@ pub mod random;
 pub mod readback;
 pub mod record;
 pub mod record_serde;
+pub mod record_text;
 pub mod record_trust;
 pub mod report;
 pub mod run;

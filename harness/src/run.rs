@@ -285,7 +285,7 @@ impl AuditReport {
 
 /// A readable table of an audit's failures: per failing record its check, model and case, the
 /// value against the oracle, the measured error and the tolerance and why, and the verdict, as
-/// every sink prints a record (`report::text::block`); then the seed and the command that
+/// every sink prints a record (`record_text::block`); then the seed and the command that
 /// reproduces the run.
 pub fn failure_table(report: &AuditReport) -> String {
     use std::fmt::Write;
@@ -304,7 +304,7 @@ pub fn failure_table(report: &AuditReport) -> String {
     );
     for r in failures {
         out.push('\n');
-        out.push_str(&crate::report::text::block(r, "  "));
+        out.push_str(&crate::record_text::block(r, "  "));
     }
     let _ = write!(out, "\nreproduce: {}", report.command);
     out

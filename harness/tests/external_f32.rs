@@ -862,6 +862,10 @@ fn the_numpy_f32_dielectric_jacobian_defect_fails_the_chi_square() {
 /// passes it at the same seeds. Only that check runs, with the seed the whole ci audit gives it
 /// (the rest of the audit is the test above's).
 #[test]
+#[cfg_attr(
+    not(has_gxx),
+    ignore = "g++ is not installed (apt-get install g++; .ci/run installs it)"
+)]
 fn the_cpp_frame_switch_fails_the_visible_jacobian_near_the_normal() {
     use mfh_harness::check::RunContext;
     use mfh_harness::external::{plan, ExternalAudit};

@@ -16,6 +16,7 @@ const LAYERS: &[(u32, &[&str])] = &[
         &[
             "record",
             "record_serde",
+            "record_text",
             "tolerance",
             "random",
             "messages",

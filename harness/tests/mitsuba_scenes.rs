@@ -51,6 +51,7 @@ const NORMAL_SAMPLING: &[&str] = &[
 const VISIBLE_SAMPLING: &[&str] = &[
     "sampling.chi2_visible",
     "sampling.pdf_visible_normalization",
+    "sampling.visible_jacobian",
 ];
 const EVERY_MATERIAL: &[&str] = &[
     "normalization.projected_area",
@@ -63,6 +64,7 @@ const BSDF_CHECKS: &[&str] = &[
     "bsdf.chi2",
     "bsdf.energy",
     "bsdf.failure_rate",
+    "bsdf.jacobian",
     "bsdf.ndf_consistency",
     "bsdf.reciprocity",
     "bsdf.sample_consistency",

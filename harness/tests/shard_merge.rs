@@ -68,7 +68,7 @@ fn normalized(mut v: Value) -> Value {
         if let Some(a) = r["artefacts"].as_array_mut() {
             for p in a.iter_mut() {
                 let s = p.as_str().unwrap_or("");
-                let at = s.find("chi2/").or_else(|| s.find("ks/"));
+                let at = ["chi2/", "ks/", "curves/"].iter().find_map(|k| s.find(k));
                 *p = Value::from(at.map_or(s, |i| &s[i..]));
             }
         }

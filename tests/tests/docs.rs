@@ -936,7 +936,11 @@ fn no_rust_source_cites_a_tracker_issue_by_number() {
         }
     }
     assert!(scanned > 100, "only {scanned} Rust files scanned");
-    assert!(found.is_empty(), "tracker issue numbers cited:\n{}", found.join("\n"));
+    assert!(
+        found.is_empty(),
+        "tracker issue numbers cited:\n{}",
+        found.join("\n")
+    );
     assert_eq!(
         issue_numbers("a (issue 27)\nthe_issue_example\nIssues 15 and 26\nissue tracker"),
         [1, 3]

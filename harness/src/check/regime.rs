@@ -155,6 +155,34 @@ pub struct Density {
     pub coarse: f64,
     /// With step h/2.
     pub fine: f64,
+    /// A bound on the extrapolated density's relative rounding error ([`rounding_bound`]).
+    pub rounding: f64,
+}
+
+/// The ulps of each component of a sampled direction that the rounding bound allows: a map
+/// computed in float32 is a chain of a few dozen operations, each direction component within a
+/// few ulps of its exact value; 8 covers the samplers mfh audits (the reference GGX's f32
+/// visible sampler measured ≤ 3).
+pub const DIRECTION_ULPS: f64 = 8.0;
+
+/// The relative rounding error of a central-difference density from directions computed in
+/// precision ε: each component of a column a = (p − q)/(2h) is off by ≤ 2·u·ε/(2h), so |a| by
+/// ≤ √3·u·ε/h (u = [`DIRECTION_ULPS`]); the density 1/|a × b| by ≤ r = √3·u·ε/h·(1/|a| + 1/|b|)
+/// to first order. The fine step doubles r, and the extrapolation (4 fine − coarse)/3 weighs
+/// the two errors 4/3 and 1/3: ≤ (8r + r)/3 = 3r. Negligible in f64 (ε 1.1e-16: ~1e-8 at
+/// |a| = 1e-3), it is what limits a float32 map at tiny roughness, whose derivatives are of the
+/// order of α: at α = 0.001 and step 4e-3, r reaches ~0.1.
+pub fn rounding_bound(eps: f64, h: f64, a: f64, b: f64) -> f64 {
+    3.0 * 3f64.sqrt() * DIRECTION_ULPS * eps / h * (1.0 / a + 1.0 / b)
+}
+
+/// The precision whose [`stencil`] steps by `h` (f64 for any other step).
+fn epsilon_of_step(h: f64) -> f64 {
+    if h == stencil(Precision::F32).0 {
+        Precision::F32.epsilon()
+    } else {
+        Precision::F64.epsilon()
+    }
 }
 
 impl Density {
@@ -167,6 +195,14 @@ impl Density {
     /// extrapolation leaves where the map is smooth within the stencil.
     pub fn spread(&self) -> f64 {
         ((self.coarse - self.fine) / self.fine).abs()
+    }
+
+    /// What a point's error is allowed beyond the tolerance: the extrapolation's [`spread`]
+    /// and the rounding bound.
+    ///
+    /// [`spread`]: Density::spread
+    pub fn allowance(&self) -> f64 {
+        self.spread() + self.rounding
     }
 }
 
@@ -213,7 +249,7 @@ pub fn densities(
             let Some(s) = all.filter(|s| s.iter().all(|d| (d[2] > 0.0) == (c[2] > 0.0))) else {
                 return (centre, None);
             };
-            let density = |k: usize, step: f64| {
+            let columns = |k: usize, step: f64| {
                 let d = |p: Vec3, q: Vec3| {
                     [
                         (p[0] - q[0]) / (2.0 * step),
@@ -221,8 +257,11 @@ pub fn densities(
                         (p[2] - q[2]) / (2.0 * step),
                     ]
                 };
-                let a = d(s[k], s[k + 1]);
-                let b = d(s[k + 2], s[k + 3]);
+                (d(s[k], s[k + 1]), d(s[k + 2], s[k + 3]))
+            };
+            let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            let density = |k: usize, step: f64| {
+                let (a, b) = columns(k, step);
                 let x = [
                     a[1] * b[2] - a[2] * b[1],
                     a[2] * b[0] - a[0] * b[2],
@@ -235,6 +274,10 @@ pub fn densities(
                 Some(Density {
                     coarse: density(0, h),
                     fine: density(4, h / 2.0),
+                    rounding: {
+                        let (a, b) = columns(0, h);
+                        rounding_bound(epsilon_of_step(h), h, norm(a), norm(b))
+                    },
                 }),
             )
         })

@@ -186,7 +186,7 @@ pub fn measure(
             f64::INFINITY
         };
         out.worst = out.worst.max(error);
-        let excess = (error - density.spread() - l.uncertainty / l.measure).max(0.0);
+        let excess = (error - density.allowance() - l.uncertainty / l.measure).max(0.0);
         if !(excess <= out.excess) {
             out.excess = excess;
         }

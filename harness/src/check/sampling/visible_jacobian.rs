@@ -80,7 +80,7 @@ pub fn measure(
         out.resolved += 1;
         let error = ((p - value) / value).abs();
         out.worst = out.worst.max(error);
-        let excess = (error - density.spread()).max(0.0);
+        let excess = (error - density.allowance()).max(0.0);
         if !(excess <= out.excess) {
             out.excess = excess;
         }
