@@ -343,7 +343,7 @@ fn plan_and_run(
     let on_check = CheckEventFn(Arc::new(move |event: CheckEvent<'_>| {
         let Some(l) = &l else { return };
         match event {
-            CheckEvent::Plan { checks, resumed } => l.plan(checks, resumed),
+            CheckEvent::Plan { checks, resumed, .. } => l.plan(checks, resumed),
             CheckEvent::Started { index, planned } => {
                 l.started(index, format!("{} {}", planned.check, planned.case))
             }
