@@ -181,7 +181,7 @@ impl Integrals {
     }
 
     /// The chi-square's cells of both hemispheres (following each hemisphere's lobe) and the
-    /// pdf's masses over them, to the accuracy its `samples` need ([`chi2_masses`]), and the
+    /// pdf's masses over them, to the accuracy its `samples` need ([`chi2_masses_about`]), and the
     /// evaluations they cost.
     pub fn pdf_masses(&self, bsdf: &dyn Bsdf) -> (&SphereMasses, u64) {
         let masses = self.pdf.get_or_init(|| {
