@@ -108,15 +108,7 @@ impl<'a> Subject<'a> {
         hints: Hints,
         precision: Precision,
     ) -> Arc<Self> {
-        Arc::new(Self {
-            model,
-            label: json!({ "name": name }),
-            reference: None,
-            hints,
-            precision,
-            remote: false,
-            measured: OnceLock::new(),
-        })
+        Self::user_model(model, name, hints, precision, false)
     }
 
     /// A user's model behind a process boundary ([`Subject::remote`]).
@@ -126,13 +118,23 @@ impl<'a> Subject<'a> {
         hints: Hints,
         precision: Precision,
     ) -> Arc<Self> {
+        Self::user_model(model, name, hints, precision, true)
+    }
+
+    fn user_model(
+        model: Arc<dyn Ndf + 'a>,
+        name: &str,
+        hints: Hints,
+        precision: Precision,
+        remote: bool,
+    ) -> Arc<Self> {
         Arc::new(Self {
             model,
             label: json!({ "name": name }),
             reference: None,
             hints,
             precision,
-            remote: true,
+            remote,
             measured: OnceLock::new(),
         })
     }
