@@ -303,6 +303,25 @@ pub struct AtIncidence {
     pub measured: usize,
 }
 
+/// The verdict of a Jacobian sweep: an error (it cannot judge) when fewer than the fraction
+/// `need` of the `measured` points had a smooth map within the stencil, else fail or pass.
+pub fn verdict(resolved: usize, measured: usize, need: f64, fails: bool) -> crate::record::Verdict {
+    use crate::record::Verdict;
+    if (resolved as f64) < need * measured as f64 {
+        Verdict::Error {
+            message: format!(
+                "only {resolved} of {measured} points had a smooth sampling map within the \
+                 finite-difference stencil (need {:.0} %)",
+                100.0 * need
+            ),
+        }
+    } else if fails {
+        Verdict::Fail
+    } else {
+        Verdict::Pass
+    }
+}
+
 /// Bisection steps of [`narrow`] on each side of a failing run.
 pub const NARROW_STEPS: usize = 8;
 

@@ -5,7 +5,8 @@
 //! `mfh audit` and `mfh chi2 --out`.
 
 #[cfg(feature = "html")]
-use super::plot::{heat_map_svg, ColourScale, HeatMap, PlotError};
+use super::heat_map::{heat_map_svg, HeatMap};
+use super::plot::{ColourScale, PlotError};
 use crate::record::{CheckRecord, RecordData};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};

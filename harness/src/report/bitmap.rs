@@ -1,4 +1,4 @@
-//! A heat map's cells as a bitmap image for its SVG (`plot::heat_map_svg` embeds it):
+//! A heat map's cells as a bitmap image for its SVG (`heat_map::heat_map_svg` embeds it):
 //! one pixel per cell where the cells are even, finer pixels where the grid's edges are uneven
 //! (the chi-square's rows at the lobe's quantiles).
 

@@ -394,18 +394,7 @@ pub fn plan<'a>(
                             case.insert("chi2_at_worst".into(), confirm);
                         }
                     }
-                    r.verdict = if resolved * 2 < measured {
-                        Verdict::Error {
-                            message: format!(
-                                "only {resolved} of {measured} lobe points had a smooth \
-                                 sampling map within the finite-difference stencil (need half)"
-                            ),
-                        }
-                    } else if worst.fails {
-                        Verdict::Fail
-                    } else {
-                        Verdict::Pass
-                    };
+                    r.verdict = regime::verdict(resolved, measured, 0.5, worst.fails);
                     Ok(())
                 })
         })

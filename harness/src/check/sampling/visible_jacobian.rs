@@ -12,7 +12,7 @@
 
 use crate::check::regime::{self, AtIncidence, SweepPoint};
 use crate::check::{applied, covers, need, Check, PlannedCheck};
-use crate::record::{Measured, RecordData, Verdict};
+use crate::record::{Measured, RecordData};
 use crate::subject::Subject;
 use crate::tolerance::PDF_JACOBIAN;
 use mfh_reference::geometry::Vec3;
@@ -162,18 +162,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> PlannedCheck<'a> {
             "visible-normal density",
             &format!("at α ≈ {alpha:.3} (lobe scale), φi {phi}"),
         );
-        r.verdict = if resolved * 10 < measured * 9 {
-            Verdict::Error {
-                message: format!(
-                    "only {resolved} of {measured} points had a smooth sampling map within \
-                     the finite-difference stencil (need 90 %)"
-                ),
-            }
-        } else if at.iter().any(|a| a.fails) {
-            Verdict::Fail
-        } else {
-            Verdict::Pass
-        };
+        r.verdict = regime::verdict(resolved, measured, 0.9, at.iter().any(|a| a.fails));
         Ok(())
     })
 }
