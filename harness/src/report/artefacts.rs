@@ -6,6 +6,7 @@
 
 #[cfg(feature = "html")]
 use super::heat_map::{heat_map_svg, HeatMap};
+#[cfg(feature = "html")]
 use super::plot::{ColourScale, PlotError};
 use crate::record::{CheckRecord, RecordData};
 use serde_json::{json, Value};

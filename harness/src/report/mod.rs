@@ -23,6 +23,7 @@ pub mod colour;
 pub mod cost;
 #[cfg(feature = "html")]
 pub mod cost_html;
+#[cfg(feature = "html")]
 pub mod heat_map;
 #[cfg(feature = "html")]
 pub mod html;
