@@ -177,3 +177,91 @@ fn every_command_to_a_full_disk_exits_two() {
     assert_write_error("merge", to_dev_full(&["merge", &shard, "--out", &merged]));
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Runs `mfh args…` with standard output closed (`>&-` in a shell): (exit status, standard
+/// error).
+fn with_stdout_closed(args: &[&str]) -> (Option<i32>, String) {
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg("exec \"$0\" \"$@\" >&-")
+        .arg(env!("CARGO_BIN_EXE_mfh"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stderr(Stdio::piped())
+        .output()
+        .expect("sh runs mfh");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Every command started with standard output closed exits 2 before it runs, naming the closed
+/// output (they exited 0: Rust's runtime puts a read-write /dev/null in a closed descriptor's
+/// place, where every write succeeds); `> /dev/null` (write-only) still runs and passes.
+#[test]
+fn every_command_with_stdout_closed_exits_two() {
+    let scene = tiny_scene();
+    let scene = scene.to_str().unwrap();
+    let out = out_dir("closed");
+    let queries =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/queries.jsonl");
+    let runs: [&[&str]; 5] = [
+        &["--version"],
+        &["--help"],
+        &[
+            "audit",
+            "--scene",
+            scene,
+            "--profile",
+            "ci",
+            "--quiet",
+            "--out",
+            &out,
+        ],
+        &["eval", "--input", queries.to_str().unwrap()],
+        &[
+            "selftest",
+            "--calibrate",
+            "1",
+            "--profile",
+            "ci",
+            "--only",
+            "ggx",
+            "--quiet",
+        ],
+    ];
+    for args in runs {
+        let (code, err) = with_stdout_closed(args);
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("standard output was closed"),
+            "{args:?}: {err}"
+        );
+    }
+    assert!(
+        !std::path::Path::new(&out).exists(),
+        "the audit ran with its output closed"
+    );
+    let status = Command::new(env!("CARGO_BIN_EXE_mfh"))
+        .args([
+            "audit",
+            "--scene",
+            scene,
+            "--profile",
+            "ci",
+            "--quiet",
+            "--out",
+            &out,
+        ])
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert_eq!(
+        status.code(),
+        Some(0),
+        "> /dev/null is a choice, not a lost output"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -10,6 +10,7 @@
 pub mod audit;
 pub mod chi2;
 pub mod chi2_bsdf;
+pub mod closed_stdout;
 pub mod cost;
 pub mod eval;
 pub mod external;
