@@ -21,6 +21,7 @@ pub mod check;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod cost;
+mod deadline;
 pub mod estimate;
 pub mod eval;
 pub mod external;

@@ -21,6 +21,7 @@ const LAYERS: &[(u32, &[&str])] = &[
             "random",
             "messages",
             "precision",
+            "deadline",
         ],
     ),
     (1, &["oracle"]),

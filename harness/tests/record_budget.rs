@@ -122,3 +122,82 @@ fn records_within_the_budget_do_not_depend_on_it() {
         run(Some(std::time::Duration::from_secs(365 * 86_400)))
     );
 }
+
+/// GGX whose D takes at least a millisecond (a tabulated or measured D in a renderer's own
+/// code, in-process), counting its calls.
+struct SlowD {
+    ggx: mfh_reference::ndf::Ggx,
+    pause: std::time::Duration,
+    calls: std::sync::atomic::AtomicU64,
+}
+
+impl mfh_harness::model::Ndf for SlowD {
+    fn d(&self, m: [f64; 3]) -> f64 {
+        self.calls
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        std::thread::sleep(self.pause);
+        self.ggx.d(m)
+    }
+}
+
+/// An in-process model is stopped at its budget too (at the oracles' checkpoints: each step of
+/// an adaptive quadrature or cubature, each chunk of a sample loop), not only at a child's
+/// requests: the audit of a D that takes 1 ms a call, under a budget of 0.3 s a record, makes
+/// under a tenth of the calls the whole audit makes (counted on the same D without the pause),
+/// and its stopped records are errors naming the budget.
+#[test]
+fn an_in_process_model_is_stopped_at_its_budget() {
+    use mfh_harness::run::RunControl;
+    use mfh_harness::{Audit, Profile};
+    let slow = |pause: u64| SlowD {
+        ggx: mfh_reference::ndf::Ggx::new(0.3, 0.3).unwrap(),
+        pause: std::time::Duration::from_millis(pause),
+        calls: std::sync::atomic::AtomicU64::new(0),
+    };
+    let whole = slow(0);
+    let unbudgeted = Audit::of(&whole)
+        .d_only()
+        .profile(Profile::Ci)
+        .seed(3)
+        .run();
+    let whole = whole.calls.into_inner();
+    let paused = slow(1);
+    let t = Instant::now();
+    let budgeted = Audit::of(&paused)
+        .d_only()
+        .profile(Profile::Ci)
+        .seed(3)
+        .control(RunControl {
+            record_budget: Some(std::time::Duration::from_millis(300)),
+            ..RunControl::default()
+        })
+        .run();
+    let calls = paused.calls.into_inner();
+    eprintln!(
+        "D of 1 ms, budget 0.3 s: {calls} calls of the whole audit's {whole}, {:.1} s",
+        t.elapsed().as_secs_f64()
+    );
+    let stopped: Vec<_> = budgeted
+        .records
+        .iter()
+        .filter(|r| mfh_harness::check::budget::is_over_budget(&r.verdict))
+        .collect();
+    assert!(!stopped.is_empty(), "{:#?}", budgeted.records);
+    for r in &stopped {
+        eprintln!("  {} stopped after {:.2} s", r.check, r.cost.wall_seconds);
+    }
+    assert!(
+        calls * 10 < whole,
+        "{calls} calls of {whole}: the stopped checks ran on"
+    );
+    // The records that finished are the unbudgeted run's.
+    for r in budgeted.records.iter().filter(|r| !stopped.contains(r)) {
+        let same = unbudgeted
+            .records
+            .iter()
+            .find(|u| u.check == r.check && u.case == r.case)
+            .expect("the same plan");
+        assert_eq!(same.verdict, r.verdict, "{}", r.check);
+        assert_eq!(same.measured, r.measured, "{}", r.check);
+    }
+}

@@ -3,12 +3,14 @@
 //! for minutes. The oracles' own budgets count evaluations, which a slow model (a child answering
 //! through the protocol, an integrand the quadrature keeps refining) turns into minutes.
 //!
-//! How it is enforced: the runner (`run::run_plan`) runs each check under [`run_within`], which
-//! sets the check's deadline for its thread; [`checkpoint`] — called where a check spends its
-//! time on the model, before each request to an external child — unwinds the check once the
-//! deadline has passed (with `resume_unwind`, so no panic message is printed, and before any
+//! How it is enforced (`deadline.rs`, a leaf module that the oracles call too): the runner
+//! (`run::run_plan`) runs each check under [`run_within`], which sets the check's deadline for
+//! its thread; [`checkpoint`] — called where a check spends its time on the model: before each
+//! request to an external child, at each step of the oracles' adaptive loops and in each chunk
+//! of their parallel sample loops (which carry the deadline to the threads that run them) —
+//! unwinds the check once the deadline has passed (with `resume_unwind`, so no panic message is printed, and before any
 //! lock is taken, so nothing is poisoned). A check that ends past its budget without meeting a
-//! checkpoint (an in-process model) is an error all the same, so what the record says depends
+//! checkpoint (an in-process model slow between two of them) is an error all the same, so what the record says depends
 //! only on whether the check finished within its budget.
 //!
 //! Determinism: a record that finishes within its budget is the record of an unbudgeted run,
@@ -18,8 +20,8 @@
 //! budget never decides its record.
 
 use crate::check::Profile;
-use std::cell::Cell;
-use std::time::{Duration, Instant};
+pub use crate::deadline::{checkpoint, passed, run_within, stop, BudgetExceeded, Outcome};
+use std::time::Duration;
 
 /// The wall-clock budget of one record at `profile`: several times the longest a correct
 /// model's record takes there through the protocol on a loaded 2-core machine (the pure-Python
@@ -50,113 +52,3 @@ pub fn is_over_budget(verdict: &crate::record::Verdict) -> bool {
 
 /// How [`over_budget_message`] begins.
 const OVER_BUDGET: &str = "not judged: the check ran past its wall-clock budget of ";
-
-/// The payload a [`checkpoint`] unwinds with: the deadline that passed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct BudgetExceeded {
-    /// The deadline of the check whose budget ran out.
-    pub deadline: Instant,
-}
-
-thread_local! {
-    /// The deadline of the check this thread runs, if any.
-    static DEADLINE: Cell<Option<Instant>> = const { Cell::new(None) };
-}
-
-/// Unwinds the running check if its deadline has passed (see the module doc); a no-op outside
-/// a budgeted check. Call it holding no lock.
-pub fn checkpoint() {
-    if passed() {
-        stop();
-    }
-}
-
-/// Whether the running check's deadline has passed (a caller holding a lock releases it, then
-/// calls [`stop`]).
-pub fn passed() -> bool {
-    DEADLINE
-        .with(Cell::get)
-        .is_some_and(|deadline| Instant::now() >= deadline)
-}
-
-/// Unwinds the running check, whose deadline has [`passed`].
-pub fn stop() -> ! {
-    let deadline = DEADLINE.with(Cell::get).unwrap_or_else(Instant::now);
-    std::panic::resume_unwind(Box::new(BudgetExceeded { deadline }))
-}
-
-/// How a budgeted run ended.
-#[derive(Debug)]
-pub enum Outcome<R> {
-    /// The check returned (within its budget or not: the caller compares its time).
-    Done(R),
-    /// It panicked (not at a checkpoint of its own deadline): the payload.
-    Panicked(Box<dyn std::any::Any + Send>),
-    /// A checkpoint stopped it once its own deadline had passed.
-    OverBudget,
-}
-
-/// Runs `f` with the deadline `start + budget` set for this thread, catching its panics; a
-/// run unwound by another check's deadline (its work lent to a thread running that check) is
-/// run again, at most `RETRIES` times.
-pub fn run_within<R>(budget: Option<Duration>, start: Instant, f: impl Fn() -> R) -> Outcome<R> {
-    const RETRIES: usize = 8;
-    let deadline = budget.and_then(|b| start.checked_add(b));
-    let previous = DEADLINE.with(|d| d.replace(deadline));
-    let mut outcome = Outcome::OverBudget;
-    for _ in 0..=RETRIES {
-        outcome = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(&f)) {
-            Ok(r) => Outcome::Done(r),
-            Err(payload) => match payload.downcast_ref::<BudgetExceeded>() {
-                Some(b) if Some(b.deadline) == deadline => Outcome::OverBudget,
-                Some(_) => continue,
-                None => Outcome::Panicked(payload),
-            },
-        };
-        break;
-    }
-    DEADLINE.with(|d| d.set(previous));
-    outcome
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_checkpoint_past_the_deadline_stops_the_run_and_a_foreign_one_is_run_again() {
-        let start = Instant::now();
-        // Within the budget: the result, untouched.
-        let r = run_within(Some(Duration::from_secs(3600)), start, || {
-            checkpoint();
-            7
-        });
-        assert!(matches!(r, Outcome::Done(7)));
-        // Past it: stopped at the checkpoint.
-        let ran = std::sync::atomic::AtomicUsize::new(0);
-        let r = run_within(Some(Duration::ZERO), start, || {
-            ran.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            checkpoint();
-            unreachable!("stopped at the checkpoint")
-        });
-        assert!(matches!(r, Outcome::OverBudget));
-        assert_eq!(ran.into_inner(), 1);
-        // Unwound by another check's deadline: run again, and its own result kept.
-        let tries = std::sync::atomic::AtomicUsize::new(0);
-        let r = run_within(Some(Duration::from_secs(3600)), start, || {
-            if tries.fetch_add(1, std::sync::atomic::Ordering::Relaxed) == 0 {
-                std::panic::resume_unwind(Box::new(BudgetExceeded {
-                    deadline: start - Duration::from_secs(1),
-                }));
-            }
-            5
-        });
-        assert!(matches!(r, Outcome::Done(5)));
-        assert_eq!(tries.into_inner(), 2);
-        // Other panics are the caller's, and the thread's deadline is restored.
-        let r = run_within(None, start, || -> () { panic!("boom") });
-        assert!(matches!(r, Outcome::Panicked(_)));
-        assert_eq!(DEADLINE.with(Cell::get), None);
-        checkpoint();
-    }
-}

@@ -284,6 +284,7 @@ pub fn integrate_rectangles_batch_budgeted(
     let budget = rectangles.len() + MAX_RECTANGLES;
     let mut denied = false;
     while !level.is_empty() {
+        crate::deadline::checkpoint();
         let start = nodes.len();
         for i in level.clone() {
             let n = &nodes[i];

@@ -191,6 +191,7 @@ pub(super) fn run_states(f: &mut TaggedBatchFn<'_>, states: &mut [(usize, State)
     let (mut xs, mut points, mut values, mut counts) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     loop {
+        crate::deadline::checkpoint();
         points.clear();
         counts.clear();
         for (tag, s) in states.iter().filter(|s| !s.1.done) {

@@ -58,9 +58,11 @@ where
     F: Fn([f64; 2]) -> f64 + Sync + ?Sized,
 {
     let chunks = samples.div_ceil(CHUNK);
+    let deadline = crate::deadline::current();
     let parts: Vec<Moments> = (0..chunks)
         .into_par_iter()
         .map(|chunk| {
+            crate::deadline::check(deadline);
             let mut rng = stream(seed, chunk);
             let mut m = Moments::default();
             let end = ((chunk + 1) * CHUNK).min(samples);
@@ -83,9 +85,11 @@ where
     F: Fn(&[[f64; 2]], &mut [f64]) + Sync + ?Sized,
 {
     let chunks = samples.div_ceil(CHUNK);
+    let deadline = crate::deadline::current();
     let parts: Vec<Moments> = (0..chunks)
         .into_par_iter()
         .map(|chunk| {
+            crate::deadline::check(deadline);
             let mut rng = stream(seed, chunk);
             let end = ((chunk + 1) * CHUNK).min(samples);
             let u: Vec<[f64; 2]> = (chunk * CHUNK..end)

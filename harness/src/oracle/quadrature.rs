@@ -333,6 +333,7 @@ pub fn integrate_pieces_many(
     let mut states: Vec<Pieces> = problems.iter().map(|(p, a)| Pieces::new(p, *a)).collect();
     let (mut tagged, mut counts) = (Vec::new(), Vec::new());
     loop {
+        crate::deadline::checkpoint();
         tagged.clear();
         counts.clear();
         let mut pending = false;

@@ -289,11 +289,13 @@ pub fn draw_chunks<A: Send, B>(
     scratch: impl Fn() -> B + Sync,
     block: impl Fn(&mut A, &mut B, u64, &[[f64; 3]]) + Sync,
 ) -> Vec<A> {
+    let deadline = crate::deadline::current();
     (0..samples.div_ceil(CHUNK))
         .into_par_iter()
         .map_init(
             || (vec![[0.0; 2]; (3 * BLOCK).div_ceil(2)], scratch()),
             |(pairs, scratch), chunk| {
+                crate::deadline::check(deadline);
                 let mut rng = stream(seed, chunk);
                 let mut acc = init();
                 let (start, end) = (chunk * CHUNK, ((chunk + 1) * CHUNK).min(samples));

@@ -101,11 +101,13 @@ where
     let chunks = samples.div_ceil(CHUNK);
     let finder = CellFinder::new(grid.clone());
     let block = block.clamp(1, CHUNK as usize);
+    let deadline = crate::deadline::current();
     (0..chunks)
         .into_par_iter()
         .fold(
             || Observed::zero(grid.cells()),
             |mut acc, chunk| {
+                crate::deadline::check(deadline);
                 let mut rng = stream(seed, chunk);
                 let start = chunk * CHUNK;
                 let end = (start + CHUNK).min(samples);

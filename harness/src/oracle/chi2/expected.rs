@@ -100,9 +100,11 @@ where
 {
     let polar = lobe.polar_cuts_with(FRAC_PI_2, theta_kinks);
     let azimuth = lobe.azimuth_cuts();
+    let deadline = crate::deadline::current();
     let estimates: Vec<_> = (0..grid.cells())
         .into_par_iter()
         .map(|i| {
+            crate::deadline::check(deadline);
             let (thetas, phis, pieces) = cell_pieces(&grid, i, &polar, &azimuth);
             let tolerance = Tolerance {
                 absolute: CELL_ABSOLUTE_TOLERANCE / pieces as f64,

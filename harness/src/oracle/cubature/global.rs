@@ -100,6 +100,7 @@ pub fn integrate_global_weighted(
     let mut evaluations = 225 * leaves.len() as u64;
     let mut converged;
     loop {
+        crate::deadline::checkpoint();
         let total: f64 = leaves.iter().map(|n| n.error).sum();
         let so_far = per_rectangle(rectangles.len(), &leaves, &owners);
         converged = total <= target || enough(&so_far);

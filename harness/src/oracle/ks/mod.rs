@@ -326,9 +326,11 @@ struct Drawn {
 /// Draws `samples` normals with `sample` (seeded streams per chunk, as the chi-square test;
 /// each chunk's uniforms in one call) and returns the marginal's values in sample order.
 fn draw_batch(sample: &BatchSampler<'_>, marginal: Marginal, samples: u64, seed: u64) -> Drawn {
+    let deadline = crate::deadline::current();
     let chunks: Vec<Drawn> = (0..samples.div_ceil(CHUNK))
         .into_par_iter()
         .map(|chunk| {
+            crate::deadline::check(deadline);
             let mut rng = stream(seed, chunk);
             let (start, end) = (chunk * CHUNK, ((chunk + 1) * CHUNK).min(samples));
             let mut d = Drawn {
