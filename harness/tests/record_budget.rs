@@ -1,5 +1,5 @@
 //! Each record has a wall-clock budget (`check/budget.rs`): a check of a slow model is stopped
-//! at its next request to the child once the budget has passed, and its record is an `error`
+//! at its next checkpoint (a request to a child, a step or chunk of an oracle) once the budget has passed, and its record is an `error`
 //! naming the budget — not a verdict on the model —, left out of `report.jsonl` so that
 //! `--resume` runs it again; the records that finish within the budget are the unbudgeted
 //! run's. Times are printed, not asserted.

@@ -147,67 +147,105 @@ pub fn points(n: usize, step: f64) -> Vec<[f64; 2]> {
         .collect()
 }
 
-/// The two central-difference densities 1/|∂w/∂u₁ × ∂w/∂u₂| at one point, with steps h and
-/// h/2; the Richardson extrapolation (4 fine − coarse)/3 cancels their h² error.
+/// The three central-difference densities 1/|∂w/∂u₁ × ∂w/∂u₂| at one point, with steps h,
+/// h/2 and h/4. The Richardson extrapolation (4 D(h/4) − D(h/2))/3 cancels the h² error of the
+/// two finer ones; the same extrapolation of the two coarser ones differs from it by about its
+/// own error (16 × the finer pair's, where the map is smooth at the step's scale), which is what
+/// the point is allowed for it: a spread |D(h) − D(h/2)| alone is no bound where the map is not
+/// yet in its asymptotic regime at h (measured: the η 0.1, α 1e4 dielectric from inside at
+/// θi 1.541, whose densities at h = 1e-4, 5e-5, 2.5e-5 … 3e-6 are 778.35238, 778.35271,
+/// 778.35121 … 778.350568 for a pdf of 778.350566: the first pair's spread, 4e-7, is 7 × below
+/// the error of its extrapolation, 2.9e-6).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Density {
     /// With step h.
     pub coarse: f64,
     /// With step h/2.
     pub fine: f64,
+    /// With step h/4.
+    pub finest: f64,
     /// A bound on the extrapolated density's relative rounding error ([`rounding_bound`]).
     pub rounding: f64,
 }
 
-/// The ulps of each component of a sampled direction that the rounding bound allows: a map
-/// computed in float32 is a chain of a few dozen operations, each direction component within a
-/// few ulps of its exact value; 8 covers the samplers mfh audits (the reference GGX's f32
-/// visible sampler measured ≤ 3).
+/// The ulps of each component of a sampled direction that the rounding bound allows at the
+/// least: a map computed in float32 is a chain of a few dozen operations, each direction
+/// component within a few ulps of its exact value (the reference GGX's f32 visible sampler
+/// measured ≤ 3). A map that amplifies its intermediate rounding (a refraction near the critical
+/// angle at η 10: 1 − η² sin² θ cancels) is allowed what its measured noise shows
+/// ([`NOISE_DIVISOR`]).
 pub const DIRECTION_ULPS: f64 = 8.0;
 
-/// The relative rounding error of a central-difference density from directions computed in
-/// precision ε: each component of a column a = (p − q)/(2h) is off by ≤ 2·u·ε/(2h), so |a| by
-/// ≤ √3·u·ε/h (u = [`DIRECTION_ULPS`]); the density 1/|a × b| by ≤ r = √3·u·ε/h·(1/|a| + 1/|b|)
-/// to first order. The fine step doubles r, and the extrapolation (4 fine − coarse)/3 weighs
-/// the two errors 4/3 and 1/3: ≤ (8r + r)/3 = 3r. Negligible in f64 (ε 1.1e-16: ~1e-8 at
-/// |a| = 1e-3), it is what limits a float32 map at tiny roughness, whose derivatives are of the
-/// order of α: at α = 0.001 and step 4e-3, r reaches ~0.1.
-pub fn rounding_bound(eps: f64, h: f64, a: f64, b: f64) -> f64 {
-    3.0 * 3f64.sqrt() * DIRECTION_ULPS * eps / h * (1.0 / a + 1.0 / b)
-}
+/// The rounding of one direction component is bounded by the largest fourth difference of the
+/// stencil's five points along u₁ and along u₂ (−h, −h/2, 0, h/2, h), divided by this: a map
+/// smooth at the step's scale contributes w⁗·(h/2)⁴ to it, far below its rounding (≈ 1e-18
+/// at the η 10, α 1e-7 corner, whose rounding is ≈ 1e-14), so the fourth difference is its
+/// rounding noise, free of extra evaluations. Of errors bounded by E it is at most 16 E; of
+/// independent errors of standard deviation s it is ≈ 8.4 s (√70 s), so that the largest of the
+/// six (2 axes × 3 components) is ≳ 8 s and a half of it ≳ 4 s bounds the errors of the eight
+/// stencil directions. (A probe of the map at c ± 64 ε, tried first, sees no noise where the
+/// map's derivatives are small: its directions move by less than an ulp, all rounded alike.)
+pub const NOISE_DIVISOR: f64 = 2.0;
 
-/// The precision whose [`stencil`] steps by `h` (f64 for any other step).
-fn epsilon_of_step(h: f64) -> f64 {
-    if h == stencil(Precision::F32).0 {
-        Precision::F32.epsilon()
-    } else {
-        Precision::F64.epsilon()
-    }
+/// The relative rounding error of a central-difference density from directions each of whose
+/// components is within `e` of its exact value: each component of a column a = (p − q)/(2h) is
+/// off by ≤ 2e/(2h), so |a| by ≤ √3·e/h; the density 1/|a × b| by ≤ r = √3·e/h·(1/|a| + 1/|b|)
+/// to first order at step h. The steps h/2 and h/4 double and quadruple r, and the
+/// extrapolation (4 D(h/4) − D(h/2))/3 weighs the two errors 4/3 and 1/3: ≤ (16r + 2r)/3 = 6r.
+/// Negligible for an f64 map of ε-accurate
+/// directions (~1e-8 at |a| = 1e-3), it is what limits a float32 map at tiny roughness, whose
+/// derivatives are of the order of α: at α = 0.001 and step 4e-3, r reaches ~0.1.
+pub fn rounding_bound(e: f64, h: f64, a: f64, b: f64) -> f64 {
+    6.0 * 3f64.sqrt() * e / h * (1.0 / a + 1.0 / b)
 }
 
 impl Density {
     /// The extrapolated density.
     pub fn value(&self) -> f64 {
-        (4.0 * self.fine - self.coarse) / 3.0
+        (4.0 * self.finest - self.fine) / 3.0
     }
 
-    /// |coarse − fine| / fine: the size of the extrapolated term, an upper bound on what the
-    /// extrapolation leaves where the map is smooth within the stencil.
+    /// The larger of |D(h) − D(h/2)| and |D(h/2) − D(h/4)|, relative: the size of the
+    /// extrapolated term; a point where it is large has a kink or a branch within its stencil.
     pub fn spread(&self) -> f64 {
-        ((self.coarse - self.fine) / self.fine).abs()
+        ((self.coarse - self.fine) / self.fine)
+            .abs()
+            .max(((self.fine - self.finest) / self.finest).abs())
     }
 
-    /// What a point's error is allowed beyond the tolerance: the extrapolation's [`spread`]
-    /// and the rounding bound.
+    /// Whether the point's densities can be judged: its [`spread`] is at most `unresolved` and
+    /// they converge as h² (the differences D(h) − D(h/2) and D(h/2) − D(h/4) in a ratio
+    /// within [2, 8] of the asymptotic 4), or differ by no more than twice their rounding
+    /// bound. A point whose densities wander instead (its map not yet smooth at the step's
+    /// scale, or its rounding beyond the bound: GGX α 1e4 refracting into η 0.1 at step 6e-6,
+    /// whose differences are in a ratio of 50) says nothing and is left out.
     ///
     /// [`spread`]: Density::spread
+    pub fn resolved(&self, unresolved: f64) -> bool {
+        let first = self.coarse - self.fine;
+        let second = self.fine - self.finest;
+        let ratio = first / second;
+        self.spread() <= unresolved
+            && (self.spread() <= 2.0 * self.rounding || (2.0..=8.0).contains(&ratio))
+    }
+
+    /// The error of the extrapolation, relative: its difference from the coarser pair's.
+    pub fn extrapolation(&self) -> f64 {
+        let coarser = (4.0 * self.fine - self.coarse) / 3.0;
+        ((coarser - self.value()) / self.value()).abs()
+    }
+
+    /// What a point's error is allowed beyond the tolerance: the [`extrapolation`]'s error and
+    /// the rounding bound.
+    ///
+    /// [`extrapolation`]: Density::extrapolation
     pub fn allowance(&self) -> f64 {
-        self.spread() + self.rounding
+        self.extrapolation() + self.rounding
     }
 }
 
-/// The offsets of a point's stencil in (u₁, u₂), in steps: ±1 and ±½ along each.
-const STENCIL: [(f64, f64); 8] = [
+/// The offsets of a point's stencil in (u₁, u₂), in steps: ±1, ±½ and ±¼ along each.
+const STENCIL: [(f64, f64); 12] = [
     (1.0, 0.0),
     (-1.0, 0.0),
     (0.0, 1.0),
@@ -216,6 +254,10 @@ const STENCIL: [(f64, f64); 8] = [
     (-0.5, 0.0),
     (0.0, 0.5),
     (0.0, -0.5),
+    (0.25, 0.0),
+    (-0.25, 0.0),
+    (0.0, 0.25),
+    (0.0, -0.25),
 ];
 
 /// A sampling map in batch: `out[k]` the direction of `u[k]` (u₀, u₁, u₂), None where it fails.
@@ -223,14 +265,50 @@ pub type BatchMap<'m> = dyn FnMut(&[[f64; 3]], &mut [Option<Vec3>]) + 'm;
 
 /// The directions at `centres` (u₀ fixed, u₁ and u₂ the coordinates of the map) and, where the
 /// map is defined on the whole stencil and stays on the centre's side of the surface there,
-/// its density by central differences with step `h`. `map` is one batch call: `out[k]` the
-/// direction of `u[k]`, None where the map fails.
+/// its density by central differences with step `h`, for a map computed in precision `eps`
+/// (its ε), with the bound of its rounding from the noise the stencil shows ([`NOISE_DIVISOR`])
+/// or [`DIRECTION_ULPS`], whichever is larger. A point whose stencil leaves the map's domain or
+/// its side of the surface, or that is not [`Density::resolved`] at `unresolved`, is measured again
+/// with the step h/[`REFINE`] (one more call of `map`, for those points only): where the map
+/// is defined on a sliver of u (a lobe that almost always fails: GGX α 1e4 refracting into
+/// η 0.1), the finer stencil fits in it. `map` is one batch call: `out[k]` the direction of
+/// `u[k]`, None where the map fails.
 pub fn densities(
     centres: &[[f64; 3]],
     h: f64,
+    eps: f64,
+    unresolved: f64,
     map: &mut BatchMap<'_>,
 ) -> Vec<(Option<Vec3>, Option<Density>)> {
-    let mut u = Vec::with_capacity(centres.len() * 9);
+    let mut out = densities_at(centres, h, eps, map);
+    let again: Vec<usize> = (0..out.len())
+        .filter(|&k| out[k].0.is_some() && !out[k].1.is_some_and(|d| d.resolved(unresolved)))
+        .collect();
+    if !again.is_empty() {
+        let retry: Vec<[f64; 3]> = again.iter().map(|&k| centres[k]).collect();
+        let finer = densities_at(&retry, h / REFINE, eps, map);
+        for (&k, (_, d)) in again.iter().zip(finer) {
+            if d.is_some_and(|d| d.resolved(unresolved)) {
+                out[k].1 = d;
+            }
+        }
+    }
+    out
+}
+
+/// The factor by which [`densities`] shrinks the step of an unresolved point: 16 (f64: 6.25e-6,
+/// whose rounding, 16 × that of 1e-4, stays ≤ 1e-7 where the map's derivatives are ≥ 1e-3).
+pub const REFINE: f64 = 16.0;
+
+/// [`densities`] at one step.
+fn densities_at(
+    centres: &[[f64; 3]],
+    h: f64,
+    eps: f64,
+    map: &mut BatchMap<'_>,
+) -> Vec<(Option<Vec3>, Option<Density>)> {
+    const PER: usize = 1 + STENCIL.len();
+    let mut u = Vec::with_capacity(centres.len() * PER);
     for c in centres {
         u.push(*c);
         for (a, b) in STENCIL {
@@ -239,7 +317,7 @@ pub fn densities(
     }
     let mut w = vec![None; u.len()];
     map(&u, &mut w);
-    w.chunks(9)
+    w.chunks(PER)
         .map(|w| {
             let centre = w[0];
             let Some(c) = centre else {
@@ -249,6 +327,17 @@ pub fn densities(
             let Some(s) = all.filter(|s| s.iter().all(|d| (d[2] > 0.0) == (c[2] > 0.0))) else {
                 return (centre, None);
             };
+            // The fourth differences along u₁ (s[1], s[5], c, s[4], s[0]) and u₂ (s[3], s[7],
+            // c, s[6], s[2]): the map's rounding noise.
+            let noise = (0..3)
+                .flat_map(|k| {
+                    let fourth = |a: usize, b: usize, d: usize, e: usize| {
+                        (s[a][k] - 4.0 * s[b][k] + 6.0 * c[k] - 4.0 * s[d][k] + s[e][k]).abs()
+                    };
+                    [fourth(1, 5, 4, 0), fourth(3, 7, 6, 2)]
+                })
+                .fold(0.0, f64::max);
+            let e = (DIRECTION_ULPS * eps).max(noise / NOISE_DIVISOR);
             let columns = |k: usize, step: f64| {
                 let d = |p: Vec3, q: Vec3| {
                     [
@@ -274,9 +363,10 @@ pub fn densities(
                 Some(Density {
                     coarse: density(0, h),
                     fine: density(4, h / 2.0),
+                    finest: density(8, h / 4.0),
                     rounding: {
                         let (a, b) = columns(0, h);
-                        rounding_bound(epsilon_of_step(h), h, norm(a), norm(b))
+                        rounding_bound(e, h, norm(a), norm(b))
                     },
                 }),
             )
@@ -457,7 +547,7 @@ mod tests {
     fn the_densities_of_a_linear_map_are_exact() {
         // u ↦ (u₁, 2u₂, 1) (not unit, but a map): density 1/2 everywhere.
         let c = [[0.5, 0.3, 0.6]];
-        let d = densities(&c, 1e-3, &mut |u, out| {
+        let d = densities(&c, 1e-3, f64::EPSILON, 1e-3, &mut |u, out| {
             for (o, u) in out.iter_mut().zip(u) {
                 *o = Some([u[1], 2.0 * u[2], 1.0]);
             }

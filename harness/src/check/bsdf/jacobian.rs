@@ -189,12 +189,12 @@ pub fn measure(
     wi: Vec3,
     theta: f64,
     points: &[[f64; 2]],
-    (step, unresolved, tolerance): (f64, f64, f64),
+    (step, unresolved, tolerance, eps): (f64, f64, f64, f64),
     spent: &mut Spent,
 ) -> AtIncidence {
     let lobes = lobes(bsdf, wi, points, spent);
     let centres: Vec<[f64; 3]> = lobes.iter().map(|l| l.u).collect();
-    let d = regime::densities(&centres, step, &mut |u, out| {
+    let d = regime::densities(&centres, step, eps, unresolved, &mut |u, out| {
         let w = directions(bsdf, wi, u, spent);
         out.copy_from_slice(&w);
     });
@@ -218,7 +218,7 @@ pub fn measure(
         }
         let Some(density) = density else { continue };
         let value = density.value() * l.measure;
-        if !(value.is_finite() && value > 0.0) || density.spread() > unresolved {
+        if !(value.is_finite() && value > 0.0 && density.resolved(unresolved)) {
             continue;
         }
         out.resolved += 1;
@@ -316,7 +316,7 @@ pub fn plan<'a>(
                     let bsdf = s.bsdf.as_ref();
                     let sweep = regime::sweep(alpha, critical, Some(ctx.seed));
                     let points = regime::points(POINTS, step);
-                    let limits = (step, unresolved, tolerance.value);
+                    let limits = (step, unresolved, tolerance.value, precision.epsilon());
                     let mut spent = Spent::default();
                     let same = 4096.0 * precision.epsilon();
                     if let Some(evidence) = mixed_lobes(bsdf, inside, same, &mut spent) {

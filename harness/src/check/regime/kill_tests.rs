@@ -190,7 +190,7 @@ mod property {
                 p.direction(inside),
                 p.theta,
                 &points(128, step),
-                (step, unresolved, PDF_JACOBIAN.value),
+                (step, unresolved, PDF_JACOBIAN.value, f64::EPSILON),
                 &mut Spent::default(),
             );
             prop_assert!(!at.fails, "{at:?}");

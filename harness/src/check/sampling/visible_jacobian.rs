@@ -33,12 +33,12 @@ pub fn measure(
     wi: Vec3,
     theta: f64,
     points: &[[f64; 2]],
-    (step, unresolved, tolerance): (f64, f64, f64),
+    (step, unresolved, tolerance, eps): (f64, f64, f64, f64),
 ) -> AtIncidence {
     let centres: Vec<[f64; 3]> = points.iter().map(|p| [0.0, p[0], p[1]]).collect();
     let mut u2 = Vec::new();
     let mut ms = Vec::new();
-    let d = regime::densities(&centres, step, &mut |u, out| {
+    let d = regime::densities(&centres, step, eps, unresolved, &mut |u, out| {
         u2.clear();
         u2.extend(u.iter().map(|u| [u[1], u[2]]));
         ms.clear();
@@ -74,7 +74,7 @@ pub fn measure(
         }
         let Some(density) = density else { continue };
         let value = density.value();
-        if !(value.is_finite() && value > 0.0) || density.spread() > unresolved {
+        if !(value.is_finite() && value > 0.0 && density.resolved(unresolved)) {
             continue;
         }
         out.resolved += 1;
@@ -119,7 +119,7 @@ pub fn plan<'a>(subject: &Arc<Subject<'a>>, why: &str) -> PlannedCheck<'a> {
         let alpha = s.lobe().width().tan();
         let sweep: Vec<SweepPoint> = regime::sweep(alpha, None, Some(ctx.seed));
         let points = regime::points(POINTS, step);
-        let limits = (step, unresolved, tolerance.value);
+        let limits = (step, unresolved, tolerance.value, precision.epsilon());
         let at_theta = |p: SweepPoint| measure(v, p.direction(false), p.theta, &points, limits);
         let at: Vec<AtIncidence> = sweep.iter().map(|p| at_theta(*p)).collect();
         let worst = at
