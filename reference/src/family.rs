@@ -1,8 +1,10 @@
 //! What a family of reference models provides, beside its model: how its spec type builds the
 //! model and what follows from the spec's parameters ([`FamilySpec`]), and what the harness
-//! knows about the family ([`FamilyInfo`]). Each family's file implements [`FamilySpec`] for
-//! its spec type (declared in `crate::spec`) and declares its `INFO`; the registry
-//! (`crate::registry`) lists them. This file names no family, so the families may name it.
+//! knows about the family ([`FamilyInfo`], with its samplers' measured cost, [`SamplerCost`]).
+//! Each family's file implements [`FamilySpec`] for its spec type (declared in `crate::spec`)
+//! and attaches its facts to it as `SpecType::INFO`; the registry (`crate::registry`) reaches
+//! both through the spec types of the one list of families. This file names no family, so the
+//! families may name it.
 
 use crate::error::ParamError;
 use crate::model::{check_alpha, Model};
@@ -75,6 +77,31 @@ pub struct FamilyInfo {
     /// Whether slope moments are part of the model itself (not only of Gaussian-slope
     /// filtering), so that they are always checked.
     pub intrinsic_moments: bool,
+    /// What its samplers cost per sample, measured ([`SamplerCost`]): a cost where, and only
+    /// where, the model has the sampler (the registry's test).
+    pub sampler_cost: SamplerCost,
+}
+
+/// The measured cost of a family's samplers in an audit: wall-clock nanoseconds per sample of
+/// its 10⁸-sample chi-square checks in the default scene's thorough audit (sampling and binning
+/// on 2 cores while the audit runs other checks beside them; AMD EPYC Zen 4, 2026-12-02). A
+/// measurement of one machine, not mathematics: the harness uses it only to balance the shards
+/// of `mfh audit --shard` (a wrong figure unbalances them, it cannot change a record). It sits
+/// in the family's entry so that a family is described in one place.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SamplerCost {
+    /// `sample_wm` (`sampling.chi2`); 0 where the family has no normal sampler.
+    pub normal_ns: f64,
+    /// `sample_wm_visible` (`sampling.chi2_visible`); 0 where the family has none.
+    pub visible_ns: f64,
+}
+
+impl SamplerCost {
+    /// A family without samplers.
+    pub const NONE: SamplerCost = SamplerCost {
+        normal_ns: 0.0,
+        visible_ns: 0.0,
+    };
 }
 
 /// Resolves `alpha` or (`alpha_x`, `alpha_y`) into validated per-axis roughness.

@@ -1,22 +1,24 @@
 //! Models described as data: [`ModelSpec`], e.g. `{"family": "std", "gamma": 2.5, "alpha": 0.3}`
-//! (ARCHITECTURE.md, "Evaluating closed forms"), and the spec type of every family. A spec is
-//! parameters only: each family's file builds its model from its spec type and describes its
-//! model as one ([`crate::family::FamilySpec`], [`crate::model::Model::spec`]), and the
-//! registry ([`crate::registry`]) lists the families. This file names no model, so the models
-//! and the registry may name it.
+//! (ARCHITECTURE.md, "Evaluating closed forms"), the spec type of every family, and the family
+//! registry's list (`families!`: one entry per family, from which [`ModelSpec`] here and the
+//! registry's lists in [`crate::registry`] are written). A spec is parameters only: each
+//! family's file builds its model from its spec type, describes its model as one
+//! ([`crate::family::FamilySpec`], [`crate::model::Model::spec`]) and attaches the family's
+//! facts to its spec type (`SpecType::INFO`). This file names no model, so the models and the
+//! registry may name it (the reference crate's files import one another without a cycle:
+//! `reference/tests/layers.rs`).
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::ndf::angular_profile::AngularProfile;
 
-/// Declares [`ModelSpec`]: one line per family, `Variant(SpecType) = "name"`, the name being
-/// the `family` key (and the registry's name of the family). Writes the enum (serde-tagged by
-/// `family`), [`ModelSpec::family`] and `From<SpecType> for ModelSpec`.
+/// Declares [`ModelSpec`] from the registry's list (`families!`). Writes the enum
+/// (serde-tagged by `family`), [`ModelSpec::family`] and `From<SpecType> for ModelSpec`.
 macro_rules! model_spec {
     ($($(#[$doc:meta])* $variant:ident($spec:ty) = $name:literal),+ $(,)?) => {
         /// A model described as data, e.g. `{"family": "std", "gamma": 2.5, "alpha": 0.3}`.
-        /// Unknown keys are errors. Each variant holds its family's spec type (below); the
-        /// registry (`crate::registry`) has a line for each.
+        /// Unknown keys are errors. Each variant holds its family's spec type (below), one
+        /// per entry of the registry's list (`families!`).
         #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
         #[serde(tag = "family")]
         pub enum ModelSpec {
@@ -40,29 +42,45 @@ macro_rules! model_spec {
     };
 }
 
-model_spec! {
-    /// Beckmann (seed 001, Table 1, γ → ∞).
-    Beckmann(BeckmannSpec) = "beckmann",
-    /// GGX / Trowbridge–Reitz (seed 001, Table 1, γ = 2).
-    Ggx(GgxSpec) = "ggx",
-    /// Student's t NDF, STD (seed 001, f = 1/(γ−1)); `gamma: "inf"` is Beckmann.
-    Std(StdSpec) = "std",
-    /// Hyper-Cauchy (seed 001, eq 8, f = 1).
-    HyperCauchy(HyperCauchySpec) = "hyper_cauchy",
-    /// The fixed-variance Student member (seed 001, eq 9, f = 1/(γ−2)); `gamma: "inf"` is
-    /// Beckmann.
-    StudentFixedVariance(FixedVarianceSpec) = "student_fixed_variance",
-    /// The general isotropic family D^G(B, C) (seed 001, eq 1–2).
-    StudentGeneral(GeneralSpec) = "student_general",
-    /// The piecewise-linear NDF (seed 000, eq 1–5).
-    PiecewiseLinear(PiecewiseSpec) = "piecewise_linear",
-    /// Two isotropic models combined by eq 1 of seed 000.
-    Blend(BlendSpec) = "blend",
-    /// Generalized-Trowbridge-Reitz (Burley 2012; Smith G1 of seed 004), isotropic.
-    Gtr(GtrSpec) = "gtr",
-    /// A Gaussian distribution of slopes N(s̄, Σ) (seed 002, eq 1; slope sign of eq 11).
-    GaussianSlopes(GaussianSlopesSpec) = "gaussian_slopes",
+/// The family registry's list: one entry per family, `Variant(SpecType) = "name"` — the
+/// [`ModelSpec`] variant, the family's spec type (declared below; the family's file implements
+/// [`crate::family::FamilySpec`] for it, its constructor, and declares `SpecType::INFO`, the
+/// family's [`crate::family::FamilyInfo`]: sources, examples, stress values, flags, measured
+/// sampler cost) and the `family` key of its specs. Every other list of families is written
+/// from this one: `families!(m)` hands the list to the macro `m`, here [`ModelSpec`]'s and in
+/// [`crate::registry`] the registry's ([`crate::registry::FAMILIES`], `info`, `by_name`, the
+/// dispatch of [`crate::family::FamilySpec`]). Adding a family: its file, its spec type and one
+/// entry here (ARCHITECTURE.md, "A new NDF family").
+macro_rules! families {
+    ($then:ident) => {
+        $then! {
+            /// Beckmann (seed 001, Table 1, γ → ∞).
+            Beckmann(BeckmannSpec) = "beckmann",
+            /// GGX / Trowbridge–Reitz (seed 001, Table 1, γ = 2).
+            Ggx(GgxSpec) = "ggx",
+            /// Student's t NDF, STD (seed 001, f = 1/(γ−1)); `gamma: "inf"` is Beckmann.
+            Std(StdSpec) = "std",
+            /// Hyper-Cauchy (seed 001, eq 8, f = 1).
+            HyperCauchy(HyperCauchySpec) = "hyper_cauchy",
+            /// The fixed-variance Student member (seed 001, eq 9, f = 1/(γ−2)); `gamma: "inf"` is
+            /// Beckmann.
+            StudentFixedVariance(FixedVarianceSpec) = "student_fixed_variance",
+            /// The general isotropic family D^G(B, C) (seed 001, eq 1–2).
+            StudentGeneral(GeneralSpec) = "student_general",
+            /// The piecewise-linear NDF (seed 000, eq 1–5).
+            PiecewiseLinear(PiecewiseSpec) = "piecewise_linear",
+            /// Two isotropic models combined by eq 1 of seed 000.
+            Blend(BlendSpec) = "blend",
+            /// Generalized-Trowbridge-Reitz (Burley 2012; Smith G1 of seed 004), isotropic.
+            Gtr(GtrSpec) = "gtr",
+            /// A Gaussian distribution of slopes N(s̄, Σ) (seed 002, eq 1; slope sign of eq 11).
+            GaussianSlopes(GaussianSlopesSpec) = "gaussian_slopes",
+        }
+    };
 }
+pub(crate) use families;
+
+families!(model_spec);
 
 /// Declares the spec type of a family parameterized by roughness only: `alpha`, or `alpha_x`
 /// and `alpha_y` (validated when the model is built).

@@ -54,9 +54,9 @@
 //!    table of both hemispheres' rows ordered by cos θ from 1 to −1.
 
 use crate::oracle::chi2::cells::{self, Layout};
-use crate::oracle::chi2::components::{components, Components};
+use crate::oracle::chi2::components::Components;
 use crate::oracle::chi2::{
-    expected_mass_global_until, pooled_statistic, Chi2Config, Expected, Verdict,
+    expected_mass_global_until, pearson_test, Chi2Config, Expected, Verdict,
 };
 use crate::oracle::domain::HemisphereGrid;
 use crate::oracle::lobe;
@@ -710,8 +710,13 @@ pub fn sphere_chi2_against(
         .chain(&result.observed.lower)
         .copied()
         .collect();
-    let (statistic, bins, _) = pooled_statistic(&observed, &result.expected_counts());
-    if bins < 2 {
+    let (table, expected) = along_cos_theta(&result, columns);
+    let Ok(test) = pearson_test(
+        (&observed, &result.expected_counts()),
+        (&table, &expected),
+        columns,
+        config.alpha,
+    ) else {
         // Too few successful samples for two bins (a BSDF whose pdf holds 10⁻⁶–10⁻⁴ of mass
         // at this incidence, every other sample failing): conditional on success the one bin
         // holds them all whatever the sampler, so the statistic is 0 and p is 1. Samples
@@ -722,20 +727,14 @@ pub fn sphere_chi2_against(
         result.p_value = 1.0;
         result.verdict = Verdict::Pass;
         return result;
-    }
-    result.sanity_failure = false;
-    result.statistic = statistic;
-    result.dof = bins - 1;
-    let (table, expected) = along_cos_theta(&result, columns);
-    result.components = components(&table, &expected, columns);
-    result.p_value = match &result.components {
-        Some(c) => c.p_value,
-        None => statrs::function::gamma::checked_gamma_ur(0.5 * result.dof as f64, 0.5 * statistic)
-            .unwrap_or(f64::NAN),
     };
-    if result.p_value >= config.alpha {
-        result.verdict = Verdict::Pass;
-    } else {
+    result.sanity_failure = false;
+    result.statistic = test.statistic;
+    result.dof = test.dof;
+    result.components = test.components;
+    result.p_value = test.p_value;
+    result.verdict = test.verdict;
+    if test.verdict == Verdict::Fail {
         result.reason = Some(format!(
             "p-value {:.3e} below α = {:.3e}",
             result.p_value, config.alpha

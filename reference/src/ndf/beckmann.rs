@@ -1,7 +1,7 @@
 //! The Beckmann NDF, isotropic and anisotropic: the γ → ∞ limit of STD (seed 001, §2, Table 1).
 
 use crate::error::{ParamError, QueryError};
-use crate::family::{resolve_roughness, roughness_fields, FamilyInfo, FamilySpec};
+use crate::family::{resolve_roughness, roughness_fields, FamilyInfo, FamilySpec, SamplerCost};
 use crate::geometry::{normal_from_slopes, Vec3};
 use crate::model::{
     check_alpha, elliptic_direction, lambda_both_hemispheres, scale_along, standardized_cotangent,
@@ -287,28 +287,34 @@ impl Model for Beckmann {
         self.described_as
             .as_ref()
             .map(ModelSpec::family)
-            .unwrap_or("beckmann")
+            .unwrap_or(BeckmannSpec::INFO.name)
     }
 }
 
-/// The registry entry of beckmann ([`crate::registry`]).
-pub const INFO: FamilyInfo = FamilyInfo {
-    name: "beckmann",
-    documents: &["001"],
-    source: "seed 001 Table 1 (γ → ∞)",
-    domain: "α (or α_x, α_y) finite and > 0",
-    examples: &[
-        r#"{"family": "beckmann", "alpha": 0.3}"#,
-        r#"{"family": "beckmann", "alpha_x": 0.1, "alpha_y": 0.4}"#,
-    ],
-    stress_alpha: &[1e-4, 10.0],
-    stress_gamma: &[],
-    stress_specs: &[],
-    lambda_numerical: false,
-    slow_sampler: false,
-    beckmann_limit: false,
-    intrinsic_moments: false,
-};
+impl BeckmannSpec {
+    /// The registry entry of beckmann ([`crate::registry`], which finds it through the spec type).
+    pub const INFO: FamilyInfo = FamilyInfo {
+        name: "beckmann",
+        documents: &["001"],
+        source: "seed 001 Table 1 (γ → ∞)",
+        domain: "α (or α_x, α_y) finite and > 0",
+        examples: &[
+            r#"{"family": "beckmann", "alpha": 0.3}"#,
+            r#"{"family": "beckmann", "alpha_x": 0.1, "alpha_y": 0.4}"#,
+        ],
+        stress_alpha: &[1e-4, 10.0],
+        stress_gamma: &[],
+        stress_specs: &[],
+        lambda_numerical: false,
+        slow_sampler: false,
+        beckmann_limit: false,
+        intrinsic_moments: false,
+        sampler_cost: SamplerCost {
+            normal_ns: 23.0,
+            visible_ns: 634.0,
+        },
+    };
+}
 
 #[cfg(test)]
 mod tests {

@@ -2,7 +2,7 @@
 //! isotropic NDFs, e.g. GGX along x and Beckmann along y.
 
 use crate::error::{ParamError, QueryError};
-use crate::family::{FamilyInfo, FamilySpec};
+use crate::family::{FamilyInfo, FamilySpec, SamplerCost};
 use crate::geometry::{from_spherical, Vec3};
 use crate::model::{Model, Ndf, Smith};
 use crate::ndf::piecewise_lambda::{both_hemispheres, lambda_exact, EXACT_REL};
@@ -181,27 +181,30 @@ impl Model for Blend {
     }
 
     fn family(&self) -> &'static str {
-        "blend"
+        BlendSpec::INFO.name
     }
 }
 
-/// The registry entry of the blend of seed 000 eq 1 ([`crate::registry`]).
-pub const INFO: FamilyInfo = FamilyInfo {
-    name: "blend",
-    documents: &["000"],
-    source: "seed 000 eq 1 (two isotropic NDFs)",
-    domain: "x, y: isotropic model specs",
-    examples: &[
-        r#"{"family": "blend", "x": {"family": "ggx", "alpha": 0.2}, "y": {"family": "beckmann", "alpha": 0.4}}"#,
-    ],
-    stress_alpha: &[],
-    stress_gamma: &[],
-    stress_specs: &[],
-    lambda_numerical: true,
-    slow_sampler: false,
-    beckmann_limit: false,
-    intrinsic_moments: false,
-};
+impl BlendSpec {
+    /// The registry entry of the blend of seed 000 eq 1 ([`crate::registry`], which finds it through the spec type).
+    pub const INFO: FamilyInfo = FamilyInfo {
+        name: "blend",
+        documents: &["000"],
+        source: "seed 000 eq 1 (two isotropic NDFs)",
+        domain: "x, y: isotropic model specs",
+        examples: &[
+            r#"{"family": "blend", "x": {"family": "ggx", "alpha": 0.2}, "y": {"family": "beckmann", "alpha": 0.4}}"#,
+        ],
+        stress_alpha: &[],
+        stress_gamma: &[],
+        stress_specs: &[],
+        lambda_numerical: true,
+        slow_sampler: false,
+        beckmann_limit: false,
+        intrinsic_moments: false,
+        sampler_cost: SamplerCost::NONE,
+    };
+}
 
 #[cfg(test)]
 mod tests {

@@ -1,7 +1,7 @@
 //! The GGX (Trowbridge–Reitz) NDF, isotropic and anisotropic: STD at γ = 2 (seed 001, Table 1).
 
 use crate::error::{ParamError, QueryError};
-use crate::family::{resolve_roughness, roughness_fields, FamilyInfo, FamilySpec};
+use crate::family::{resolve_roughness, roughness_fields, FamilyInfo, FamilySpec, SamplerCost};
 use crate::geometry::{normal_from_slopes, Vec3};
 use crate::model::{
     check_alpha, elliptic_direction, lambda_both_hemispheres, scale_along, standardized_cotangent,
@@ -214,28 +214,34 @@ impl Model for Ggx {
     }
 
     fn family(&self) -> &'static str {
-        "ggx"
+        GgxSpec::INFO.name
     }
 }
 
-/// The registry entry of ggx ([`crate::registry`]).
-pub const INFO: FamilyInfo = FamilyInfo {
-    name: "ggx",
-    documents: &["001"],
-    source: "seed 001 Table 1 (γ = 2)",
-    domain: "α (or α_x, α_y) finite and > 0",
-    examples: &[
-        r#"{"family": "ggx", "alpha": 0.3}"#,
-        r#"{"family": "ggx", "alpha_x": 0.1, "alpha_y": 0.4}"#,
-    ],
-    stress_alpha: &[1e-4, 10.0],
-    stress_gamma: &[],
-    stress_specs: &[],
-    lambda_numerical: false,
-    slow_sampler: false,
-    beckmann_limit: false,
-    intrinsic_moments: false,
-};
+impl GgxSpec {
+    /// The registry entry of ggx ([`crate::registry`], which finds it through the spec type).
+    pub const INFO: FamilyInfo = FamilyInfo {
+        name: "ggx",
+        documents: &["001"],
+        source: "seed 001 Table 1 (γ = 2)",
+        domain: "α (or α_x, α_y) finite and > 0",
+        examples: &[
+            r#"{"family": "ggx", "alpha": 0.3}"#,
+            r#"{"family": "ggx", "alpha_x": 0.1, "alpha_y": 0.4}"#,
+        ],
+        stress_alpha: &[1e-4, 10.0],
+        stress_gamma: &[],
+        stress_specs: &[],
+        lambda_numerical: false,
+        slow_sampler: false,
+        beckmann_limit: false,
+        intrinsic_moments: false,
+        sampler_cost: SamplerCost {
+            normal_ns: 11.0,
+            visible_ns: 14.0,
+        },
+    };
+}
 
 #[cfg(test)]
 mod tests {

@@ -7,7 +7,9 @@
 //! runtime dispatch where the CPU has it and bit for bit the scalar result on every path (so a
 //! count never depends on the CPU); and `ggx_visible_batch.rs`, GGX's visible-normal batch on
 //! the same block loop, within [`GGX_VISIBLE_BATCH_MAX_ULPS`] per component of the scalar
-//! sampler and the same bits on every path. A new family: ARCHITECTURE.md, "A new NDF family".
+//! sampler and the same bits on every path. A new family is its file (with its `pub mod` line
+//! below), its spec type and one entry in the list of families (`crate::spec`):
+//! ARCHITECTURE.md, "A new NDF family".
 
 pub mod angular_profile;
 mod batch;

@@ -4,7 +4,7 @@
 //! `Smith` implementation are in `piecewise_lambda`, which builds on this file.
 
 use crate::error::ParamError;
-use crate::family::{FamilyInfo, FamilySpec};
+use crate::family::{FamilyInfo, FamilySpec, SamplerCost};
 use crate::geometry::Vec3;
 use crate::model::{Model, Ndf, NormalSampler, Smith};
 use crate::ndf::angular_profile::AngularProfile;
@@ -594,28 +594,34 @@ impl Model for PiecewiseLinear {
     }
 
     fn family(&self) -> &'static str {
-        "piecewise_linear"
+        PiecewiseSpec::INFO.name
     }
 }
 
-/// The registry entry of the piecewise-linear NDF ([`crate::registry`]).
-pub const INFO: FamilyInfo = FamilyInfo {
-    name: "piecewise_linear",
-    documents: &["000"],
-    source: "seed 000 eq 1–5",
-    domain: "profiles: θ strictly increasing from 0 to π/2, values ≥ 0 and finite, not all 0",
-    examples: &[
-        r#"{"family": "piecewise_linear", "x": {"theta": [0.0, 0.3, 0.8, 1.2, 1.5707963267948966], "value": [3.0, 2.0, 0.6, 0.1, 0.0]}}"#,
-        r#"{"family": "piecewise_linear", "x": {"theta": [0.0, 0.3, 0.8, 1.2, 1.5707963267948966], "value": [3.0, 2.0, 0.6, 0.1, 0.0]}, "y": {"theta": [0.0, 0.5, 1.0, 1.5707963267948966], "value": [1.5, 1.2, 0.3, 0.05]}}"#,
-    ],
-    stress_alpha: &[],
-    stress_gamma: &[],
-    stress_specs: &[],
-    lambda_numerical: true,
-    slow_sampler: true,
-    beckmann_limit: false,
-    intrinsic_moments: false,
-};
+impl PiecewiseSpec {
+    /// The registry entry of the piecewise-linear NDF ([`crate::registry`], which finds it through the spec type).
+    pub const INFO: FamilyInfo = FamilyInfo {
+        name: "piecewise_linear",
+        documents: &["000"],
+        source: "seed 000 eq 1–5",
+        domain: "profiles: θ strictly increasing from 0 to π/2, values ≥ 0 and finite, not all 0",
+        examples: &[
+            r#"{"family": "piecewise_linear", "x": {"theta": [0.0, 0.3, 0.8, 1.2, 1.5707963267948966], "value": [3.0, 2.0, 0.6, 0.1, 0.0]}}"#,
+            r#"{"family": "piecewise_linear", "x": {"theta": [0.0, 0.3, 0.8, 1.2, 1.5707963267948966], "value": [3.0, 2.0, 0.6, 0.1, 0.0]}, "y": {"theta": [0.0, 0.5, 1.0, 1.5707963267948966], "value": [1.5, 1.2, 0.3, 0.05]}}"#,
+        ],
+        stress_alpha: &[],
+        stress_gamma: &[],
+        stress_specs: &[],
+        lambda_numerical: true,
+        slow_sampler: true,
+        beckmann_limit: false,
+        intrinsic_moments: false,
+        sampler_cost: SamplerCost {
+            normal_ns: 568.0,
+            visible_ns: 0.0,
+        },
+    };
+}
 
 #[cfg(test)]
 #[path = "piecewise_tests.rs"]

@@ -3,7 +3,7 @@
 
 use crate::error::{ParamError, QueryError};
 use crate::family::{
-    resolve_roughness, roughness_fields, student_smith_limit, FamilyInfo, FamilySpec,
+    resolve_roughness, roughness_fields, student_smith_limit, FamilyInfo, FamilySpec, SamplerCost,
 };
 use crate::geometry::{normal_from_slopes, Vec3};
 use crate::model::{
@@ -223,10 +223,10 @@ impl Student {
 
 fn member_family(member: Member) -> &'static str {
     match member {
-        Member::Std => "std",
-        Member::HyperCauchy => "hyper_cauchy",
-        Member::FixedVariance => "student_fixed_variance",
-        Member::General => "student_general",
+        Member::Std => StdSpec::INFO.name,
+        Member::HyperCauchy => HyperCauchySpec::INFO.name,
+        Member::FixedVariance => FixedVarianceSpec::INFO.name,
+        Member::General => GeneralSpec::INFO.name,
     }
 }
 
@@ -431,72 +431,96 @@ impl Model for Student {
     }
 }
 
-/// The registry entry of STD ([`crate::registry`]).
-pub const STD_INFO: FamilyInfo = FamilyInfo {
-    name: "std",
-    documents: &["001"],
-    source: "seed 001 eq 1–7 (f = 1/(γ−1)), Table 1",
-    domain: "γ > 1 (Λ needs γ > 3/2), or \"inf\" (Beckmann); α finite and > 0",
-    examples: &[
-        r#"{"family": "std", "gamma": 2.5, "alpha_x": 0.1, "alpha_y": 0.4}"#,
-        r#"{"family": "std", "gamma": "inf", "alpha": 0.3}"#,
-    ],
-    stress_alpha: &[1e-4, 10.0],
-    stress_gamma: &[1.5 + 1e-9, 1e8],
-    stress_specs: &[],
-    lambda_numerical: false,
-    slow_sampler: false,
-    beckmann_limit: true,
-    intrinsic_moments: false,
-};
+impl StdSpec {
+    /// The registry entry of STD ([`crate::registry`], which finds it through the spec type).
+    pub const INFO: FamilyInfo = FamilyInfo {
+        name: "std",
+        documents: &["001"],
+        source: "seed 001 eq 1–7 (f = 1/(γ−1)), Table 1",
+        domain: "γ > 1 (Λ needs γ > 3/2), or \"inf\" (Beckmann); α finite and > 0",
+        examples: &[
+            r#"{"family": "std", "gamma": 2.5, "alpha_x": 0.1, "alpha_y": 0.4}"#,
+            r#"{"family": "std", "gamma": "inf", "alpha": 0.3}"#,
+        ],
+        stress_alpha: &[1e-4, 10.0],
+        stress_gamma: &[1.5 + 1e-9, 1e8],
+        stress_specs: &[],
+        lambda_numerical: false,
+        slow_sampler: false,
+        beckmann_limit: true,
+        intrinsic_moments: false,
+        sampler_cost: SamplerCost {
+            normal_ns: 44.6,
+            visible_ns: 0.0,
+        },
+    };
+}
 
-/// The registry entry of Hyper-Cauchy ([`crate::registry`]).
-pub const HYPER_CAUCHY_INFO: FamilyInfo = FamilyInfo {
-    name: "hyper_cauchy",
-    documents: &["001"],
-    source: "seed 001 eq 8 (f = 1)",
-    domain: "γ > 1 (Λ needs γ > 3/2); α finite and > 0",
-    examples: &[r#"{"family": "hyper_cauchy", "gamma": 3, "alpha_x": 0.2, "alpha_y": 0.5}"#],
-    stress_alpha: &[1e-4, 10.0],
-    stress_gamma: &[1.5 + 1e-9, 1e8],
-    stress_specs: &[],
-    lambda_numerical: false,
-    slow_sampler: false,
-    beckmann_limit: false,
-    intrinsic_moments: false,
-};
+impl HyperCauchySpec {
+    /// The registry entry of Hyper-Cauchy ([`crate::registry`], which finds it through the spec type).
+    pub const INFO: FamilyInfo = FamilyInfo {
+        name: "hyper_cauchy",
+        documents: &["001"],
+        source: "seed 001 eq 8 (f = 1)",
+        domain: "γ > 1 (Λ needs γ > 3/2); α finite and > 0",
+        examples: &[r#"{"family": "hyper_cauchy", "gamma": 3, "alpha_x": 0.2, "alpha_y": 0.5}"#],
+        stress_alpha: &[1e-4, 10.0],
+        stress_gamma: &[1.5 + 1e-9, 1e8],
+        stress_specs: &[],
+        lambda_numerical: false,
+        slow_sampler: false,
+        beckmann_limit: false,
+        intrinsic_moments: false,
+        sampler_cost: SamplerCost {
+            normal_ns: 46.1,
+            visible_ns: 0.0,
+        },
+    };
+}
 
-/// The registry entry of the fixed-variance Student member ([`crate::registry`]).
-pub const FIXED_VARIANCE_INFO: FamilyInfo = FamilyInfo {
-    name: "student_fixed_variance",
-    documents: &["001"],
-    source: "seed 001 eq 9 (f = 1/(γ−2))",
-    domain: "γ > 2, or \"inf\" (Beckmann); α finite and > 0",
-    examples: &[r#"{"family": "student_fixed_variance", "gamma": 4, "alpha": 0.3}"#],
-    stress_alpha: &[1e-4, 10.0],
-    stress_gamma: &[2.0 + 1e-9, 1e8],
-    stress_specs: &[],
-    lambda_numerical: false,
-    slow_sampler: false,
-    beckmann_limit: false,
-    intrinsic_moments: false,
-};
+impl FixedVarianceSpec {
+    /// The registry entry of the fixed-variance Student member ([`crate::registry`], which finds it through the spec type).
+    pub const INFO: FamilyInfo = FamilyInfo {
+        name: "student_fixed_variance",
+        documents: &["001"],
+        source: "seed 001 eq 9 (f = 1/(γ−2))",
+        domain: "γ > 2, or \"inf\" (Beckmann); α finite and > 0",
+        examples: &[r#"{"family": "student_fixed_variance", "gamma": 4, "alpha": 0.3}"#],
+        stress_alpha: &[1e-4, 10.0],
+        stress_gamma: &[2.0 + 1e-9, 1e8],
+        stress_specs: &[],
+        lambda_numerical: false,
+        slow_sampler: false,
+        beckmann_limit: false,
+        intrinsic_moments: false,
+        sampler_cost: SamplerCost {
+            normal_ns: 42.3,
+            visible_ns: 0.0,
+        },
+    };
+}
 
-/// The registry entry of the general Student family ([`crate::registry`]).
-pub const GENERAL_INFO: FamilyInfo = FamilyInfo {
-    name: "student_general",
-    documents: &["001"],
-    source: "seed 001 eq 1–2 (D^G(B, C))",
-    domain: "B > 0, C > 1 (Λ needs C > 3/2)",
-    examples: &[r#"{"family": "student_general", "b": 4, "c": 2.5}"#],
-    stress_alpha: &[],
-    stress_gamma: &[],
-    stress_specs: &[],
-    lambda_numerical: false,
-    slow_sampler: false,
-    beckmann_limit: false,
-    intrinsic_moments: false,
-};
+impl GeneralSpec {
+    /// The registry entry of the general Student family ([`crate::registry`], which finds it through the spec type).
+    pub const INFO: FamilyInfo = FamilyInfo {
+        name: "student_general",
+        documents: &["001"],
+        source: "seed 001 eq 1–2 (D^G(B, C))",
+        domain: "B > 0, C > 1 (Λ needs C > 3/2)",
+        examples: &[r#"{"family": "student_general", "b": 4, "c": 2.5}"#],
+        stress_alpha: &[],
+        stress_gamma: &[],
+        stress_specs: &[],
+        lambda_numerical: false,
+        slow_sampler: false,
+        beckmann_limit: false,
+        intrinsic_moments: false,
+        sampler_cost: SamplerCost {
+            normal_ns: 43.3,
+            visible_ns: 0.0,
+        },
+    };
+}
 
 #[cfg(test)]
 mod tests {

@@ -3,7 +3,7 @@
 //! (eq 12–69), evaluated without cancellation from θ = 0 to π/2 and for near-singular Σ.
 
 use crate::error::{ParamError, QueryError};
-use crate::family::{FamilyInfo, FamilySpec};
+use crate::family::{FamilyInfo, FamilySpec, SamplerCost};
 use crate::geometry::Vec3;
 use crate::model::{Model, Ndf, SlopeDistribution, Smith, VisibleMoments, VisibleSlopeMoments};
 use crate::slopes::pseudocode::{self, Transcription};
@@ -365,7 +365,7 @@ impl Model for GaussianSlopes {
     }
 
     fn family(&self) -> &'static str {
-        "gaussian_slopes"
+        GaussianSlopesSpec::INFO.name
     }
 }
 
@@ -613,23 +613,26 @@ impl Cov2 {
 #[path = "gaussian_tests.rs"]
 mod tests;
 
-/// The registry entry of Gaussian slopes ([`crate::registry`]).
-pub const INFO: FamilyInfo = FamilyInfo {
-    name: "gaussian_slopes",
-    documents: &["002"],
-    source: "seed 002 eq 1 (slope sign of eq 11)",
-    domain: "mean finite; cov symmetric positive definite",
-    examples: &[
-        r#"{"family": "gaussian_slopes", "mean": [0.1, -0.05], "cov": [[0.04, 0.01], [0.01, 0.09]]}"#,
-    ],
-    stress_alpha: &[],
-    stress_gamma: &[],
-    stress_specs: &[(
-        "cov correlation 1 − 1e-9",
-        r#"{"family": "gaussian_slopes", "mean": [0.1, -0.05], "cov": [[0.04, 0.03999999996], [0.03999999996, 0.04]]}"#,
-    )],
-    lambda_numerical: false,
-    slow_sampler: false,
-    beckmann_limit: false,
-    intrinsic_moments: true,
-};
+impl GaussianSlopesSpec {
+    /// The registry entry of Gaussian slopes ([`crate::registry`], which finds it through the spec type).
+    pub const INFO: FamilyInfo = FamilyInfo {
+        name: "gaussian_slopes",
+        documents: &["002"],
+        source: "seed 002 eq 1 (slope sign of eq 11)",
+        domain: "mean finite; cov symmetric positive definite",
+        examples: &[
+            r#"{"family": "gaussian_slopes", "mean": [0.1, -0.05], "cov": [[0.04, 0.01], [0.01, 0.09]]}"#,
+        ],
+        stress_alpha: &[],
+        stress_gamma: &[],
+        stress_specs: &[(
+            "cov correlation 1 − 1e-9",
+            r#"{"family": "gaussian_slopes", "mean": [0.1, -0.05], "cov": [[0.04, 0.03999999996], [0.03999999996, 0.04]]}"#,
+        )],
+        lambda_numerical: false,
+        slow_sampler: false,
+        beckmann_limit: false,
+        intrinsic_moments: true,
+        sampler_cost: SamplerCost::NONE,
+    };
+}

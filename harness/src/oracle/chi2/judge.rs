@@ -1,7 +1,9 @@
 //! The verdict of the chi-square test from its observed and expected counts: the sanity
-//! failures first, then the pooled statistic, its two parts and their p-value against α.
+//! failures first, then the verdict step [`pearson_test`] — the pooled statistic, its two
+//! parts and their p-value against α — which the whole sphere's test
+//! (`crate::oracle::sphere_chi2`) takes too.
 
-use super::components::components;
+use super::components::{components, Components};
 use super::{Chi2Config, Chi2Result, Expected, Failure, Observed, OutsideDomain, Verdict};
 use crate::oracle::domain::{DomainError, HemisphereGrid};
 use crate::tolerance::{MASS_TOLERANCE, MIN_EXPECTED};
@@ -53,29 +55,94 @@ pub(super) fn judge(
     if result.reason.is_some() {
         return result;
     }
-    let (statistic, bins, pooled) = pooled_statistic(&result.observed, &result.expected);
-    result.pooled_cells = pooled;
-    if bins < 2 {
-        result.reason = Some(Failure::TooFewBins { bins });
-        return result;
-    }
-    result.statistic = statistic;
-    result.dof = bins - 1;
-    result.components = components(&result.observed, &result.expected, grid.columns());
-    result.p_value = match &result.components {
-        Some(c) => c.p_value,
-        None => statrs::function::gamma::checked_gamma_ur(0.5 * result.dof as f64, 0.5 * statistic)
-            .unwrap_or(f64::NAN),
+    let counts = (&result.observed[..], &result.expected[..]);
+    let test = match pearson_test(counts, counts, grid.columns(), config.alpha) {
+        Ok(test) => test,
+        Err(few) => {
+            result.pooled_cells = few.pooled_cells;
+            result.reason = Some(Failure::TooFewBins { bins: few.bins });
+            return result;
+        }
     };
-    if result.p_value >= config.alpha {
-        result.verdict = Verdict::Pass;
-    } else {
+    result.pooled_cells = test.pooled_cells;
+    result.statistic = test.statistic;
+    result.dof = test.dof;
+    result.components = test.components;
+    result.p_value = test.p_value;
+    result.verdict = test.verdict;
+    if test.verdict == Verdict::Fail {
         result.reason = Some(Failure::Rejected {
             p_value: result.p_value,
             alpha: config.alpha,
         });
     }
     result
+}
+
+/// The outcome of the verdict step ([`pearson_test`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PearsonTest {
+    /// Σ (O − E)² / E over the pooled bins.
+    pub statistic: f64,
+    /// Bins − 1.
+    pub dof: usize,
+    /// The cells pooled because they expect fewer than [`MIN_EXPECTED`] samples.
+    pub pooled_cells: usize,
+    /// The statistic's two parts ([`components`]), where the table has two rows that expect
+    /// samples.
+    pub components: Option<Components>,
+    /// The p-value: the two parts' combination, or Q(dof/2, statistic/2) without them.
+    pub p_value: f64,
+    /// Pass when the p-value is at least α.
+    pub verdict: Verdict,
+}
+
+/// Fewer than two bins after pooling: no statistic to judge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TooFewBins {
+    /// The bins left.
+    pub bins: usize,
+    /// The cells pooled.
+    pub pooled_cells: usize,
+}
+
+/// The verdict step of every chi-square test of the harness, after its sanity failures:
+/// Pearson's statistic over the cells `cells` = (observed, expected counts), those expecting
+/// fewer than [`MIN_EXPECTED`] pooled ([`pooled_statistic`]), dof = bins − 1; the statistic's
+/// two parts on `table` (the same counts as rows ordered along cos θ, `columns` a row:
+/// [`components`]) and the p-value judged against `alpha`. The hemisphere's test passes its
+/// grid for both; the whole sphere's its cells as binned (upper hemisphere, then lower) and the
+/// table of both hemispheres' rows from cos θ = 1 to −1.
+pub(crate) fn pearson_test(
+    cells: (&[u64], &[f64]),
+    table: (&[u64], &[f64]),
+    columns: usize,
+    alpha: f64,
+) -> Result<PearsonTest, TooFewBins> {
+    let (statistic, bins, pooled_cells) = pooled_statistic(cells.0, cells.1);
+    if bins < 2 {
+        return Err(TooFewBins { bins, pooled_cells });
+    }
+    let dof = bins - 1;
+    let components = components(table.0, table.1, columns);
+    let p_value = match &components {
+        Some(c) => c.p_value,
+        None => statrs::function::gamma::checked_gamma_ur(0.5 * dof as f64, 0.5 * statistic)
+            .unwrap_or(f64::NAN),
+    };
+    let verdict = if p_value >= alpha {
+        Verdict::Pass
+    } else {
+        Verdict::Fail
+    };
+    Ok(PearsonTest {
+        statistic,
+        dof,
+        pooled_cells,
+        components,
+        p_value,
+        verdict,
+    })
 }
 
 /// The sanity failures, in order: samples outside the domain, invalid or off mass, samples in

@@ -56,7 +56,7 @@ use crate::tolerance::CELL_RELATIVE_TOLERANCE;
 use binning::scalar_batch;
 pub use cells::Layout;
 use judge::judge;
-pub(crate) use judge::pooled_statistic;
+pub(crate) use judge::{pearson_test, pooled_statistic};
 use mfh_reference::geometry::Vec3;
 use mfh_reference::NormalSampler;
 use std::time::Instant;
