@@ -61,7 +61,9 @@ impl SweepPoint {
     }
 }
 
-/// The incidences of one side: near normal (tan θi = t/`alpha` over [`stretched_tilts`]),
+/// The incidences of one side: near normal (tan θi = t/`alpha` over [`stretched_tilts`], those
+/// not beyond the grazing ones, cos θi ≥ 0.01: at α 1e-7 the stretched tilts 1e-6 … 1e-1 are
+/// cos θi 0.1 … 1e-6, where the sampler is in its grazing regime, not its near-normal one),
 /// oblique, grazing, around `critical` (θc ± [`CRITICAL_OFFSETS`]) when the side has a critical
 /// angle, and [`DRAWN`] drawn from `seed` (θi uniform in cos θ ∈ (0.01, 1), φ uniform), sorted
 /// by θi.
@@ -73,6 +75,7 @@ pub fn sweep(alpha: f64, critical: Option<f64>, seed: Option<u64>) -> Vec<SweepP
             phi: PHI,
             regime: "near_normal",
         })
+        .filter(|p| p.theta.cos() >= GRAZING_COSINES[2])
         .collect();
     for theta in OBLIQUE_THETAS {
         out.push(SweepPoint {
@@ -508,6 +511,11 @@ mod tests {
         // Drawn per seed: another seed, other incidences; the same seed, the same.
         assert_eq!(s, sweep(0.05, None, Some(7)));
         assert_ne!(s, sweep(0.05, None, Some(8)));
+        // At α 1e-7 the stretched tilts below 1e-5 only (tan θi < 100): cos θi ≥ 0.01.
+        let tiny = sweep(1e-7, None, None);
+        let near: Vec<_> = tiny.iter().filter(|p| p.regime == "near_normal").collect();
+        assert_eq!(near.len(), 4, "{near:?}");
+        assert!(tiny.iter().all(|p| p.theta.cos() >= 0.01 - 1e-15));
     }
 
     #[test]

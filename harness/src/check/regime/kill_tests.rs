@@ -130,9 +130,23 @@ fn total_internal_reflection_decided_early_fails_around_the_critical_angle() {
             .find(|r| r.case["side"] == "inside")
             .expect("an inside record");
         assert!(inside.verdict.is_failure(), "seed {seed}: {}", show(inside));
-        let region = inside.region.as_ref().expect("a region");
-        // The failing incidences lie around the critical angle asin(1/1.5) = 0.7297.
-        assert!(region.from < 0.7297 && region.to > 0.72, "{}", region.text);
+        assert!(inside.region.is_some(), "a region");
+        // Most incidences around the critical angle asin(1/1.5) = 0.7297 fail (others may
+        // too: microfacets tilted past θc − 1e-3 from wi exist at every incidence at α 0.3,
+        // and the region reported is the worst one's).
+        let Some(crate::record::RecordData::Curve { x, y, .. }) = &inside.data else {
+            panic!("a curve of the error against θi: {}", show(inside));
+        };
+        let near: Vec<f64> = x
+            .iter()
+            .zip(y)
+            .filter(|(t, _)| (**t - 0.7297).abs() < 0.01)
+            .map(|(_, e)| *e)
+            .collect();
+        assert!(
+            near.iter().filter(|e| **e > 1e-3).count() * 2 > near.len(),
+            "seed {seed}: around θc {near:?}"
+        );
         // The chi-square ran where the Jacobian disagreed; its p-value is recorded.
         let chi2 = &inside.case["chi2_at_worst"];
         println!("seed {seed}: chi-square at the worst incidence {chi2}");
