@@ -169,11 +169,20 @@ pub fn plan<'a>(
                 // The cubature's G7/K15 bound under-states its error where a lobe far
                 // narrower than its cells meets their edges: it is cross-checked by a second
                 // cubature on other cells, and A's error is allowed max(b_A, |A − B| + b_B)
-                // ([`cross_checked_allowance`]; before, max(b_A, 2 × the target asked), which
-                // nothing proved).
+                // ([`cross_checked_allowance`]), past ALBEDO_CERTIFIED_BOUND an error record.
+                // Below 2 × the target asked (`albedo_target`: 2e-5 at 10⁶ samples) the check
+                // does not judge: an error common to both layouts stays there (measured
+                // 2026-12-06: Beckmann α 1e-7 at η 0.999, θi 0.9, both 1.0020034303 ± 1.3e-7
+                // where Fresnel's law gives 1.0020030022 and the mean weight 1.002002998 ±
+                // 3.5e-9; GGX 0.3 at η 1.00005, cos θi 0.05, both 0.5830581 ± 1.1e-6 against
+                // a mean weight of 0.5830906 ± 5.4e-6, 3.2e-5 apart, untraced). That floor is
+                // the check's stated resolution, validated against Monte Carlo over the
+                // accepted domain (`oracle/sphere_mass_tests.rs`) and at its corners, not a
+                // proven bound.
                 let (second_upper, second_lower) = cross.get(bsdf, wi, n);
                 let second_total = sum(&second_upper, &second_lower);
-                let allowance = allowance(&quad, &second_total);
+                let cross_checked = allowance(&quad, &second_total);
+                let allowance = cross_checked.max(2.0 * albedo_target(n));
                 let deviation = ((mean - quad.value).abs() - allowance - rounding).max(0.0);
                 // The standard error of the mean weight is at least that of weights all equal
                 // to ∫ eval / P drawn with the success probability P = ∫ pdf: without it, a
@@ -214,6 +223,7 @@ pub fn plan<'a>(
                     case.insert("standard_error".into(), json!(se));
                     case.insert("rounding_allowance".into(), json!(rounding));
                     case.insert("cubature_allowance".into(), json!(allowance));
+                    case.insert("cross_checked_allowance".into(), json!(cross_checked));
                     case.insert(
                         "cross_check".into(),
                         json!({
@@ -247,7 +257,7 @@ pub fn plan<'a>(
                 } else {
                     Verdict::Fail
                 };
-                if let Some(e) = uncertified(allowance, &quad, &second_total) {
+                if let Some(e) = uncertified(cross_checked, &quad, &second_total) {
                     r.verdict = e;
                 }
                 Ok(())
