@@ -10,10 +10,21 @@
 //! `reference/src/bsdf/tests.rs` and the reference's ci audits establish. Each mass must lie
 //! within its bound plus 5 standard errors of the Monte Carlo estimate (5σ: a false alarm
 //! once in 1.7 million comparisons), or the oracle must decline to certify it (a bound or
-//! noncentrality past what the checks accept: an `error` record, never a verdict).
+//! noncentrality past what the checks accept: an `error` record, never a verdict). ∫ eval is
+//! held to the allowance `bsdf.albedo` gives it (its bound, or its disagreement with the
+//! second cubature on other cells: [`cross_checked_allowance`], and at least the check's
+//! resolution of 2 × its target), not to its bound alone.
+//!
+//! A lobe the cubature misses altogether holds little mass where the reference's ci audit
+//! meets it (1.3e-5 of the samples of the anisotropic GGX α 1e-6 × 1e-4 at η 1.0001, beyond
+//! the critical angle from inside): 2.6 samples of 2·10⁵, far inside 5 standard errors of the
+//! fraction, which is why this test passed while that mass was 1e-13. So the count in each
+//! hemisphere is also held to the oracle's mass plus its bound by the Poisson tail
+//! (Chernoff: P(X ≥ k) ≤ e^{−λ}(eλ/k)^k), refused below 1e-9; and the incidences include the
+//! audit's beyond the critical angle from the denser side, with that corner pinned.
 
 use super::*;
-use crate::check::bsdf::{eval_at, fold_samples, pdf_at, ALBEDO_CERTIFIED_BOUND};
+use crate::check::bsdf::{albedo_target, eval_at, fold_samples, pdf_at, ALBEDO_CERTIFIED_BOUND};
 use crate::oracle::lobe_centres::lobe_centres;
 use crate::random::Stream;
 use mfh_reference::bsdf::BsdfSpec;
@@ -84,16 +95,15 @@ fn draw_case(rng: &mut Stream) -> Case {
         "normals"
     };
     let dielectric = rng.uniform() < 0.7;
+    let eta = if dielectric { draw_eta(rng) } else { 1.0 };
     let spec = if dielectric {
-        format!(
-            r#"{{"bsdf":"dielectric","eta":{},"ndf":{ndf},"sampling":"{sampling}"}}"#,
-            draw_eta(rng)
-        )
+        format!(r#"{{"bsdf":"dielectric","eta":{eta},"ndf":{ndf},"sampling":"{sampling}"}}"#)
     } else {
         format!(r#"{{"bsdf":"conductor","n":0.2,"k":3.0,"ndf":{ndf},"sampling":"{sampling}"}}"#)
     };
     // The audit's polar angles (normal, 0.9 rad, grazing) and any between, at an azimuth off
-    // the survey's; from inside for a third of the dielectrics.
+    // the survey's; from inside for a third of the dielectrics; and the audit's incidence
+    // beyond the critical angle, from the denser side, for a sixth of them.
     let theta = match (rng.uniform() * 4.0) as u32 {
         0 => (1.0f64 - 5e-7).acos(),
         1 => 0.9,
@@ -102,11 +112,47 @@ fn draw_case(rng: &mut Stream) -> Case {
     };
     let phi = rng.uniform() * std::f64::consts::TAU;
     let inside = dielectric && rng.uniform() < 0.35;
+    if dielectric && rng.uniform() < 0.2 {
+        return beyond_critical(spec, eta, phi);
+    }
     let (s, c) = theta.sin_cos();
     Case {
         spec,
         wi: [s * phi.cos(), s * phi.sin(), if inside { -c } else { c }],
     }
+}
+
+/// The audit's incidence beyond the critical angle (`check::bsdf::incidences`): θc plus a
+/// third of what is left to grazing, from the denser side, at azimuth `phi`.
+fn beyond_critical(spec: String, eta: f64, phi: f64) -> Case {
+    let critical = eta.min(1.0 / eta).asin();
+    let theta = critical + (std::f64::consts::FRAC_PI_2 - critical) / 3.0;
+    let (s, c) = theta.sin_cos();
+    Case {
+        spec,
+        wi: [s * phi.cos(), s * phi.sin(), if eta > 1.0 { -c } else { c }],
+    }
+}
+
+/// The corners where an oracle was found wrong, checked first (with 10⁶ samples): the
+/// anisotropic GGX of η 1.0001 beyond the critical angle from inside (a transmission lobe
+/// 1e-4 wide whose mass the cubature put at 1e-13 for 1.3e-5).
+fn pinned() -> Vec<Case> {
+    vec![beyond_critical(
+        r#"{"bsdf":"dielectric","eta":1.0001,"ndf":{"family":"ggx","alpha_x":1e-6,"alpha_y":1e-4}}"#
+            .into(),
+        1.0001,
+        0.3,
+    )]
+}
+
+/// A Chernoff bound on the chance of `k` or more events of a Poisson (or binomial) count of
+/// mean `lambda`: e^{−λ}(eλ/k)^k for k > λ, else 1.
+fn poisson_tail(k: f64, lambda: f64) -> f64 {
+    if k <= lambda {
+        return 1.0;
+    }
+    (-lambda + k * (1.0 + lambda.ln() - k.ln())).exp()
 }
 
 /// Monte Carlo per hemisphere (upper, lower): the fraction of samples there and the mean
@@ -153,12 +199,20 @@ fn monte_carlo(bsdf: &dyn mfh_reference::bsdf::Bsdf, wi: Vec3, n: u64) -> [[(f64
 #[test]
 fn sphere_masses_hold_their_bounds_over_the_accepted_domain() {
     let cases: u64 = if cfg!(mfh_extensive) { 200 } else { 24 };
-    let n = 200_000;
+    // Samples a case; the pinned ones 10⁶ (a missed lobe of mass 1.3e-5 shows as 13 samples).
+    let drawn_samples = 200_000;
     let mut rng = Stream::new(2026, 40);
     let (mut certified, mut declined, mut refused) = (0, 0, 0);
     let mut wrong = Vec::new();
-    for i in 0..cases {
-        let case = draw_case(&mut rng);
+    let pinned = pinned();
+    for i in 0..cases + pinned.len() as u64 {
+        let case = match pinned.get(i as usize) {
+            Some(c) => Case {
+                spec: c.spec.clone(),
+                wi: c.wi,
+            },
+            None => draw_case(&mut rng),
+        };
         let spec: BsdfSpec = serde_json::from_str(&case.spec).unwrap();
         let bsdf = match spec.build() {
             Ok(b) => b,
@@ -173,26 +227,46 @@ fn sphere_masses_hold_their_bounds_over_the_accepted_domain() {
         let wi = case.wi;
         let centres = lobe_centres(wi, bsdf.eta());
         let masses = chi2_masses_about(&pdf_at(bsdf.as_ref(), wi), 16, 1_000_000, &centres);
+        // ∫ eval as `bsdf.albedo` and `bsdf.energy` take it: on the 16-row grid, cross-checked
+        // on the other cells, each hemisphere allowed what `cross_checked_allowance` gives.
+        let eval = eval_at(bsdf.as_ref(), wi);
+        let target = albedo_target(1_000_000);
         let grid = HemisphereGrid::new(16).unwrap();
-        let albedo = expected_sphere_about(
-            &eval_at(bsdf.as_ref(), wi),
-            grid,
-            crate::check::bsdf::albedo_target(1_000_000),
-            &centres,
-        );
+        let albedo = expected_sphere_about(&eval, grid, target, &centres);
+        let second = cross_check_sphere(&eval, target, &centres);
+        let allowed = |a: &Expected, b: &Expected| {
+            cross_checked_allowance((a.total, a.error_bound), (b.total, b.error_bound))
+        };
+        // What `bsdf.albedo` judges by: the cross-checked allowance, at least its resolution
+        // (2 × the target, which is validated here, not proven).
+        let judged = |a: f64| a.max(2.0 * target);
+        let allowance = (allowed(&albedo.0, &second.0), allowed(&albedo.1, &second.1));
+        let n = if (i as usize) < pinned.len() {
+            1_000_000
+        } else {
+            drawn_samples
+        };
         let mc = monte_carlo(bsdf.as_ref(), wi, n);
         let lambda = sphere_noncentrality(&masses.upper, &masses.lower, 1_000_000);
-        let bounds_ok = lambda <= MASS_NONCENTRALITY
-            && albedo.0.error_bound + albedo.1.error_bound <= ALBEDO_CERTIFIED_BOUND;
+        let bounds_ok =
+            lambda <= MASS_NONCENTRALITY && allowance.0 + allowance.1 <= ALBEDO_CERTIFIED_BOUND;
         if !bounds_ok {
             declined += 1;
             eprintln!("{i}: declined (λ {lambda:.3e}) {} wi {wi:?}", case.spec);
             continue;
         }
         certified += 1;
-        for (side, (mass, albedo), [(p, p_se), (w, w_se)]) in [
-            ("upper", (&masses.upper, &albedo.0), mc[0]),
-            ("lower", (&masses.lower, &albedo.1), mc[1]),
+        for (side, (mass, albedo, allowance), [(p, p_se), (w, w_se)]) in [
+            (
+                "upper",
+                (&masses.upper, &albedo.0, judged(allowance.0)),
+                mc[0],
+            ),
+            (
+                "lower",
+                (&masses.lower, &albedo.1, judged(allowance.1)),
+                mc[1],
+            ),
         ] {
             let slack = mass.error_bound + 5.0 * p_se + 1e-12;
             if (mass.total - p).abs() > slack {
@@ -201,10 +275,22 @@ fn sphere_masses_hold_their_bounds_over_the_accepted_domain() {
                     mass.total, mass.error_bound, case.spec
                 ));
             }
-            let slack = albedo.error_bound + 5.0 * w_se + 1e-12 + 1e-12 * w.abs();
+            // Samples where the oracle holds (almost) no mass: a lobe it missed.
+            let count = (p * n as f64).round();
+            let most = (mass.total + mass.error_bound).max(0.0) * n as f64;
+            let chance = poisson_tail(count, most);
+            if chance < 1e-9 {
+                wrong.push(format!(
+                    "{i} {side} {count} samples of {n} against a mass of {:.3e} ± {:.1e} \
+                     (chance ≤ {chance:.1e}): {} wi {wi:?}",
+                    mass.total, mass.error_bound, case.spec
+                ));
+            }
+            let slack = allowance + 5.0 * w_se + 1e-12 + 1e-12 * w.abs();
             if (albedo.total - w).abs() > slack {
                 wrong.push(format!(
-                    "{i} {side} albedo {:.6e} ± {:.1e} vs Monte Carlo {w:.6e} ± {w_se:.1e}: {} wi {wi:?}",
+                    "{i} {side} albedo {:.6e} (allowed {allowance:.1e}; bound {:.1e}) vs Monte \
+                     Carlo {w:.6e} ± {w_se:.1e}: {} wi {wi:?}",
                     albedo.total, albedo.error_bound, case.spec
                 ));
             }

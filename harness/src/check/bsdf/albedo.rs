@@ -9,16 +9,66 @@
 //! every incidence: the transmitted part of a radiance BSDF is converted ([`importance_factor`]).
 
 use super::{
-    albedo_target, fold_samples, BsdfSubject, Incidence, Integrals, ALBEDO_CERTIFIED_BOUND, SOURCE,
+    albedo_target, eval_at, fold_samples, BsdfSubject, Incidence, Integrals,
+    ALBEDO_CERTIFIED_BOUND, SOURCE,
 };
 use crate::check::{applied, covers, Check, PlannedCheck, Profile};
+use crate::oracle::chi2::Expected;
+use crate::oracle::lobe_centres::lobe_centres;
 use crate::oracle::monte_carlo::two_sided_p;
+use crate::oracle::sphere_chi2::{
+    cross_check_sphere, cross_checked_allowance, CROSS_CHECK_RESOLUTION,
+};
+use crate::oracle::Estimate;
 use crate::record::{Measured, OracleValue, Verdict};
 use crate::tolerance::{BSDF_ENERGY, STATISTICAL_ALPHA};
 use mfh_reference::bsdf::Bsdf;
 use mfh_reference::geometry::Vec3;
 use serde_json::{json, Value};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
+
+/// ∫ eval dωo at one incidence a second time, on other cells ([`cross_check_sphere`]), shared
+/// by `bsdf.albedo` and `bsdf.energy` (computed by whichever runs first, billed to
+/// `bsdf.albedo` as [`Integrals`] bills its integrals).
+#[derive(Default)]
+struct CrossCheck(OnceLock<(Estimate, Estimate)>);
+
+impl CrossCheck {
+    /// (upper, lower) hemispheres' second estimates at `wi`, to the target of `samples`.
+    fn get(&self, bsdf: &dyn Bsdf, wi: Vec3, samples: u64) -> (Estimate, Estimate) {
+        *self.0.get_or_init(|| {
+            let (u, l) = cross_check_sphere(
+                &eval_at(bsdf, wi),
+                albedo_target(samples),
+                &lobe_centres(wi, bsdf.eta()),
+            );
+            (estimate(&u), estimate(&l))
+        })
+    }
+}
+
+/// One hemisphere's integral as an estimate.
+fn estimate(e: &Expected) -> Estimate {
+    Estimate {
+        value: e.total,
+        error_bound: e.error_bound,
+        evaluations: e.evaluations,
+    }
+}
+
+/// Two hemispheres' integrals summed.
+fn sum(a: &Estimate, b: &Estimate) -> Estimate {
+    Estimate {
+        value: a.value + b.value,
+        error_bound: a.error_bound + b.error_bound,
+        evaluations: a.evaluations + b.evaluations,
+    }
+}
+
+/// The allowance of one integral `a` against its second estimate `b` ([`cross_checked_allowance`]).
+fn allowance(a: &Estimate, b: &Estimate) -> f64 {
+    cross_checked_allowance((a.value, a.error_bound), (b.value, b.error_bound))
+}
 
 /// Running sums of the sampled weights of one chunk.
 #[derive(Debug, Clone, Copy, Default)]
@@ -65,8 +115,10 @@ pub fn plan<'a>(
     let family = subject.family();
     let mut case = incidence.case();
     case["samples"] = json!(n);
+    let second = Arc::new(CrossCheck::default());
     let s = subject.clone();
     let integrals = shared.clone();
+    let cross = second.clone();
     let mut out = vec![
         Check::new("bsdf.albedo", subject.label.clone(), case, SOURCE)
             .why(format!(
@@ -114,13 +166,23 @@ pub fn plan<'a>(
                 // standard error shows (0 when the weights are all equal), so 64 ε of it are
                 // allowed (1.4e-14 relative in f64, 7.6e-6 in float32).
                 let rounding = 64.0 * s.precision.epsilon() * mean.abs();
-                // The cubature is trusted to its bound or to the accuracy it was asked for
-                // (`albedo_target` a hemisphere), whichever is larger: its bound is the
-                // G7/K15 difference, which under-states the error where a lobe far narrower
-                // than its cells meets their edges (the GGX 0.3 dielectric of η 1.00005 at
-                // normal incidence: ∫ eval 0.9998985 ± 1.6e-7 against a mean weight of
-                // 0.99989998 ± 6e-11, 1.5e-6 apart, within the 2e-5 asked).
-                let allowance = quad.error_bound.max(2.0 * albedo_target(n));
+                // The cubature's G7/K15 bound under-states its error where a lobe far
+                // narrower than its cells meets their edges: it is cross-checked by a second
+                // cubature on other cells, and A's error is allowed max(b_A, |A − B| + b_B)
+                // ([`cross_checked_allowance`]), past ALBEDO_CERTIFIED_BOUND an error record.
+                // Below 2 × the target asked (`albedo_target`: 2e-5 at 10⁶ samples) the check
+                // does not judge: an error common to both layouts stays there (measured
+                // 2026-12-06: Beckmann α 1e-7 at η 0.999, θi 0.9, both 1.0020034303 ± 1.3e-7
+                // where Fresnel's law gives 1.0020030022 and the mean weight 1.002002998 ±
+                // 3.5e-9; GGX 0.3 at η 1.00005, cos θi 0.05, both 0.5830581 ± 1.1e-6 against
+                // a mean weight of 0.5830906 ± 5.4e-6, 3.2e-5 apart, untraced). That floor is
+                // the check's stated resolution, validated against Monte Carlo over the
+                // accepted domain (`oracle/sphere_mass_tests.rs`) and at its corners, not a
+                // proven bound.
+                let (second_upper, second_lower) = cross.get(bsdf, wi, n);
+                let second_total = sum(&second_upper, &second_lower);
+                let cross_checked = allowance(&quad, &second_total);
+                let allowance = cross_checked.max(2.0 * albedo_target(n));
                 let deviation = ((mean - quad.value).abs() - allowance - rounding).max(0.0);
                 // The standard error of the mean weight is at least that of weights all equal
                 // to ∫ eval / P drawn with the success probability P = ∫ pdf: without it, a
@@ -142,7 +204,7 @@ pub fn plan<'a>(
                 };
                 let p = two_sided_p(z);
                 r.cost.samples = n;
-                r.cost.evaluations += quad.evaluations;
+                r.cost.evaluations += quad.evaluations + second_total.evaluations;
                 r.value = Some(mean);
                 r.oracle = Some(OracleValue {
                     value: quad.value,
@@ -161,6 +223,15 @@ pub fn plan<'a>(
                     case.insert("standard_error".into(), json!(se));
                     case.insert("rounding_allowance".into(), json!(rounding));
                     case.insert("cubature_allowance".into(), json!(allowance));
+                    case.insert("cross_checked_allowance".into(), json!(cross_checked));
+                    case.insert(
+                        "cross_check".into(),
+                        json!({
+                            "albedo": second_total.value,
+                            "error_bound": second_total.error_bound,
+                            "resolution": CROSS_CHECK_RESOLUTION,
+                        }),
+                    );
                     case.insert("standard_error_floor".into(), json!(floor));
                     for (name, quad, mean, se) in [
                         ("reflection", reflected, r_mean, r_se),
@@ -186,7 +257,7 @@ pub fn plan<'a>(
                 } else {
                     Verdict::Fail
                 };
-                if let Some(e) = uncertified(quad.error_bound) {
+                if let Some(e) = uncertified(cross_checked, &quad, &second_total) {
                     r.verdict = e;
                 }
                 Ok(())
@@ -213,9 +284,18 @@ pub fn plan<'a>(
             } else {
                 (lower, upper)
             };
+            // Each hemisphere's integral cross-checked on other cells (as in `bsdf.albedo`).
+            let (second_upper, second_lower) = second.get(bsdf, wi, n);
+            let (second_reflected, second_transmitted) = if wi[2] > 0.0 {
+                (second_upper, second_lower)
+            } else {
+                (second_lower, second_upper)
+            };
+            let reflected_allowance = allowance(&reflected, &second_reflected);
+            let transmitted_allowance = allowance(&transmitted, &second_transmitted);
             let to_importance = importance_factor(bsdf, wi);
             let value = reflected.value + to_importance * transmitted.value;
-            let bound = reflected.error_bound + to_importance * transmitted.error_bound;
+            let bound = reflected_allowance + to_importance * transmitted_allowance;
             r.value = Some(value);
             r.oracle = Some(OracleValue {
                 value: 1.0,
@@ -238,7 +318,11 @@ pub fn plan<'a>(
             } else {
                 Verdict::Fail
             };
-            if let Some(e) = uncertified(reflected.error_bound + transmitted.error_bound) {
+            if let Some(e) = uncertified(
+                reflected_allowance + transmitted_allowance,
+                &sum(&reflected, &transmitted),
+                &sum(&second_upper, &second_lower),
+            ) {
                 r.verdict = e;
             }
             Ok(())
@@ -247,13 +331,16 @@ pub fn plan<'a>(
     out
 }
 
-/// The error record of an ∫ eval whose summed bound exceeds [`ALBEDO_CERTIFIED_BOUND`] (or is
-/// not a number): the oracle cannot certify a verdict with it.
-fn uncertified(bound: f64) -> Option<Verdict> {
-    (!(bound <= ALBEDO_CERTIFIED_BOUND)).then(|| Verdict::Error {
+/// The error record of an ∫ eval whose allowance (its bound, or its disagreement with the
+/// second cubature `second`: [`cross_checked_allowance`]) exceeds [`ALBEDO_CERTIFIED_BOUND`]
+/// (or is not a number): the oracle cannot certify a verdict with it.
+fn uncertified(allowance: f64, quad: &Estimate, second: &Estimate) -> Option<Verdict> {
+    (!(allowance <= ALBEDO_CERTIFIED_BOUND)).then(|| Verdict::Error {
         message: format!(
-            "∫ eval dωo unresolved within the cubature's budget: its error bound {bound:.3e} \
-             exceeds {ALBEDO_CERTIFIED_BOUND:.0e}"
+            "∫ eval dωo not certified: {:.9} ± {:.1e} on the 16-row cells against {:.9} ± \
+             {:.1e} on the {CROSS_CHECK_RESOLUTION}-row cells, an allowance of {allowance:.3e} \
+             beyond {ALBEDO_CERTIFIED_BOUND:.0e}",
+            quad.value, quad.error_bound, second.value, second.error_bound
         ),
     })
 }

@@ -23,11 +23,12 @@ fn not_passed(records: &[CheckRecord]) -> Vec<String> {
 
 /// The corners of the reference's accepted domain, one ci audit each: η at 0.1, 10 and within
 /// the transmission-width limit of 1 (`TRANSMISSION_WIDTH_MIN`), α at 1e-7 and 1e4, the
-/// anisotropy limit (100), both samplings, conductors and dielectrics. Not yet passing, so not
-/// listed: the anisotropic GGX (α 1e-6 × 1e-4) at η 1.0001 fails `bsdf.chi2` beyond the
-/// critical angle (cos θi 0.0094 from inside: statistic 12.5 on 15 dof, smooth-component
-/// p 0), which is not yet traced to the oracle or the sampler.
-const CORNERS: [&str; 8] = [
+/// anisotropy limit (100), both samplings, conductors and dielectrics; and the anisotropic GGX
+/// (α 1e-6 × 1e-4) at η 1.0001, whose transmission lobe beyond the critical angle (cos θi
+/// 0.0094 from inside: 1.3e-5 of the samples, about 1e-4 wide) the oracle missed before the
+/// centres beyond the critical angle (`lobe_centres`: mass 1e-13, 17 samples in a cell
+/// expecting 1e-7, smooth-component p 0).
+const CORNERS: [&str; 9] = [
     r#"{"bsdf":"dielectric","eta":1.00005,"ndf":{"family":"ggx","alpha":0.3}}"#,
     r#"{"bsdf":"dielectric","eta":0.999,"ndf":{"family":"beckmann","alpha":1e-7},"sampling":"normals"}"#,
     r#"{"bsdf":"dielectric","eta":10,"ndf":{"family":"ggx","alpha":1e-7}}"#,
@@ -36,6 +37,7 @@ const CORNERS: [&str; 8] = [
     r#"{"bsdf":"conductor","n":0.2,"k":3.0,"ndf":{"family":"beckmann","alpha":1e-4}}"#,
     r#"{"bsdf":"conductor","n":0.2,"k":3.0,"ndf":{"family":"ggx","alpha":1e-7}}"#,
     r#"{"bsdf":"conductor","n":0.2,"k":3.0,"ndf":{"family":"beckmann","alpha_x":1e4,"alpha_y":100},"sampling":"normals"}"#,
+    r#"{"bsdf":"dielectric","eta":1.0001,"ndf":{"family":"ggx","alpha_x":1e-6,"alpha_y":1e-4}}"#,
 ];
 
 /// Beyond the domain: an anisotropy of 10¹¹, which the oracle could not certify, is refused
@@ -73,11 +75,22 @@ fn an_anisotropy_beyond_the_limit_is_refused_by_name() {
 /// listed check that passes fails too, so that the exemption is removed when the check is fixed.
 const JACOBIAN_OPEN: [(usize, f64); 2] = [(3, 1e-4), (4, 1e-4)];
 
+/// As [`JACOBIAN_OPEN`], for the corner added with the lobe centres beyond the critical angle
+/// (kept apart so that the list above is edited in one place): the anisotropic GGX of η 1.0001
+/// fails `bsdf.jacobian` by 2.8e-4 relative from outside at θi 1.505 and 1.5e-5 from inside at
+/// θi 1.556 (measured 2026-12-06), where `bsdf.chi2` passes (p 0.23 and 0.60 with the lobe
+/// centres; the record's `chi2_at_worst`, integrated without them, misses the mirror lobe).
+const JACOBIAN_OPEN_BEYOND_CRITICAL: [(usize, f64); 1] = [(8, 1e-3)];
+
 /// One test a corner, so that nextest spreads them over the cores.
 fn corner_passes(i: usize) {
     let b = build(CORNERS[i]);
     let report = Audit::of_bsdf(&b).profile(Profile::Ci).run();
-    let open = JACOBIAN_OPEN.iter().find(|(c, _)| *c == i).map(|(_, b)| *b);
+    let open = JACOBIAN_OPEN
+        .iter()
+        .chain(&JACOBIAN_OPEN_BEYOND_CRITICAL)
+        .find(|(c, _)| *c == i)
+        .map(|(_, b)| *b);
     let (jacobian, others): (Vec<_>, Vec<_>) = report
         .records
         .iter()
@@ -126,6 +139,7 @@ corners! {
     corner_conductor_beckmann_1e_4: 5,
     corner_conductor_ggx_1e_7: 6,
     corner_conductor_beckmann_1e4_100_normals: 7,
+    corner_eta_1_0001_anisotropic_1e_6_1e_4: 8,
 }
 
 /// The reference that silently fails `loss` of its samples (those whose u₀ has its 7th–16th
