@@ -275,7 +275,8 @@ pub fn calibrate_bsdf(
     progress: Option<super::Progress<'_>>,
 ) -> Result<Vec<TestCalibration>, String> {
     use crate::check::bsdf::{incidences, pdf_at};
-    use crate::oracle::sphere_chi2::{chi2_masses, sphere_chi2_against};
+    use crate::oracle::lobe_centres::lobe_centres;
+    use crate::oracle::sphere_chi2::{chi2_masses_about, sphere_chi2_against};
     let spec: mfh_reference::bsdf::BsdfSpec =
         serde_json::from_str(BSDF_MODEL).map_err(|e| format!("calibration BSDF: {e}"))?;
     let bsdf = spec.build().map_err(|e| format!("calibration BSDF: {e}"))?;
@@ -288,7 +289,12 @@ pub fn calibrate_bsdf(
         .filter(|i| matches!(i.name, "oblique" | "total_internal_reflection"))
     {
         let t = Instant::now();
-        let expected = chi2_masses(&pdf_at(bsdf.as_ref(), inc.wi), resolution, samples);
+        let expected = chi2_masses_about(
+            &pdf_at(bsdf.as_ref(), inc.wi),
+            resolution,
+            samples,
+            &lobe_centres(inc.wi, bsdf.eta()),
+        );
         let p: Vec<Option<f64>> = (0..runs)
             .into_par_iter()
             .map(|i| {
