@@ -14,7 +14,7 @@
 //! ```
 
 pub mod capabilities;
-pub mod precision_probe;
+mod precision_probe;
 
 use crate::check::{self, against, PlannedCheck, Profile};
 use crate::plan::{plan_model, Effects};

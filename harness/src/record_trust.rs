@@ -34,7 +34,8 @@ impl Identity {
     }
 
     /// The line the plan fingerprint and the plan key hash: `check|model|case`, the model and
-    /// case as compact JSON.
+    /// case as compact JSON. (Only shards use it, and they are the CLI's.)
+    #[cfg_attr(not(feature = "cli"), allow(dead_code))]
     pub fn line(&self) -> String {
         format!("{}|{}|{}", self.check, self.model, self.case)
     }

@@ -353,9 +353,9 @@ pub fn check_seed(seed: u64, planned: &PlannedCheck<'_>) -> u64 {
     )
 }
 
-/// Runs a plan: every check in parallel (with `MFH_TRACE` set, each start and end is printed
-/// to standard error with its time), records in plan order, statistical verdicts at the
-/// Šidák-corrected level.
+/// Runs a plan: every check in parallel, records in plan order, statistical verdicts at the
+/// Šidák-corrected level. Prints nothing: each check's start and finish go to
+/// `options.control.on_check` (the CLI prints them under `MFH_TRACE`).
 ///
 /// Scheduling: the checks are started longest first by [`crate::estimate::estimated_cost`]
 /// (ties in plan order), each thread taking the next from one queue, so that a long check does
@@ -373,7 +373,6 @@ pub fn run_plan(
     let start = Instant::now();
     let control = &options.control;
     let deadline = control.max_time.map(|limit| start + limit);
-    let trace = std::env::var_os("MFH_TRACE").is_some();
     let record_budget = control
         .record_budget
         .unwrap_or_else(|| budget::record_budget(options.profile));
@@ -421,9 +420,6 @@ pub fn run_plan(
     order.sort_by(|&a, &b| costs[b].total_cmp(&costs[a]));
     let next = AtomicUsize::new(0);
     let run_one = |index: usize, p: &PlannedCheck<'_>| {
-        if trace {
-            eprintln!("start {} {} {}", p.check, p.model, p.case);
-        }
         if let Some(f) = &control.on_check {
             (f.0)(CheckEvent::Started { index, planned: p });
         }
@@ -462,16 +458,6 @@ pub fn run_plan(
             r.covers = p.covers.clone();
         }
         crate::record_trust::keep_planned_case(&mut r.case, &p.case);
-        if trace {
-            eprintln!(
-                "done {:.3}s {} {} {} {}",
-                r.cost.wall_seconds,
-                r.verdict.name(),
-                p.check,
-                p.model,
-                p.case
-            );
-        }
         if let Some(f) = &control.on_check {
             (f.0)(CheckEvent::Finished {
                 index,

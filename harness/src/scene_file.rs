@@ -8,7 +8,7 @@ use std::path::Path;
 impl Scene {
     /// Reads a scene file of at most [`MAX_SCENE_BYTES`] (read bounded: a larger file or an
     /// endless stream is refused after the limit): `.xml` is a Mitsuba 3 scene
-    /// ([`crate::mitsuba`]), anything else mfh's JSON.
+    /// (`mitsuba.rs`, feature `mitsuba`), anything else mfh's JSON.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         use std::io::Read;
         let unreadable = |e: std::io::Error| SceneError::Unreadable {

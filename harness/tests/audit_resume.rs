@@ -353,6 +353,48 @@ fn a_non_terminal_stderr_gets_progress_lines_unless_quiet() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `MFH_TRACE` makes the CLI print one `start` line as each check starts and one `done` line,
+/// with its time and verdict, as it ends (from the library's check events: the library itself
+/// prints nothing); without it, neither.
+#[test]
+fn mfh_trace_prints_each_check_start_and_end() {
+    let dir = temp("trace");
+    let scene = tiny_scene(&dir);
+    let out = dir.join("out");
+    let args = tiny_args(&scene, out.to_str().unwrap());
+    let (code, _, err) = mfh_env(&args, &[("MFH_TRACE", "1")]);
+    assert_eq!(code, 0, "{err}");
+    let records = read(&out.join("report.json"))["records"]
+        .as_array()
+        .expect("records")
+        .len();
+    let starts: Vec<&str> = err.lines().filter(|l| l.starts_with("start ")).collect();
+    let dones: Vec<&str> = err.lines().filter(|l| l.starts_with("done ")).collect();
+    assert!(records > 0);
+    assert_eq!((starts.len(), dones.len()), (records, records), "{err}");
+    for line in &dones {
+        // done 0.123s pass sampling.chi2 {model} {case}
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let seconds = words[1].strip_suffix('s').expect("seconds");
+        assert!(seconds.parse::<f64>().is_ok_and(|t| t >= 0.0), "{line}");
+        assert!(words[3].contains('.'), "a check id: {line}");
+        assert!(
+            starts
+                .iter()
+                .any(|s| s.starts_with(&format!("start {} ", words[3]))),
+            "{line}"
+        );
+    }
+    // Without it (when the test itself runs without it), no trace line.
+    if std::env::var_os("MFH_TRACE").is_none() {
+        let (code, _, err) = mfh(&args);
+        assert_eq!(code, 0, "{err}");
+        let traced = |l: &str| l.starts_with("start ") || l.starts_with("done ");
+        assert!(!err.lines().any(traced), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// The library's hook: `on_check` sees every check start and finish with its record, and those
 /// records given back as `resume` run nothing and give the same report.
 #[test]

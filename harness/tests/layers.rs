@@ -1,7 +1,8 @@
 //! The layering of ARCHITECTURE.md, enforced: data flows models → oracles → checks → records →
 //! sinks, and no module imports a layer above its own. Also: every module named here exists and
 //! every module has a layer; no circle of imports between top-level modules or between the
-//! sinks of `report/`; only the CLI knows clap; checks and oracles do no file I/O.
+//! sinks of `report/`; only the CLI knows clap; checks and oracles do no file I/O; only the CLI
+//! prints.
 //!
 //! Every non-test line of every file is read: comments, literals and `#[cfg(test)]` items are
 //! blanked by `tests/support/rust_source.rs`, nothing else; `use` groups are expanded.
@@ -214,6 +215,56 @@ fn no_module_imports_a_layer_above_its_own() {
     violations.sort();
     violations.dedup();
     assert!(violations.is_empty(), "{violations:#?}");
+}
+
+/// The printing a library must not do: the standard-stream macros and handles. Only the CLI
+/// (`cli/`, `main.rs`) writes to the terminal; the library tells it what happens through
+/// callbacks (`run::RunControl`, progress functions).
+const PRINTS: &[&str] = &[
+    "print!",
+    "println!",
+    "eprint!",
+    "eprintln!",
+    "dbg!",
+    "io::stdout",
+    "io::stderr",
+];
+
+/// Where `code` uses one of [`PRINTS`] as a whole token (`fingerprint!` would not count).
+fn prints(code: &str) -> Vec<&'static str> {
+    PRINTS
+        .iter()
+        .filter(|p| {
+            code.match_indices(*p).any(|(i, _)| {
+                !code[..i]
+                    .chars()
+                    .next_back()
+                    .is_some_and(|c| c.is_alphanumeric() || c == '_')
+            })
+        })
+        .copied()
+        .collect()
+}
+
+#[test]
+fn the_library_prints_nothing() {
+    let mut violations = Vec::new();
+    for file in &source_files() {
+        if matches!(module_of(file).as_str(), "cli" | "main") {
+            continue;
+        }
+        let text = code(&std::fs::read_to_string(file).expect("readable"));
+        for p in prints(&text) {
+            violations.push(format!(
+                "{}: `{p}` outside the CLI (the library prints nothing)",
+                file.display()
+            ));
+        }
+    }
+    assert!(violations.is_empty(), "{violations:#?}");
+    assert_eq!(prints("eprintln!(\"x\")"), ["eprintln!"]);
+    assert_eq!(prints("std::io::stderr()"), ["io::stderr"]);
+    assert!(prints("fingerprint!(x); my_dbg!(y)").is_empty());
 }
 
 #[test]

@@ -109,6 +109,7 @@ fn a_survivor_or_a_miss_fails_the_selftest() {
         seeds: SelftestOptions::seeds(1),
         subset: Subset::Ci,
         filter: None,
+        on_check: None,
     };
     let run = |killed: bool, hit: bool| KillRun {
         seed: options.seeds[0],

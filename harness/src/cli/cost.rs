@@ -88,7 +88,7 @@ pub fn run(args: CostArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> i3
     };
     let planned = crate::cost::planned(&options);
     let bar = Bar::new(planned as u64, "quantities", args.quiet);
-    let trace = std::env::var_os("MFH_TRACE").is_some();
+    let trace = super::trace::enabled();
     let mut last = std::time::Instant::now();
     let report = crate::cost::run(&options, &mut |done, _, name| {
         bar.update(done as u64, format!(", {name}"));

@@ -19,6 +19,7 @@ pub mod progress;
 pub mod selftest;
 pub mod signals;
 pub mod stream;
+pub mod trace;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::ffi::OsString;

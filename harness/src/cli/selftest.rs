@@ -85,6 +85,7 @@ pub fn run(args: SelftestArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -
             SubsetArg::All => Subset::All,
         },
         filter: args.only.clone(),
+        on_check: super::trace::events(),
     };
     if args.calibrate.is_none()
         && !args.power

@@ -2,8 +2,8 @@
 //! it: each finished record appended to `report.jsonl` in `--out` (`report::jsonl`), the
 //! progress lines of a non-terminal standard error (`progress::Lines`), `--resume DIR` (the
 //! records of an interrupted run taken instead of running their checks again) and
-//! `--max-time S` (no check started after S seconds). The library only sends events
-//! (`run::RunControl`); the files are written here and in the sinks.
+//! `--max-time S` (no check started after S seconds), and the `MFH_TRACE` lines (`trace`). The
+//! library only sends events (`run::RunControl`); the files are written here and in the sinks.
 
 use super::progress::Lines;
 use crate::record::Verdict;
@@ -121,35 +121,41 @@ pub fn prepare(
     let (s, l) = (sink.clone(), lines.clone());
     let distrusted = Arc::new(std::sync::Mutex::new(Vec::new()));
     let dist = distrusted.clone();
-    let on_check = CheckEventFn(Arc::new(move |event: CheckEvent<'_>| match event {
-        CheckEvent::Plan {
-            checks,
-            resumed,
-            distrusted,
-        } => {
-            if let Ok(mut d) = dist.lock() {
-                d.extend(distrusted.iter().cloned());
-            }
-            if let Some(l) = &l {
-                l.plan(checks, resumed);
-            }
+    let trace = super::trace::enabled();
+    let on_check = CheckEventFn(Arc::new(move |event: CheckEvent<'_>| {
+        if trace {
+            super::trace::print(&event);
         }
-        CheckEvent::Started { index, planned } => {
-            if let Some(l) = &l {
-                l.started(index, format!("{} {}", planned.check, planned.case));
+        match event {
+            CheckEvent::Plan {
+                checks,
+                resumed,
+                distrusted,
+            } => {
+                if let Ok(mut d) = dist.lock() {
+                    d.extend(distrusted.iter().cloned());
+                }
+                if let Some(l) = &l {
+                    l.plan(checks, resumed);
+                }
             }
-        }
-        CheckEvent::Finished {
-            index,
-            planned,
-            record,
-        } => {
-            // A record stopped by its budget is not kept: `--resume` runs its check again.
-            if !crate::check::budget::is_over_budget(&record.verdict) {
-                s.append(&crate::run::plan_key(planned), record);
+            CheckEvent::Started { index, planned } => {
+                if let Some(l) = &l {
+                    l.started(index, format!("{} {}", planned.check, planned.case));
+                }
             }
-            if let Some(l) = &l {
-                l.finished(index, record.verdict.is_failure());
+            CheckEvent::Finished {
+                index,
+                planned,
+                record,
+            } => {
+                // A record stopped by its budget is not kept: `--resume` runs its check again.
+                if !crate::check::budget::is_over_budget(&record.verdict) {
+                    s.append(&crate::run::plan_key(planned), record);
+                }
+                if let Some(l) = &l {
+                    l.finished(index, record.verdict.is_failure());
+                }
             }
         }
     }));

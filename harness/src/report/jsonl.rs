@@ -44,7 +44,7 @@ pub struct Header {
     pub profile: String,
     /// The audit seed.
     pub seed: u64,
-    /// The plan's fingerprint ([`crate::shard::fingerprint`]) and its number of checks, where
+    /// The plan's fingerprint (`shard::fingerprint`, the CLI's) and its number of checks, where
     /// the plan is known before the run (`mfh audit`; an external child's plan follows from its
     /// `describe` answer, and its records name the child's command, parameters and
     /// capabilities, so a record of a changed child matches no planned check and is not used).

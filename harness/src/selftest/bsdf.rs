@@ -79,6 +79,7 @@ pub fn run(
                 .name("control")
                 .profile(options.profile)
                 .seed(seed)
+                .control(options.control())
                 .run();
             controls.push(BsdfControl {
                 base: serde_json::to_value(base).unwrap_or(Value::Null),
@@ -99,6 +100,7 @@ pub fn run(
                     .name(defect.id())
                     .profile(options.profile)
                     .seed(seed)
+                    .control(options.control())
                     .run();
                 let run = kill_run(
                     &report.records,

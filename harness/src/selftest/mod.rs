@@ -30,7 +30,7 @@ use crate::audit::Audit;
 use crate::check::Profile;
 use crate::record::{CheckRecord, Verdict};
 use crate::run::DEFAULT_SEED;
-use crate::run::{run_plan, AuditOptions};
+use crate::run::{run_plan, AuditOptions, CheckEventFn, RunControl};
 use crate::subject::{spec_width, Hints};
 use catalog::{Entry, Route, CATALOG};
 use mfh_reference::family::FamilySpec;
@@ -65,9 +65,21 @@ pub struct SelftestOptions {
     pub subset: Subset,
     /// Only the mutants whose id contains this (None: all of the subset).
     pub filter: Option<String>,
+    /// Told of each check of the mutants' and controls' audits as it starts and finishes (the
+    /// CLI prints these under `MFH_TRACE`); None: nothing is told.
+    pub on_check: Option<CheckEventFn>,
 }
 
 impl SelftestOptions {
+    /// The run control of every audit of the self-test: its check events go to
+    /// [`SelftestOptions::on_check`].
+    fn control(&self) -> RunControl {
+        RunControl {
+            on_check: self.on_check.clone(),
+            ..Default::default()
+        }
+    }
+
     /// `n` seeds derived from the default audit seed: DEFAULT_SEED + i.
     pub fn seeds(n: usize) -> Vec<u64> {
         (0..n as u64)
@@ -279,7 +291,7 @@ fn sg_records(defect: mutant::Defect, profile: Profile) -> Vec<CheckRecord> {
         .collect()
 }
 
-/// Audits the model of `base` with `defect` by `route` at `seed`: the records.
+/// Audits the model of `base` with `defect` by `route` at `seed` under `control`: the records.
 fn audit(
     base: &str,
     defect: mutant::Defect,
@@ -287,6 +299,7 @@ fn audit(
     route: Route,
     profile: Profile,
     seed: u64,
+    control: RunControl,
 ) -> Result<Vec<CheckRecord>, String> {
     if route == Route::SgProduct {
         return Ok(sg_records(defect, profile));
@@ -303,6 +316,7 @@ fn audit(
                 .profile(profile)
                 .seed(seed)
                 .slope_moments(slope_moments)
+                .control(control)
                 .run()
                 .records
         }
@@ -318,6 +332,7 @@ fn audit(
                 profile,
                 seed,
                 out: None,
+                control,
                 ..Default::default()
             };
             run_plan(&plan, &options).0
@@ -403,18 +418,25 @@ pub fn run(options: &SelftestOptions, progress: Option<Progress<'_>>) -> Selftes
             _ => mutant::Defect::DScale { e: 0.0 },
         };
         for &seed in &options.seeds {
-            let (passed, failures) =
-                match audit(base, identity, "control", route, options.profile, seed) {
-                    Ok(records) => {
-                        let failures: Vec<String> = records
-                            .iter()
-                            .filter(|r| r.verdict.is_failure())
-                            .map(describe)
-                            .collect();
-                        (failures.is_empty() && !records.is_empty(), failures)
-                    }
-                    Err(e) => (false, vec![e]),
-                };
+            let (passed, failures) = match audit(
+                base,
+                identity,
+                "control",
+                route,
+                options.profile,
+                seed,
+                options.control(),
+            ) {
+                Ok(records) => {
+                    let failures: Vec<String> = records
+                        .iter()
+                        .filter(|r| r.verdict.is_failure())
+                        .map(describe)
+                        .collect();
+                    (failures.is_empty() && !records.is_empty(), failures)
+                }
+                Err(e) => (false, vec![e]),
+            };
             say(format!(
                 "control {base} seed {seed:#x}: {}",
                 if passed { "pass" } else { "FAIL" }
@@ -435,11 +457,18 @@ pub fn run(options: &SelftestOptions, progress: Option<Progress<'_>>) -> Selftes
             .iter()
             .map(|&seed| {
                 let t = Instant::now();
-                let (records, error) =
-                    match audit(e.base, e.defect, e.id, e.route, options.profile, seed) {
-                        Ok(r) => (r, None),
-                        Err(err) => (Vec::new(), Some(err)),
-                    };
+                let (records, error) = match audit(
+                    e.base,
+                    e.defect,
+                    e.id,
+                    e.route,
+                    options.profile,
+                    seed,
+                    options.control(),
+                ) {
+                    Ok(r) => (r, None),
+                    Err(err) => (Vec::new(), Some(err)),
+                };
                 let run = kill_run(&records, e.expected, seed, t.elapsed().as_secs_f64());
                 say(format!(
                     "{} seed {seed:#x}: {} by {:?} ({:.1} s){}",
