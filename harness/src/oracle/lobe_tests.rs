@@ -122,7 +122,7 @@ fn lobe_anisotropic_1_to_100() {
 #[test]
 fn lobe_off_axis_gaussian_slopes() {
     // Slopes N((0.5, −0.2), diag(0.01, 0.0004)): the mode of D cos θ is near tan θ = |s̄|,
-    // φ = atan2(0.2, −0.5) (the slope sign of seed 002 eq 11: m ∝ (−s̄x, −s̄y, 1)).
+    // φ = atan2(0.2, −0.5) (the slope sign of document 002 eq 11: m ∝ (−s̄x, −s̄y, 1)).
     let json = r#"{"family":"gaussian_slopes","mean":[0.5,-0.2],"cov":[[0.01,0.0],[0.0,0.0004]]}"#;
     let l = lobe_of(json);
     let m = model(json);

@@ -27,11 +27,11 @@
 //! 2πj/2R the same way. Either way the cell is a function of the direction alone, whatever the
 //! block, the thread or the dispatch path (tested).
 
-use crate::oracle::domain::{
-    accepted_squared_lengths, approximate_azimuth, finish_cells, CellFinder, DomainError,
+use crate::oracle::edge_table::EdgeTable;
+use crate::oracle::hemisphere_grid::{
+    accepted_squared_lengths, approximate_azimuth, finish_cells, CellFinder, DirectionError,
     HemisphereGrid, COLUMN_MARGIN, FIND_BLOCK, POLE_CLEARANCE, ROW_MARGIN,
 };
-use crate::oracle::edge_table::EdgeTable;
 use mfh_reference::bsdf::Directions;
 use mfh_reference::geometry::Vec3;
 use std::f64::consts::{PI, TAU};
@@ -99,7 +99,7 @@ impl SphereFinder {
     /// The cell of a direction: the upper grid's for z ≥ 0, the lower grid's (of (x, y, −z),
     /// after the upper's) for z < 0 or NaN, as [`CellFinder::cell_of`] finds them; or why it
     /// is not in the domain.
-    pub fn cell_of(&self, w: Vec3) -> Result<usize, DomainError> {
+    pub fn cell_of(&self, w: Vec3) -> Result<usize, DirectionError> {
         if w[2] >= 0.0 {
             self.upper.cell_of(w)
         } else {

@@ -9,16 +9,16 @@
 //! route evaluates are transcribed here, each with its document and equation. The oracle is
 //! always harness code (`crate::oracle`), never the reference crate's `*_exact` routes.
 //!
-//! One file per document (`seed000.rs` … `seed004.rs`); this file holds the catalogue, the
+//! One file per document (`document000.rs` … `document004.rs`); this file holds the catalogue, the
 //! planning by [`Scope`] and the verdict. Forms the documents present as approximations are
 //! claims (`check::claims`), not errata.
 
+mod document000;
+mod document001;
+mod document002;
+mod document003;
+mod document004;
 mod scope;
-mod seed000;
-mod seed001;
-mod seed002;
-mod seed003;
-mod seed004;
 
 pub use scope::{Concern, Effect, Scope, STUDENT};
 
@@ -210,7 +210,7 @@ pub const NOT_DEMONSTRABLE: &[(&str, &str, Concern)] = &[
     ),
 ];
 
-/// The piecewise-linear family of seed 000.
+/// The piecewise-linear family of document 000.
 const PIECEWISE: &[&str] = &["piecewise_linear"];
 
 /// What a demonstration found: the printed and the corrected value against one oracle.
@@ -261,11 +261,11 @@ struct Demo(
 
 /// Every demonstration, document by document.
 fn demos() -> Vec<Demo> {
-    let mut out = seed001::demos();
-    out.extend(seed000::demos());
-    out.extend(seed002::demos());
-    out.extend(seed004::demos());
-    out.extend(seed003::demos());
+    let mut out = document001::demos();
+    out.extend(document000::demos());
+    out.extend(document002::demos());
+    out.extend(document004::demos());
+    out.extend(document003::demos());
     out
 }
 

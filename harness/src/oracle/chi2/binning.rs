@@ -2,7 +2,7 @@
 //! chunk by chunk, and binned into the cells of a [`HemisphereGrid`] in parallel, with counts
 //! independent of the thread count and of how the samples are batched.
 
-use crate::oracle::domain::{CellFinder, DomainError, HemisphereGrid};
+use crate::oracle::hemisphere_grid::{CellFinder, DirectionError, HemisphereGrid};
 use crate::random::stream;
 use mfh_reference::geometry::Vec3;
 use rayon::prelude::*;
@@ -21,7 +21,7 @@ pub struct Observed {
     /// Samples outside the domain.
     pub outside: u64,
     /// The first sample outside the domain (lowest index) and why.
-    pub first_outside: Option<(u64, DomainError)>,
+    pub first_outside: Option<(u64, DirectionError)>,
 }
 
 impl Observed {

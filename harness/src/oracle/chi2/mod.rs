@@ -33,7 +33,7 @@
 //!
 //! [`MASS_TOLERANCE`]: crate::tolerance::MASS_TOLERANCE
 //! [`MIN_EXPECTED`]: crate::tolerance::MIN_EXPECTED
-//! [`CellFinder`]: crate::oracle::domain::CellFinder
+//! [`CellFinder`]: crate::oracle::hemisphere_grid::CellFinder
 //! [`KINKED_CELL_RELATIVE_TOLERANCE`]: crate::tolerance::KINKED_CELL_RELATIVE_TOLERANCE
 //! [`CELL_RELATIVE_TOLERANCE`]: crate::tolerance::CELL_RELATIVE_TOLERANCE
 //! [`CELL_ABSOLUTE_TOLERANCE`]: crate::tolerance::CELL_ABSOLUTE_TOLERANCE
@@ -50,7 +50,7 @@ pub use expected::{
     expected_mass_in_batch, expected_mass_to, Expected,
 };
 
-use crate::oracle::domain::{DomainError, HemisphereGrid};
+use crate::oracle::hemisphere_grid::{DirectionError, HemisphereGrid};
 use crate::oracle::lobe::{self, Lobe};
 use crate::tolerance::CELL_RELATIVE_TOLERANCE;
 use binning::scalar_batch;
@@ -77,7 +77,7 @@ pub struct Chi2Config {
 /// The outcome of a test.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Verdict {
+pub enum TestOutcome {
     /// Consistent with the pdf at level α.
     Pass,
     /// A sanity failure, or p < α.
@@ -88,11 +88,11 @@ pub enum Verdict {
 /// how many, and the first of them (in the seeded sequence) with what is wrong with it.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 #[error("{count} samples outside the domain; the first, sample {index}: {error}")]
-pub struct OutsideDomain {
+pub struct OutsideHemisphere {
     /// Index of the first offending sample (in the seeded sequence).
     pub index: u64,
     /// What is wrong with it.
-    pub error: DomainError,
+    pub error: DirectionError,
     /// How many samples were outside.
     pub count: u64,
 }
@@ -102,7 +102,7 @@ pub struct OutsideDomain {
 pub enum Failure {
     /// Samples lie outside the upper hemisphere.
     #[error(transparent)]
-    OutsideDomain(OutsideDomain),
+    OutsideHemisphere(OutsideHemisphere),
     /// The pdf does not integrate to 1 over the hemisphere.
     #[error("pdf mass {mass} (± {error_bound:.1e}) differs from 1 by more than {tolerance}")]
     MassOff {
@@ -194,7 +194,7 @@ pub struct Chi2Result {
     /// The seed of the random streams.
     pub seed: u64,
     /// Pass or fail.
-    pub verdict: Verdict,
+    pub verdict: TestOutcome,
     /// Why it failed, if it did.
     pub reason: Option<Failure>,
     /// The integrated pdf mass over the hemisphere.

@@ -57,7 +57,7 @@ pub enum GridError {
 
 /// Why a direction lies outside the upper hemisphere.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-pub enum DomainError {
+pub enum DirectionError {
     /// A component is NaN or infinite.
     #[error("non-finite direction {0:?}")]
     NotFinite(Vec3),
@@ -180,7 +180,7 @@ impl HemisphereGrid {
     /// The cell index (row-major: `row * columns + column`, row 0 at the horizon) of a unit
     /// direction in the upper hemisphere, or why it is not in the domain.
     #[inline]
-    pub fn cell_of(&self, m: Vec3) -> Result<usize, DomainError> {
+    pub fn cell_of(&self, m: Vec3) -> Result<usize, DirectionError> {
         let row = self.row_of(m)?;
         let mut phi = m[1].atan2(m[0]);
         if phi < 0.0 {
@@ -196,7 +196,7 @@ impl HemisphereGrid {
 
     /// The z-row of a unit direction in the upper hemisphere, or why it is not in the domain.
     #[inline]
-    fn row_of(&self, m: Vec3) -> Result<usize, DomainError> {
+    fn row_of(&self, m: Vec3) -> Result<usize, DirectionError> {
         let len = validate(m)?;
         let z = m[2] / len;
         let rows = self.rows();
@@ -228,16 +228,16 @@ impl HemisphereGrid {
 /// The length of `m` if it is a unit direction (within [`UNIT_TOLERANCE`]) in the closed upper
 /// hemisphere, else why it is not.
 #[inline]
-pub fn validate(m: Vec3) -> Result<f64, DomainError> {
+pub fn validate(m: Vec3) -> Result<f64, DirectionError> {
     if !(m[0].is_finite() && m[1].is_finite() && m[2].is_finite()) {
-        return Err(DomainError::NotFinite(m));
+        return Err(DirectionError::NotFinite(m));
     }
     let len = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
     if !((len - 1.0).abs() <= UNIT_TOLERANCE) {
-        return Err(DomainError::NotUnit(m, len));
+        return Err(DirectionError::NotUnit(m, len));
     }
     if m[2] < 0.0 {
-        return Err(DomainError::BelowHorizon(m));
+        return Err(DirectionError::BelowHorizon(m));
     }
     Ok(len)
 }
@@ -321,7 +321,7 @@ impl CellFinder {
     /// The cell index of a direction, or why it is not in the domain: the same answer as
     /// [`HemisphereGrid::cell_of`] (up to directions within ~1e-16 rad of a column boundary).
     #[inline(always)]
-    pub fn cell_of(&self, m: Vec3) -> Result<usize, DomainError> {
+    pub fn cell_of(&self, m: Vec3) -> Result<usize, DirectionError> {
         // The same decisions as `validate` (`squared_length` is its accepted interval of |m|²;
         // a non-finite component makes |m|² NaN or ∞, outside it), without its square root;
         // a rejected direction goes through `validate` for the same error.
@@ -569,7 +569,7 @@ impl CellFinder {
     /// Why `m`, rejected by the squared-length test, is outside the domain.
     #[cold]
     #[inline(never)]
-    fn rejection(&self, m: Vec3) -> DomainError {
+    fn rejection(&self, m: Vec3) -> DirectionError {
         match validate(m) {
             Err(error) => error,
             Ok(len) => unreachable!(
@@ -823,7 +823,7 @@ mod tests {
             }
             assert!(matches!(
                 finder.cell_of([0.0, 0.6, -0.8]),
-                Err(DomainError::BelowHorizon(_))
+                Err(DirectionError::BelowHorizon(_))
             ));
         }
     }
@@ -831,7 +831,7 @@ mod tests {
     /// The cell of `m` as `CellFinder::cell_of` found it before the square-root-free
     /// validation, the row from z·R and the branch-free first step (validate, row from
     /// z / |m|, then the two searches from the estimate).
-    fn previous_cell_of(finder: &CellFinder, m: Vec3) -> Result<usize, DomainError> {
+    fn previous_cell_of(finder: &CellFinder, m: Vec3) -> Result<usize, DirectionError> {
         let row = finder.grid.row_of(m)?;
         let (x, y) = (m[0], m[1]);
         let columns = finder.grid.columns();
@@ -890,7 +890,7 @@ mod tests {
         let mut rng = crate::random::Stream::new(11, 0);
         let mut uniform = || rng.uniform();
         // Debug text: errors carrying NaN compare unequal with ==.
-        let same = |a: &Result<usize, DomainError>, b: &Result<usize, DomainError>| {
+        let same = |a: &Result<usize, DirectionError>, b: &Result<usize, DirectionError>| {
             format!("{a:?}") == format!("{b:?}")
         };
         let mut rejected = 0usize;
@@ -1264,15 +1264,15 @@ mod tests {
         assert_eq!(grid.cell_of([1.0, -1e-300, 0.0]), Ok(7));
         assert!(matches!(
             grid.cell_of([0.0, 0.6, -0.8]),
-            Err(DomainError::BelowHorizon(_))
+            Err(DirectionError::BelowHorizon(_))
         ));
         assert!(matches!(
             grid.cell_of([f64::NAN, 0.0, 1.0]),
-            Err(DomainError::NotFinite(_))
+            Err(DirectionError::NotFinite(_))
         ));
         assert!(matches!(
             grid.cell_of([0.0, 0.0, 1.1]),
-            Err(DomainError::NotUnit(..))
+            Err(DirectionError::NotUnit(..))
         ));
         assert!(HemisphereGrid::new(0).is_none());
     }
