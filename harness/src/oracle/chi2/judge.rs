@@ -41,7 +41,7 @@ pub(super) fn judge(
     };
     result.reason = sanity(&result, &expected, observed.outside, observed.first_outside);
     // Masses whose cubature ran out of budget above its target judge nothing (not even a
-    // mass off or a zero-pdf cell); samples outside the domain are wrong whatever they are.
+    // mass off or a zero-pdf cell); samples outside the upper hemisphere are wrong whatever they are.
     if let Some(hit) = expected.budget_hit.filter(|h| !(h.bound <= h.target)) {
         if !matches!(result.reason, Some(Failure::OutsideHemisphere(_))) {
             result.reason = Some(Failure::CubatureBudget {
@@ -145,7 +145,7 @@ pub(crate) fn pearson_test(
     })
 }
 
-/// The sanity failures, in order: samples outside the domain, invalid or off mass, samples in
+/// The sanity failures, in order: samples outside the upper hemisphere, invalid or off mass, samples in
 /// zero-pdf cells.
 fn sanity(
     result: &Chi2Result,

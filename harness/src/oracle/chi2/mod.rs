@@ -16,7 +16,7 @@
 //!    ([`crate::oracle::lobe`]); every cell is integrated in (φ, θ), cut where the lobe varies,
 //!    by adaptive G7/K15 product cubature ([`crate::oracle::cubature`]) with a per-cell error
 //!    bound ([`expected_mass_in`]); the total mass and the summed error bound are reported.
-//! 3. **Sanity failures first** (no p-value): a sample outside the domain (non-finite, non-unit,
+//! 3. **Sanity failures first** (no p-value): a sample outside the upper hemisphere (non-finite, non-unit,
 //!    below the horizon), a total pdf mass off from 1 by more than [`MASS_TOLERANCE`], a
 //!    non-finite or negative cell mass, a sample in a cell of zero expected count.
 //! 4. **Pooling.** Cells with expected count < [`MIN_EXPECTED`] are pooled into one bin; if that
@@ -87,7 +87,7 @@ pub enum TestOutcome {
 /// Samples outside the upper hemisphere (a sanity failure of the chi-square and KS tests):
 /// how many, and the first of them (in the seeded sequence) with what is wrong with it.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-#[error("{count} samples outside the domain; the first, sample {index}: {error}")]
+#[error("{count} samples outside the upper hemisphere; the first, sample {index}: {error}")]
 pub struct OutsideHemisphere {
     /// Index of the first offending sample (in the seeded sequence).
     pub index: u64,

@@ -316,7 +316,7 @@ pub struct KsResult {
     pub table_seconds: f64,
 }
 
-/// The drawn values of a marginal, or the samples outside the domain.
+/// The drawn values of a marginal, or the samples outside the upper hemisphere.
 struct Drawn {
     values: Vec<f64>,
     outside: u64,
@@ -494,7 +494,7 @@ where
 pub struct KsKept {
     /// The result.
     pub result: KsResult,
-    /// The drawn marginal values, sorted (samples outside the domain are not among them).
+    /// The drawn marginal values, sorted (samples outside the upper hemisphere are not among them).
     pub sorted: Vec<f64>,
     /// The model's CDF table of the marginal.
     pub table: CdfTable,
@@ -613,7 +613,7 @@ fn judge(result: &mut KsResult, values: &[f64], table: &CdfTable, config: &KsCon
     }
 }
 
-/// The failures that leave no statistic: samples outside the domain, no samples, an invalid
+/// The failures that leave no statistic: samples outside the upper hemisphere, no samples, an invalid
 /// density or mass, a table too coarse for N.
 fn sanity(drawn: &Drawn, table: &CdfTable, samples: u64) -> Option<Failure> {
     if let Some((index, error)) = drawn.first_outside {
