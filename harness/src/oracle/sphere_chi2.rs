@@ -470,7 +470,7 @@ fn expected_hemisphere_until(
         .collect();
     let options = lobe::Options {
         hint: None,
-        seeds: &seeds,
+        start_points: &seeds,
     };
     let lobe = lobe::measure_with_batch(&mirrored, &options);
     let (grid, placed) = match cells {

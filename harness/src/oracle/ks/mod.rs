@@ -450,7 +450,7 @@ where
 {
     let options = lobe::Options {
         hint: Some(hints.width),
-        seeds: &[],
+        start_points: &[],
     };
     let lobe = lobe::measure_with(&|m| pdf(m), &options);
     ks_test_lobe(sample, pdf, marginal, &lobe, hints.theta_kinks, config)
