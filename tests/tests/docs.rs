@@ -735,8 +735,8 @@ fn the_checkers_catch_broken_links_and_citations() {
     assert_eq!(slug("Where does X go?"), "where-does-x-go");
     assert_eq!(slug("An `mfh eval` quantity"), "an-mfh-eval-quantity");
     assert_eq!(
-        slug("Seed 004 — Deriving G1 for γ ∈ (0, 4] (Dimov, GTR)"),
-        "seed-004--deriving-g1-for-γ--0-4-dimov-gtr"
+        slug("Document 004 — Deriving G1 for γ ∈ (0, 4] (Dimov, GTR)"),
+        "document-004--deriving-g1-for-γ--0-4-dimov-gtr"
     );
     assert_eq!(
         anchors("# A\n## A\n```\n# not a heading\n```\n"),

@@ -386,14 +386,14 @@ mod tests {
     fn ids_in_errata_md() -> Vec<String> {
         let text = include_str!("../../../../reference/ERRATA.md");
         let mut out = Vec::new();
-        let mut seed = "";
+        let mut document = "";
         for line in text.lines() {
-            if let Some(rest) = line.strip_prefix("## Seed ") {
-                seed = &rest[..3];
+            if let Some(rest) = line.strip_prefix("## Document ") {
+                document = &rest[..3];
                 continue;
             }
             let t = line.trim();
-            if seed == "001" && t.starts_with("| ") {
+            if document == "001" && t.starts_with("| ") {
                 let cell = t[2..].split('|').next().unwrap_or("").trim();
                 if !cell.is_empty() && cell.chars().all(|c| c.is_ascii_digit()) {
                     out.push(format!("001-{cell}"));
@@ -401,13 +401,14 @@ mod tests {
             } else if let Some(rest) = t.strip_prefix("### ") {
                 let head = rest.split([' ', '—']).next().unwrap_or("");
                 let head = head.trim_end_matches('.');
-                if seed == "002" && head.chars().all(|c| c.is_ascii_digit()) && !head.is_empty() {
+                if document == "002" && head.chars().all(|c| c.is_ascii_digit()) && !head.is_empty()
+                {
                     out.push(format!("002-{head}"));
                 } else if (head.starts_with('E') || head.starts_with('S') || head.starts_with('U'))
                     && head.len() > 1
                     && head[1..].chars().all(|c| c.is_ascii_digit())
                 {
-                    out.push(format!("{seed}-{head}"));
+                    out.push(format!("{document}-{head}"));
                 }
             }
         }
