@@ -16,7 +16,7 @@
 
 use criterion::{black_box, Criterion, Throughput};
 use mfh_harness::oracle::chi2::{cells, observe_batch};
-use mfh_harness::oracle::domain::CellFinder;
+use mfh_harness::oracle::hemisphere_grid::CellFinder;
 use mfh_harness::oracle::sphere_chi2::{chi2_masses, observe_sphere, SphereMasses};
 use mfh_harness::oracle::sphere_finder::SphereFinder;
 use mfh_harness::random::stream;

@@ -18,7 +18,7 @@
 
 use criterion::{black_box, Criterion, Throughput};
 use mfh_harness::oracle::chi2::{cells, observe_batch, CHUNK};
-use mfh_harness::oracle::domain::{CellFinder, HemisphereGrid};
+use mfh_harness::oracle::hemisphere_grid::{CellFinder, HemisphereGrid};
 use mfh_harness::random::stream;
 use mfh_reference::geometry::Vec3;
 use mfh_reference::ndf::Ggx;

@@ -260,7 +260,7 @@ fn bench_piecewise_blend(c: &mut Criterion) {
     g.finish();
 }
 
-/// GTR (seed 004): D and sample_wm at γ = 1.5, Λ by every route of `gtr_lambda::ROUTES` at
+/// GTR (document 004): D and sample_wm at γ = 1.5, Λ by every route of `gtr_lambda::ROUTES` at
 /// γ ∈ {1, 1.5, 2, 4} where it applies.
 fn bench_gtr(c: &mut Criterion) {
     let m = Gtr::new(1.5, ALPHA).expect("valid GTR");
@@ -292,7 +292,7 @@ fn bench_gtr(c: &mut Criterion) {
     g.finish();
 }
 
-/// Gaussian slopes (seed 002): D, Λ and the moments of the visible slopes D_s (no sampler).
+/// Gaussian slopes (document 002): D, Λ and the moments of the visible slopes D_s (no sampler).
 fn bench_gaussian_slopes(c: &mut Criterion) {
     let m = GaussianSlopes::new([0.1, -0.05], [[0.04, 0.01], [0.01, 0.09]]).expect("valid");
     let params = "mean=[0.1,-0.05],cov=[[0.04,0.01],[0.01,0.09]]";

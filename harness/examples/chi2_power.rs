@@ -16,7 +16,7 @@
 //! smallest error caught at all seeds (with every larger one tried also caught), and the
 //! p-values of every run.
 
-use mfh_harness::oracle::chi2::{chi2_test_batch_layout, Chi2Config, Layout, Verdict};
+use mfh_harness::oracle::chi2::{chi2_test_batch_layout, Chi2Config, Layout, TestOutcome};
 use mfh_harness::selftest::mutant::{Defect, Mutated};
 use mfh_harness::tolerance::{CELL_RELATIVE_TOLERANCE, STATISTICAL_ALPHA};
 use mfh_reference::geometry::Vec3;
@@ -90,7 +90,7 @@ fn main() {
                         (CELL_RELATIVE_TOLERANCE, None, &[]),
                         layout,
                     );
-                    all &= r.verdict == Verdict::Fail;
+                    all &= r.verdict == TestOutcome::Fail;
                     ps.push(format!("{:.0e}", r.p_value));
                 }
                 caught_all.push(all);

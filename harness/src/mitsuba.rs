@@ -19,7 +19,7 @@
 //! index is listed as not audited); masking uncorrelated, exact Fresnel, radiance transport.
 //!
 //! Masking: Mitsuba 3's `MicrofacetDistribution::G` is "Smith's separable shadowing-masking
-//! approximation", G1(wi, m)·G1(wo, m) — the uncorrelated G2 (seed 001 eq 22), not the
+//! approximation", G1(wi, m)·G1(wo, m) — the uncorrelated G2 (document 001 eq 22), not the
 //! height-correlated form. Mitsuba clamps α ≥ 10⁻⁴ (`MicrofacetDistribution::configure`); so
 //! does this reader. The clearcoat lobe masks with a GGX G1 at α = 0.25 (`clearcoat_G`), which
 //! is not the Smith G of its own NDF: that masking is listed as not audited.

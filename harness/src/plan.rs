@@ -21,7 +21,7 @@ pub struct Effects {
     pub masking: Option<Masking>,
     /// How it samples, if it does.
     pub sampling: Option<Sampling>,
-    /// Whether it filters with slope moments (Gaussian-slope filtering, seed 002).
+    /// Whether it filters with slope moments (Gaussian-slope filtering, document 002).
     pub slope_moments: bool,
     /// The largest incidence it evaluates (radians).
     pub theta_max: f64,

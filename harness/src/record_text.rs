@@ -147,6 +147,61 @@ pub fn record_title(record: &CheckRecord) -> String {
     )
 }
 
+/// A record's name in a list of tests (JUnit's `<testcase name>`): the check id, then the
+/// model's kind and the model's and the case's values as `key=value` words, numbers short
+/// ([`json`]): `normalization.d ggx alpha=0.3 theta=0.5`. Nested values are flattened to
+/// dotted keys (`lobes.0.family=ggx`); no braces or quotes, so that a CI page shows a name,
+/// not JSON. Short numbers can make two records' names equal: a list that needs unique names
+/// numbers the repeats (`report::junit`); the full case stays in the record.
+pub fn test_name(record: &CheckRecord) -> String {
+    let mut words = vec![record.check.clone()];
+    if let Some(map) = record.model.as_object() {
+        let kind = ["family", "bsdf", "name"]
+            .into_iter()
+            .find(|k| map.get(*k).is_some_and(Value::is_string));
+        words.extend(kind.and_then(|k| map.get(k)).map(json));
+        for (k, v) in map.iter().filter(|(k, _)| Some(k.as_str()) != kind) {
+            flat_words(k, v, &mut words);
+        }
+    } else if !record.model.is_null() {
+        flat_words("model", &record.model, &mut words);
+    }
+    match record.case.as_object() {
+        Some(map) => map.iter().for_each(|(k, v)| flat_words(k, v, &mut words)),
+        None if record.case.is_null() => {}
+        None => flat_words("case", &record.case, &mut words),
+    }
+    words
+        .join(" ")
+        .chars()
+        .map(|c| match c {
+            '{' => '(',
+            '}' => ')',
+            '"' => '\'',
+            c if c.is_control() => ' ',
+            c => c,
+        })
+        .collect()
+}
+
+/// `key=value` words of a JSON value: scalars and arrays of scalars as one word ([`json`]),
+/// objects and arrays holding objects or arrays flattened to `key.sub` and `key.index`.
+fn flat_words(key: &str, value: &Value, out: &mut Vec<String>) {
+    match value {
+        Value::Object(map) => {
+            for (k, v) in map {
+                flat_words(&format!("{key}.{k}"), v, out);
+            }
+        }
+        Value::Array(items) if items.iter().any(|v| v.is_object() || v.is_array()) => {
+            for (i, v) in items.iter().enumerate() {
+                flat_words(&format!("{key}.{i}"), v, out);
+            }
+        }
+        v => out.push(format!("{key}={}", json(v))),
+    }
+}
+
 /// `n` and the noun, singular or plural (`1 record`, `3 records`).
 pub fn count(n: usize, singular: &str, plural: &str) -> String {
     format!("{n} {}", if n == 1 { singular } else { plural })

@@ -446,7 +446,7 @@ mod tests {
             "{}",
             result.expected_mass
         );
-        assert_eq!(result.verdict, crate::oracle::chi2::Verdict::Pass);
+        assert_eq!(result.verdict, crate::oracle::chi2::TestOutcome::Pass);
         // A model without kinks has none.
         assert!(validate(&request(GGX)).unwrap().theta_kinks.is_empty());
     }

@@ -57,7 +57,7 @@ pub struct Material {
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Filtering {
-    /// Gaussian slope distributions (LEAN-style filtering, seed 002 visible-slope moments).
+    /// Gaussian slope distributions (LEAN-style filtering, document 002 visible-slope moments).
     #[serde(default)]
     pub gaussian_slopes: bool,
 }
@@ -66,10 +66,10 @@ pub struct Filtering {
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Lighting {
-    /// Spherical Gaussians (seed 003).
+    /// Spherical Gaussians (document 003).
     #[serde(default)]
     pub spherical_gaussians: bool,
-    /// Anisotropic spherical Gaussians (seed 003).
+    /// Anisotropic spherical Gaussians (document 003).
     #[serde(default)]
     pub anisotropic_spherical_gaussians: bool,
 }

@@ -6,7 +6,7 @@
 //! (`check/claims.rs` names them, it defines none) — except the BSDF checks', in
 //! `tolerance/bsdf.rs`; their float32 rows are in `tolerance/precision.rs` (the BSDF checks'
 //! `_f32` rows in `tolerance/bsdf.rs`), picked by [`Tolerance::at`]; the expected-failure types
-//! (`Bound`, `Domain`, `ExpectedFailure`) and their table are in `tolerance/expected.rs`, and
+//! (`Bound`, `ParameterBox`, `ExpectedFailure`) and their table are in `tolerance/expected.rs`, and
 //! the chi-square oracle's numeric tolerances in `tolerance/chi2.rs`; all re-exported here.
 //! [`TABLE`] lists every [`Tolerance`] (its test: a reason each, unique names).
 //!
@@ -31,7 +31,7 @@ pub use chi2::{
     LAYOUT_ABSOLUTE_TOLERANCE, LAYOUT_RELATIVE_TOLERANCE, MASS_TOLERANCE, MIN_EXPECTED,
     REMOTE_CELL_ABSOLUTE_TOLERANCE,
 };
-pub use expected::{expected_failures, Bound, Domain, ExpectedFailure, EXPECTED_FAILURES};
+pub use expected::{expected_failures, Bound, ExpectedFailure, ParameterBox, EXPECTED_FAILURES};
 pub use precision::{cell_relative_tolerance, EPS32, F32_TABLE};
 
 /// A named tolerance.
@@ -149,7 +149,7 @@ pub const MOMENT: Tolerance = Tolerance {
              under the tail substitution; 1e-9 against a 1e-11 request",
 };
 
-/// Visible-slope moments (seed 002) against 2-D quadrature.
+/// Visible-slope moments (document 002) against 2-D quadrature.
 pub const VISIBLE_MOMENTS: Tolerance = Tolerance {
     name: "visible_moments",
     value: 1e-8,
@@ -186,7 +186,7 @@ pub const ERRATUM_VISIBLE_MOMENTS: Tolerance = Tolerance {
              are off by > 1e-2",
 };
 
-/// Seed 004 §4: the α → 0 limit of G1 at μ = 1.
+/// Document 004 §4: the α → 0 limit of G1 at μ = 1.
 pub const GTR_LIMIT: Tolerance = Tolerance {
     name: "gtr_limit",
     value: 1e-6,
@@ -195,7 +195,7 @@ pub const GTR_LIMIT: Tolerance = Tolerance {
              γ = 2, μ = 1 the true G1 is 1 − O(α²) ≈ 1 − 2.5e-9, so a limit must be met to 1e-6",
 };
 
-/// Seed 004 §2 / §5: the spline's claimed error.
+/// Document 004 §2 / §5: the spline's claimed error.
 pub const GTR_SPLINE: Tolerance = Tolerance {
     name: "gtr_spline",
     value: 1e-3,
@@ -203,7 +203,7 @@ pub const GTR_SPLINE: Tolerance = Tolerance {
              than 0.1 % error\"; §5: \"ca. 0.1 % difference … the mean difference was 0.001\"",
 };
 
-/// Seed 004 §6: the γ > 4 clamp.
+/// Document 004 §6: the γ > 4 clamp.
 pub const GTR_CLAMP: Tolerance = Tolerance {
     name: "gtr_clamp",
     value: 0.3,
@@ -211,7 +211,7 @@ pub const GTR_CLAMP: Tolerance = Tolerance {
              in μ ∈ (0, 1) and it's up to 0.3\" (absolute)",
 };
 
-/// Seed 003 §3.2.3: the ASG–SG convolution error claim.
+/// Document 003 §3.2.3: the ASG–SG convolution error claim.
 pub const SG_CONVOLUTION_L2: Tolerance = Tolerance {
     name: "sg_convolution_l2",
     value: 2e-3,
@@ -219,7 +219,7 @@ pub const SG_CONVOLUTION_L2: Tolerance = Tolerance {
              the error is bounded by 2.8 %.\" (relative L2 over the SG axis, ERRATA.md 003-E5)",
 };
 
-/// Seed 000 eq 28: the trapezoid rule has no stated bound; the measured envelope guards it.
+/// Document 000 eq 28: the trapezoid rule has no stated bound; the measured envelope guards it.
 pub const PIECEWISE_TRAPEZOID: Tolerance = Tolerance {
     name: "piecewise_trapezoid",
     value: 5e-2,
@@ -228,7 +228,7 @@ pub const PIECEWISE_TRAPEZOID: Tolerance = Tolerance {
              in G1 for 5–11 irregular breakpoints, so 5e-2 catches a regression",
 };
 
-/// Seed 001 eq 7 and 9: slope-moment claims, against quadrature of P2.
+/// Document 001 eq 7 and 9: slope-moment claims, against quadrature of P2.
 pub const SLOPE_MOMENT_CLAIM: Tolerance = Tolerance {
     name: "slope_moment_claim",
     value: 1e-8,
@@ -237,7 +237,7 @@ pub const SLOPE_MOMENT_CLAIM: Tolerance = Tolerance {
              an algebraic tail (1e-12 asked, heavy tails converge slowly: 1e-8)",
 };
 
-/// SG/ASG identities between two evaluations (seed 003): product of SGs against the product of
+/// SG/ASG identities between two evaluations (document 003): product of SGs against the product of
 /// evaluations, the SG decomposition into circular Gaussians, evaluation against the definition.
 pub const SG_IDENTITY: Tolerance = Tolerance {
     name: "sg_identity",
@@ -247,7 +247,7 @@ pub const SG_IDENTITY: Tolerance = Tolerance {
              gives relative differences up to ~1e-13: 1e-12",
 };
 
-/// The clamped-cosine fit max(v·n, 0) ≈ G(v; n, 2.133, 1.170) in use, G · C* (seed 003 §2.4).
+/// The clamped-cosine fit max(v·n, 0) ≈ G(v; n, 2.133, 1.170) in use, G · C* (document 003 §2.4).
 pub const CLAMPED_COSINE_FIT: Tolerance = Tolerance {
     name: "clamped_cosine_fit",
     value: 0.195,
@@ -257,7 +257,7 @@ pub const CLAMPED_COSINE_FIT: Tolerance = Tolerance {
              constant or inner product fails",
 };
 
-/// The lobe warp's sharpness λ_W = λ/(4|p·o|) (seed 003 §2.1), as a factor of ln 10/(2λ).
+/// The lobe warp's sharpness λ_W = λ/(4|p·o|) (document 003 §2.1), as a factor of ln 10/(2λ).
 pub const SG_WARP_AREA: Tolerance = Tolerance {
     name: "sg_warp_area",
     value: 1.1,
@@ -267,7 +267,7 @@ pub const SG_WARP_AREA: Tolerance = Tolerance {
              the warp's sharpness is off by more than a tenth of its own error",
 };
 
-/// The ASG integral's large-bandwidth form π/√(λμ) for λ, μ > 5 (seed 003 §3.2.1).
+/// The ASG integral's large-bandwidth form π/√(λμ) for λ, μ > 5 (document 003 §3.2.1).
 pub const ASG_LARGE_BANDWIDTH: Tolerance = Tolerance {
     name: "asg_large_bandwidth",
     value: 7e-3,
@@ -275,7 +275,7 @@ pub const ASG_LARGE_BANDWIDTH: Tolerance = Tolerance {
              case is λ = μ = 5, where the relative error is e^{−5}/(1 − e^{−5}) = 0.68 %: 0.7 %",
 };
 
-/// The ASG × ASG product with the smooth terms frozen at z₃ (seed 003 §3.2.2), error relative
+/// The ASG × ASG product with the smooth terms frozen at z₃ (document 003 §3.2.2), error relative
 /// to the exact product's peak.
 pub const ASG_PRODUCT_FIT: Tolerance = Tolerance {
     name: "asg_product_fit",
@@ -285,7 +285,7 @@ pub const ASG_PRODUCT_FIT: Tolerance = Tolerance {
              0.2 bounds it over the planned bandwidths ≥ 1",
 };
 
-/// The ASG–SG convolution approximation (seed 003 §3.2.3).
+/// The ASG–SG convolution approximation (document 003 §3.2.3).
 pub const ASG_CONVOLUTION_CLAIM: Tolerance = Tolerance {
     name: "asg_convolution_claim",
     value: 0.028,
@@ -295,7 +295,7 @@ pub const ASG_CONVOLUTION_CLAIM: Tolerance = Tolerance {
              unless the SG is sharp)",
 };
 
-/// The ASG–SG convolution approximation for λ, μ > 3 (seed 003 §3.2.3).
+/// The ASG–SG convolution approximation for λ, μ > 3 (document 003 §3.2.3).
 pub const ASG_CONVOLUTION_CLAIM_SHARP: Tolerance = Tolerance {
     name: "asg_convolution_claim_sharp",
     value: 0.002,
@@ -304,7 +304,7 @@ pub const ASG_CONVOLUTION_CLAIM_SHARP: Tolerance = Tolerance {
              the SG is very sharp)",
 };
 
-/// Seed 003 §3.2.1's ASG integral with F, an approximation the document states no error for
+/// Document 003 §3.2.1's ASG integral with F, an approximation the document states no error for
 /// (not an erratum: "can be approximated as follows"). Judged by `claims.asg_integral`
 /// (`check/claims.rs`).
 pub const ASG_INTEGRAL_APPROXIMATION: Tolerance = Tolerance {
@@ -315,7 +315,7 @@ pub const ASG_INTEGRAL_APPROXIMATION: Tolerance = Tolerance {
              4.5 % bounds the measured error over the planned grid, so a changed form fails",
 };
 
-/// Seed 003 §4.3's ∫g^c ≈ ∫g (erf form), as a multiple of its leading-order relative error
+/// Document 003 §4.3's ∫g^c ≈ ∫g (erf form), as a multiple of its leading-order relative error
 /// σ²/16. Judged by `claims.circular_interval_erf` (`check/claims.rs`).
 pub const CIRCULAR_ERF_LEADING_ORDER: Tolerance = Tolerance {
     name: "circular_erf_leading_order",

@@ -108,7 +108,7 @@ fn conductor_plans_ggx_with_separable_masking_and_visible_normals() {
         ])
     );
     // Errata and claims are planned only where they concern a family or effect the scene
-    // uses (errata::Scope): none of seed 001's concern a GGX material alone.
+    // uses (errata::Scope): none of document 001's concern a GGX material alone.
     let planned = plan(&s, Profile::Quick);
     let others: BTreeSet<&str> = planned
         .iter()
@@ -248,7 +248,7 @@ fn anisotropic_principled_plans_its_ggx_lobe_and_gtr1_clear_coat() {
     let na = not_audited(&s);
     assert!(na[0].starts_with("not audited: principled clearcoat masking (car_paint/clearcoat)"));
     assert_eq!(na[1], "not audited: shape ply (body) is not a BSDF");
-    // GTR1 comes from seed 004: its errata and claims are planned too.
+    // GTR1 comes from document 004: its errata and claims are planned too.
     assert!(plan(&s, Profile::Quick)
         .iter()
         .any(|p| p.check.starts_with("claims.gtr")));

@@ -51,7 +51,7 @@ pub enum ParamError {
     /// The parameters were given in a combination the model does not accept.
     #[error("{0}")]
     Combination(String),
-    /// A piecewise-linear profile (breakpoints and values, seed 000 eq 4) is malformed.
+    /// A piecewise-linear profile (breakpoints and values, document 000 eq 4) is malformed.
     #[error("profile {axis}: {requirement} (at index {index}, got {value})")]
     InvalidProfile {
         /// Which profile (`x`, `y`).

@@ -17,7 +17,7 @@ pub trait FamilySpec {
 
     /// The parameter (name, value) that puts the model outside the domain of its Smith Λ, if
     /// any: for the Student-t members with γ ≤ 3/2 (and D^G(B, C) with C ≤ 3/2) the mean slope
-    /// diverges and Λ = ∞ at every incidence (seed 001 eq 18).
+    /// diverges and Λ = ∞ at every incidence (document 001 eq 18).
     fn smith_limit(&self) -> Option<(&'static str, f64)> {
         None
     }
@@ -35,7 +35,7 @@ pub trait FamilySpec {
     }
 
     /// The mean slope (s̄x, s̄y) of the slope distribution (non-zero only for Gaussian slopes
-    /// with a mean, seed 002).
+    /// with a mean, document 002).
     fn mean_slope(&self) -> [f64; 2] {
         [0.0, 0.0]
     }
@@ -47,7 +47,7 @@ pub trait FamilySpec {
 pub struct FamilyInfo {
     /// The family name, as in specs (`"family": "ggx"`).
     pub name: &'static str,
-    /// The source documents (seed ids, the source documents, seeds 000–004) the family's closed forms come from.
+    /// The source documents (seed ids, the source documents, documents 000–004) the family's closed forms come from.
     pub documents: &'static [&'static str],
     /// Where in the documents the family is defined.
     pub source: &'static str,
@@ -71,7 +71,7 @@ pub struct FamilyInfo {
     /// ~0.6 µs against 0.01–0.1 µs for the closed-form samplers): the KS checks take fewer
     /// samples.
     pub slow_sampler: bool,
-    /// Whether the family tends to Beckmann as γ → ∞ (seed 001 §4), which the limit check
+    /// Whether the family tends to Beckmann as γ → ∞ (document 001 §4), which the limit check
     /// measures.
     pub beckmann_limit: bool,
     /// Whether slope moments are part of the model itself (not only of Gaussian-slope

@@ -1,7 +1,7 @@
 //! mfh-reference: the reference closed forms of microfacet BSDF mathematics.
 //!
 //! Normal distribution functions, Smith Λ / G1 / G2, importance-sampling inversions and slope
-//! moments, each citing the source document and equation it implements (seeds 000–004, cited by id;
+//! moments, each citing the source document and equation it implements (documents 000–004, cited by id;
 //! see ARCHITECTURE.md). This crate holds closed forms only: no oracles, no I/O, no randomness.
 //! Every closed form is checked by the harness (`mfh-harness`) against independent oracles.
 

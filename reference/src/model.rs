@@ -53,7 +53,7 @@ pub trait Ndf: Send + Sync {
     fn as_slopes(&self) -> Option<&dyn SlopeDistribution> {
         None
     }
-    /// The visible-slope-moments capability (seed 002, D_s), if the model has one.
+    /// The visible-slope-moments capability (document 002, D_s), if the model has one.
     fn as_visible_moments(&self) -> Option<&dyn VisibleSlopeMoments> {
         None
     }
@@ -106,9 +106,9 @@ delegate_ndf!(&T, Box<T>, std::sync::Arc<T>);
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Masking {
-    /// G2 = G1(wo, m) G1(wi, m) (seed 001, eq 22).
+    /// G2 = G1(wo, m) G1(wi, m) (document 001, eq 22).
     Uncorrelated,
-    /// G2 = χ⁺(wo·m) χ⁺(wi·m) / (1 + Λ(wo) + Λ(wi)) (seed 001, eq 23).
+    /// G2 = χ⁺(wo·m) χ⁺(wi·m) / (1 + Λ(wo) + Λ(wi)) (document 001, eq 23).
     HeightCorrelated,
 }
 
@@ -134,7 +134,7 @@ pub trait Smith: Ndf {
         }
     }
 
-    /// G1(w, m) = χ⁺(w·m / w·n) / (1 + Λ(w)) (seed 001, eq 16). Zero at grazing incidence and
+    /// G1(w, m) = χ⁺(w·m / w·n) / (1 + Λ(w)) (document 001, eq 16). Zero at grazing incidence and
     /// for back-facing microfacets.
     fn g1(&self, w: Vec3, m: Vec3) -> f64 {
         if w[2] <= 0.0 || dot(w, m) <= 0.0 {
@@ -143,7 +143,7 @@ pub trait Smith: Ndf {
         1.0 / (1.0 + self.lambda(w))
     }
 
-    /// G2(wo, wi, m) in the uncorrelated (eq 22) or height-correlated (eq 23) form of seed 001.
+    /// G2(wo, wi, m) in the uncorrelated (eq 22) or height-correlated (eq 23) form of document 001.
     fn g2(&self, wo: Vec3, wi: Vec3, m: Vec3, masking: Masking) -> f64 {
         smith_g2(self, wo, wi, m, masking)
     }
@@ -164,7 +164,7 @@ pub trait Smith: Ndf {
     }
 }
 
-/// G2(wo, wi, m) of seed 001 from `s`'s G1 and Λ: uncorrelated (eq 22), G1(wo)·G1(wi), or
+/// G2(wo, wi, m) of document 001 from `s`'s G1 and Λ: uncorrelated (eq 22), G1(wo)·G1(wi), or
 /// height-correlated (eq 23), χ⁺ / (1 + Λ(wo) + Λ(wi)). [`Smith::g2`]'s default, and what a
 /// wrapper that overrides `g2` (the self-test's mutants) calls after changing the masking.
 pub fn smith_g2<S: Smith + ?Sized>(s: &S, wo: Vec3, wi: Vec3, m: Vec3, masking: Masking) -> f64 {
@@ -232,7 +232,7 @@ pub trait NormalSampler: Ndf {
 
 /// Importance sampling of the normals visible from a direction `wi`: the distribution of
 /// visible normals of Heitz & d'Eon 2014 ("Importance Sampling Microfacet-Based BSDFs using the
-/// Distribution of Visible Normals", CGF 33(4), eq 2; seed 001 §7 cites it as \[9\]):
+/// Distribution of Visible Normals", CGF 33(4), eq 2; document 001 §7 cites it as \[9\]):
 ///
 /// ```text
 /// D_wi(m) = G1(wi) ⟨wi·m⟩⁺ D(m) / cos θi,   G1(wi) = 1/(1 + Λ(wi)),   ∫ D_wi(m) dm = 1
@@ -408,7 +408,7 @@ pub(crate) fn check_alpha(name: &'static str, value: f64) -> Result<f64, crate::
 
 /// The azimuthal part shared by every elliptic sampler: (cos 2πu, sin 2πu) scaled by the
 /// per-axis slope scales. Multiplying by the sampled slope radius gives the slope (p, q).
-/// This is the quadrant-correct form of seed 001 eq 11 / 40.
+/// This is the quadrant-correct form of document 001 eq 11 / 40.
 #[inline]
 pub(crate) fn elliptic_direction(sx: f64, sy: f64, u1: f64) -> (f64, f64) {
     let (s, c) = crate::geometry::sin_cos_turns(u1);
@@ -416,7 +416,7 @@ pub(crate) fn elliptic_direction(sx: f64, sy: f64, u1: f64) -> (f64, f64) {
 }
 
 /// The mean and covariance of a two-dimensional slope distribution, e.g. of the visible slopes
-/// D_s (seed 002, eq 19–23, 39–46).
+/// D_s (document 002, eq 19–23, 39–46).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VisibleMoments {
     /// The mean slope `[s̄x, s̄y]`.
@@ -425,7 +425,7 @@ pub struct VisibleMoments {
     pub cov: [[f64; 2]; 2],
 }
 
-/// Moments of the distribution of visible slopes D_s(s) ∝ p_s(s) ⟨w·m(s)⟩⁺ / m_z(s) (seed 002,
+/// Moments of the distribution of visible slopes D_s(s) ∝ p_s(s) ⟨w·m(s)⟩⁺ / m_z(s) (document 002,
 /// eq 12–13) for a view direction `w`.
 pub trait VisibleSlopeMoments {
     /// The mean and covariance of D_s seen from `w` by the model's default (most accurate)

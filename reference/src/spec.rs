@@ -54,26 +54,26 @@ macro_rules! model_spec {
 macro_rules! families {
     ($then:ident) => {
         $then! {
-            /// Beckmann (seed 001, Table 1, γ → ∞).
+            /// Beckmann (document 001, Table 1, γ → ∞).
             Beckmann(BeckmannSpec) = "beckmann",
-            /// GGX / Trowbridge–Reitz (seed 001, Table 1, γ = 2).
+            /// GGX / Trowbridge–Reitz (document 001, Table 1, γ = 2).
             Ggx(GgxSpec) = "ggx",
-            /// Student's t NDF, STD (seed 001, f = 1/(γ−1)); `gamma: "inf"` is Beckmann.
+            /// Student's t NDF, STD (document 001, f = 1/(γ−1)); `gamma: "inf"` is Beckmann.
             Std(StdSpec) = "std",
-            /// Hyper-Cauchy (seed 001, eq 8, f = 1).
+            /// Hyper-Cauchy (document 001, eq 8, f = 1).
             HyperCauchy(HyperCauchySpec) = "hyper_cauchy",
-            /// The fixed-variance Student member (seed 001, eq 9, f = 1/(γ−2)); `gamma: "inf"` is
+            /// The fixed-variance Student member (document 001, eq 9, f = 1/(γ−2)); `gamma: "inf"` is
             /// Beckmann.
             StudentFixedVariance(FixedVarianceSpec) = "student_fixed_variance",
-            /// The general isotropic family D^G(B, C) (seed 001, eq 1–2).
+            /// The general isotropic family D^G(B, C) (document 001, eq 1–2).
             StudentGeneral(GeneralSpec) = "student_general",
-            /// The piecewise-linear NDF (seed 000, eq 1–5).
+            /// The piecewise-linear NDF (document 000, eq 1–5).
             PiecewiseLinear(PiecewiseSpec) = "piecewise_linear",
-            /// Two isotropic models combined by eq 1 of seed 000.
+            /// Two isotropic models combined by eq 1 of document 000.
             Blend(BlendSpec) = "blend",
-            /// Generalized-Trowbridge-Reitz (Burley 2012; Smith G1 of seed 004), isotropic.
+            /// Generalized-Trowbridge-Reitz (Burley 2012; Smith G1 of document 004), isotropic.
             Gtr(GtrSpec) = "gtr",
-            /// A Gaussian distribution of slopes N(s̄, Σ) (seed 002, eq 1; slope sign of eq 11).
+            /// A Gaussian distribution of slopes N(s̄, Σ) (document 002, eq 1; slope sign of eq 11).
             GaussianSlopes(GaussianSlopesSpec) = "gaussian_slopes",
         }
     };
@@ -137,21 +137,21 @@ roughness_spec!(
     GgxSpec
 );
 student_spec!(
-    /// The spec of an STD model (seed 001, f = 1/(γ−1)): `{"family": "std", "gamma": 2.5,
+    /// The spec of an STD model (document 001, f = 1/(γ−1)): `{"family": "std", "gamma": 2.5,
     /// "alpha": 0.3}`; `gamma: "inf"` is Beckmann.
     StdSpec
 );
 student_spec!(
-    /// The spec of a Hyper-Cauchy model (seed 001 eq 8, f = 1), γ > 1.
+    /// The spec of a Hyper-Cauchy model (document 001 eq 8, f = 1), γ > 1.
     HyperCauchySpec
 );
 student_spec!(
-    /// The spec of the fixed-variance Student member (seed 001 eq 9, f = 1/(γ−2)), γ > 2;
+    /// The spec of the fixed-variance Student member (document 001 eq 9, f = 1/(γ−2)), γ > 2;
     /// `gamma: "inf"` is Beckmann.
     FixedVarianceSpec
 );
 
-/// The spec of the general isotropic family D^G(B, C) (seed 001 eq 1–2):
+/// The spec of the general isotropic family D^G(B, C) (document 001 eq 1–2):
 /// `{"family": "student_general", "b": 4, "c": 2.5}`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -104,7 +104,7 @@ pub fn golden_beckmann() -> Vec<serde_json::Value> {
     all["lambda"].as_array().expect("golden table").clone()
 }
 
-/// A table of `reports/accuracy-other-seeds.md` built by an accuracy test: printed as it is
+/// A table of `reports/accuracy-other-documents.md` built by an accuracy test: printed as it is
 /// built, then compared with the file's section between `<!-- generated: NAME -->` and
 /// `<!-- end: NAME -->` — or, with `MFH_WRITE_REPORTS=1`, written into it. So the tracked
 /// tables are this test's output, and the test fails when they are stale.
@@ -135,8 +135,8 @@ impl ReportTable {
     /// If the report or its markers are missing, or the section differs from the table.
     pub fn check_report(&self) {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../reports/accuracy-other-seeds.md");
-        let report = std::fs::read_to_string(&path).expect("reports/accuracy-other-seeds.md");
+            .join("../reports/accuracy-other-documents.md");
+        let report = std::fs::read_to_string(&path).expect("reports/accuracy-other-documents.md");
         let begin = format!("<!-- generated: {} -->\n", self.name);
         let end = format!("<!-- end: {} -->", self.name);
         let start = report.find(&begin).expect("the section's begin marker") + begin.len();
@@ -146,12 +146,12 @@ impl ReportTable {
                 .expect("the section's end marker");
         if std::env::var_os("MFH_WRITE_REPORTS").is_some() {
             let updated = format!("{}{}{}", &report[..start], self.text, &report[stop..]);
-            std::fs::write(&path, updated).expect("write reports/accuracy-other-seeds.md");
+            std::fs::write(&path, updated).expect("write reports/accuracy-other-documents.md");
             return;
         }
         assert!(
             report[start..stop] == self.text,
-            "reports/accuracy-other-seeds.md, section {}, is stale: regenerate it with \
+            "reports/accuracy-other-documents.md, section {}, is stale: regenerate it with \
              `MFH_EXTENSIVE=1 MFH_WRITE_REPORTS=1 cargo test -p mfh-reference --release \
              accuracy_table_`\n--- now ---\n{}--- in the file ---\n{}",
             self.name,

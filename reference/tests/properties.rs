@@ -5,9 +5,9 @@
 //!
 //! - D(m) is finite and ≥ 0 on the upper hemisphere;
 //! - Λ(w) is finite and ≥ 0 above the horizon, G1 ∈ (0, 1] toward the normal, and the
-//!   height-correlated G2 = 1/(1 + Λo + Λi) is never below the uncorrelated G1·G1 (seed 001,
+//!   height-correlated G2 = 1/(1 + Λo + Λi) is never below the uncorrelated G1·G1 (document 001,
 //!   eq 22–23: (1 + a)(1 + b) ≥ 1 + a + b for a, b ≥ 0);
-//! - Λ is non-decreasing in θ for the shape-invariant families (seed 001, Λ a function of
+//! - Λ is non-decreasing in θ for the shape-invariant families (document 001, Λ a function of
 //!   a = cot θ/α that decreases in a);
 //! - `sample_wm(u)` is a finite unit vector in the upper hemisphere for every u ∈ [0, 1)², and
 //!   `pdf_wm(m) = D(m) m_z` there (the density of normal sampling).

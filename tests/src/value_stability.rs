@@ -155,7 +155,7 @@ pub fn queries() -> Vec<Value> {
         json!({"model": {"family": "std", "gamma": 1.2, "alpha": 0.3},
                   "quantity": "sample_wm", "u": [0.4, 0.999]}),
     );
-    // Spherical Gaussians (seed 003): no model.
+    // Spherical Gaussians (document 003): no model.
     let a = json!({"axis": unit(0.3, 0.2), "sharpness": 8.0, "amplitude": 1.5});
     let b = json!({"axis": unit(0.5, 1.9), "sharpness": 20.0, "amplitude": 0.7});
     let asg = json!({"x": [1.0, 0.0, 0.0], "y": [0.0, 1.0, 0.0], "z": [0.0, 0.0, 1.0],

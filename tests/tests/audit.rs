@@ -66,7 +66,7 @@ fn a_passing_audit_exits_0_and_writes_a_versioned_report_and_junit() {
         }
         assert!(!r["source"].as_str().unwrap().is_empty(), "{r}");
     }
-    // Only what the scene uses: GGX (seed 001) checks, no SG, D_s, GTR or piecewise checks.
+    // Only what the scene uses: GGX (document 001) checks, no SG, D_s, GTR or piecewise checks.
     for r in records {
         let check = r["check"].as_str().unwrap();
         assert!(

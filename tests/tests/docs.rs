@@ -386,7 +386,7 @@ const FILE_EXTENSIONS: &[&str] = &["rs", "md", "toml", "py", "hpp", "cpp"];
 /// `ks.rs`) or has a `/` and begins with the name of a folder of the workspace
 /// (`harness/src/check/run.rs`, `check/bsdf/chi2.rs`, `oracle/chi2/`). A component with
 /// `<placeholder>` or `NNN` in it stands for any name (`reference/src/ndf/<family>.rs`,
-/// `seedNNN.rs`). Not paths: `family/quantity/route` (no folder is called `family`),
+/// `documentNNN.rs`). Not paths: `family/quantity/route` (no folder is called `family`),
 /// `report.json` (an output, not a source extension).
 fn path_candidate(span: &str, folders: &BTreeSet<String>) -> Option<String> {
     let allowed = |c: char| c.is_ascii_alphanumeric() || "_-./<>".contains(c);
@@ -735,8 +735,8 @@ fn the_checkers_catch_broken_links_and_citations() {
     assert_eq!(slug("Where does X go?"), "where-does-x-go");
     assert_eq!(slug("An `mfh eval` quantity"), "an-mfh-eval-quantity");
     assert_eq!(
-        slug("Seed 004 — Deriving G1 for γ ∈ (0, 4] (Dimov, GTR)"),
-        "seed-004--deriving-g1-for-γ--0-4-dimov-gtr"
+        slug("Document 004 — Deriving G1 for γ ∈ (0, 4] (Dimov, GTR)"),
+        "document-004--deriving-g1-for-γ--0-4-dimov-gtr"
     );
     assert_eq!(
         anchors("# A\n## A\n```\n# not a heading\n```\n"),
@@ -795,9 +795,9 @@ fn the_checker_catches_missing_files_and_identifiers() {
             (1, "wrapped span".to_string())
         ]
     );
-    assert!(glob("seed*.rs", "seed004.rs") && glob("*", "") && !glob("a*b", "ac"));
+    assert!(glob("document*.rs", "document004.rs") && glob("*", "") && !glob("a*b", "ac"));
     assert_eq!(component_pattern("<family>.rs"), "*.rs");
-    assert_eq!(component_pattern("seedNNN.rs"), "seed*.rs");
+    assert_eq!(component_pattern("documentNNN.rs"), "document*.rs");
 
     let entries: Vec<Vec<String>> = [
         "harness/src/check/bsdf/chi2.rs",
@@ -809,7 +809,7 @@ fn the_checker_catches_missing_files_and_identifiers() {
         "reference/src/ndf",
         "reference/src",
         "reference",
-        "reference/src/errata/seed001.rs",
+        "reference/src/errata/document001.rs",
         "reference/src/errata",
         "Cargo.toml",
     ]
@@ -837,7 +837,7 @@ fn the_checker_catches_missing_files_and_identifiers() {
     let index = RustIndex::of(rust);
     let markdown = "\
 `harness/src/check/bsdf/chi2.rs` `check/bsdf/chi2.rs` `check/bsdf/` `Cargo.toml`
-`reference/src/ndf/<family>.rs` `reference/src/errata/seedNNN.rs`
+`reference/src/ndf/<family>.rs` `reference/src/errata/documentNNN.rs`
 `family/quantity/route` `report.json` `bsdf.chi2` `d` `seed` `Check::new(id, model)`
 `PlannedCheck` `Audit::of` `Audit::of_bsdf` `Precision::F32` `registry!` `of()` `MEASURED`
 `MFH_SEED`

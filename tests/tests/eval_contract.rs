@@ -579,7 +579,7 @@ fn non_finite_values_are_strings() {
         // Just below the horizon, Λ(−w) = −1 − Λ(w) overflows to −∞.
         json!({"model": ggx, "quantity": "lambda", "w": [1.0, 0.0, -1e-320]}),
     ];
-    // (Algorithm 2 of seed 001 as printed, which hits a pole of Γ at integer γ, now answers a
+    // (Algorithm 2 of document 001 as printed, which hits a pole of Γ at integer γ, now answers a
     // typed `route` error outside the domain where it is accurate, not NaN.)
     let r = mfh(&["eval"], &lines(&queries));
     let got: Vec<Value> = answers(&r)

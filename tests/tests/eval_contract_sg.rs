@@ -1,4 +1,4 @@
-//! End to end: the `mfh eval` contract for spherical Gaussians (seed 003: SG, ASG), driven
+//! End to end: the `mfh eval` contract for spherical Gaussians (document 003: SG, ASG), driven
 //! through `mfh_harness::cli::run` exactly as the binary calls it: every SG/ASG quantity answers
 //! `{"value": …}` equal bit for bit to the reference library called directly.
 

@@ -22,7 +22,7 @@ fn out_folder() -> PathBuf {
 }
 
 /// A small scene: a GGX material that masks and samples (Λ plots, chi-square heat maps, KS
-/// marginals) and an STD one (γ → ∞ limits, seed 001 errata and claims).
+/// marginals) and an STD one (γ → ∞ limits, document 001 errata and claims).
 const SCENE: &str = r#"{
   "name": "html report test",
   "materials": [

@@ -1,4 +1,4 @@
-//! What the closed-form benchmarks share (`closed_forms.rs`, `other_seeds.rs`): the swept
+//! What the closed-form benchmarks share (`closed_forms.rs`, `other_documents.rs`): the swept
 //! inputs, groups with per-element throughput, the sweep loop and the default settings.
 #![allow(dead_code)] // each benchmark binary uses a part of it
 
@@ -81,7 +81,7 @@ pub fn config(measurement: Duration, warm_up: Duration) -> Criterion {
         .configure_from_args()
 }
 
-/// The piecewise-linear model of the benchmarks: the anisotropic blend (eq 1 of seed 000) of
+/// The piecewise-linear model of the benchmarks: the anisotropic blend (eq 1 of document 000) of
 /// GGX α = 0.2 along x and Beckmann α = 0.4 along y, each discretized at 32 breakpoints.
 pub fn piecewise_model() -> PiecewiseLinear {
     let ggx = Ggx::new(0.2, 0.2).expect("valid");

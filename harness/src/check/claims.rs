@@ -2,7 +2,7 @@
 //! formulations, convergence) as a check with a verdict: value = the measured error, tolerance =
 //! the claimed bound (with the document's words as its reason, `crate::tolerance`), oracle =
 //! harness quadrature. A claim reference/ERRATA.md shows false is an expected failure tagged
-//! with its erratum id. Forms a document presents as approximations without a bound (seed 003
+//! with its erratum id. Forms a document presents as approximations without a bound (document 003
 //! §3.2.1, §4.3) are measured against a bound on their measured error, so a changed form fails.
 //! Each claim declares what it concerns ([`Concern`]); a scene plans only those it uses.
 
@@ -21,7 +21,7 @@ use crate::tolerance::{
     Tolerance, ASG_INTEGRAL_APPROXIMATION, CIRCULAR_ERF_LEADING_ORDER, CLOSED_FORM, GTR_CLAMP,
     GTR_LIMIT, GTR_SPLINE, IDENTITY, PIECEWISE_TRAPEZOID, SLOPE_MOMENT_CLAIM,
 };
-use mfh_reference::errata::seed001;
+use mfh_reference::errata::document001;
 use mfh_reference::geometry::from_spherical;
 use mfh_reference::ndf::gtr::Gtr;
 use mfh_reference::sg::asg::Asg;
@@ -188,7 +188,7 @@ fn gtr_g1_many(gamma: f64, alpha: f64, thetas: &[f64]) -> Result<Vec<Estimate>, 
     )
 }
 
-/// The plot domain of seed 004 §5 with γ between the knots.
+/// The plot domain of document 004 §5 with γ between the knots.
 /// The μ of the spline grid (the innermost index of `spline_grid`).
 const SPLINE_MUS: [f64; 6] = [0.1, 1.1, 2.1, 3.1, 4.1, 5.0];
 
@@ -289,7 +289,7 @@ fn trapezoid_spec() -> Value {
     })
 }
 
-/// max relative error of G1 = 1/(1 + Λ) by the trapezoid route (seed 000 eq 28) against the
+/// max relative error of G1 = 1/(1 + Λ) by the trapezoid route (document 000 eq 28) against the
 /// harness oracle, θ_o ∈ {0.05, 0.3, 0.8, 1.2, 1.5}.
 fn trapezoid_error() -> Result<Measurement, String> {
     let spec = trapezoid_spec();
@@ -320,7 +320,7 @@ fn moment(m: &dyn Model, k: i32, scale: f64) -> Result<f64, String> {
     .value)
 }
 
-/// Seed 001 eq 9: the fixed-variance member has variance σ²/2 whatever γ (> 2); max relative
+/// Document 001 eq 9: the fixed-variance member has variance σ²/2 whatever γ (> 2); max relative
 /// error over γ ∈ {3.5, 6, 20}, σ = α = 0.4, variance by quadrature.
 fn fixed_variance() -> Result<Measurement, String> {
     let mut max = 0.0f64;
@@ -332,7 +332,7 @@ fn fixed_variance() -> Result<Measurement, String> {
     Ok(Measurement::new(max, true))
 }
 
-/// Seed 001 eq 7: excess kurtosis 3/(C − 3) of D^G (STD γ = 8, α = 0.3), by quadrature.
+/// Document 001 eq 7: excess kurtosis 3/(C − 3) of D^G (STD γ = 8, α = 0.3), by quadrature.
 fn excess_kurtosis() -> Result<Measurement, String> {
     let g = 8.0;
     let m = build(json!({"family": "std", "gamma": g, "alpha": 0.3}))?;
@@ -345,7 +345,7 @@ fn excess_kurtosis() -> Result<Measurement, String> {
     ))
 }
 
-/// Seed 001 §1.1 / Table 1: "STD … includes GGX" (γ = 2) and Hyper-Cauchy includes GGX (γ = 2):
+/// Document 001 §1.1 / Table 1: "STD … includes GGX" (γ = 2) and Hyper-Cauchy includes GGX (γ = 2):
 /// max relative difference of D over θ ∈ {0, 0.4, 0.9, 1.4}.
 fn includes_ggx(family: &'static str) -> Result<Measurement, String> {
     let m = build(json!({"family": family, "gamma": 2.0, "alpha": 0.3}))?;
@@ -358,7 +358,7 @@ fn includes_ggx(family: &'static str) -> Result<Measurement, String> {
     Ok(Measurement::new(max, true))
 }
 
-/// Seed 001 eq 41–42 as a pair: θ_m from eq 42 as printed, at φ ∈ {0, 0.7, 2} and ξ₂ on a
+/// Document 001 eq 41–42 as a pair: θ_m from eq 42 as printed, at φ ∈ {0, 0.7, 2} and ξ₂ on a
 /// grid, must satisfy F(θ_m | φ) = ξ₂, F the conditional cdf of θ by harness quadrature of
 /// D cos θ sin θ (in u = tan θ: (1 + A u²)^{−γ} u). Eq 41 alone tends to 1/(σxσy A′) ≠ 1 (it
 /// keeps 2π p(φ)), but eq 42 divides ξ₂ by the same factor (formerly erratum 001-11,
@@ -372,11 +372,11 @@ fn eq41_42_sampler() -> Result<Measurement, String> {
         let f = |u: f64| (1.0 + a * u * u).powf(-g) * u;
         let whole = integrate_upper(&f, 0.0, 1.0 / a.sqrt(), Accuracy::relative(1e-13)).value;
         for xi in [0.02, 0.1, 0.3, 0.5, 0.7, 0.9, 0.98] {
-            let theta = seed001::eq42_theta_printed(g, sx, sy, phi, xi);
+            let theta = document001::eq42_theta_printed(g, sx, sy, phi, xi);
             let part = integrate(&f, 0.0, theta.tan(), Accuracy::relative(1e-13)).value;
             max = max.max((part / whole - xi).abs());
         }
-        limits.push(seed001::eq41_theta_cdf_printed(
+        limits.push(document001::eq41_theta_cdf_printed(
             g,
             sx,
             sy,
@@ -391,7 +391,7 @@ fn eq41_42_sampler() -> Result<Measurement, String> {
     })
 }
 
-/// Seed 003 §3.2.1: max relative error of the ASG integral with F against harness quadrature
+/// Document 003 §3.2.1: max relative error of the ASG integral with F against harness quadrature
 /// of the ASG over the hemisphere, bandwidths λ ≥ μ ≥ 1.
 fn asg_integral_error() -> Result<Measurement, String> {
     let mut worst = (0.0f64, [0.0f64; 2]);
@@ -425,7 +425,7 @@ fn asg_integral_error() -> Result<Measurement, String> {
     })
 }
 
-/// Seed 003 §4.3: max over σ ≤ 1 and means in [−1.4, 1.4] of the relative error of ∫g (the erf
+/// Document 003 §4.3: max over σ ≤ 1 and means in [−1.4, 1.4] of the relative error of ∫g (the erf
 /// form) for ∫g^c over [−π/2, π/2], in units of σ²/16; ∫g^c by harness quadrature.
 fn circular_erf_error() -> Result<Measurement, String> {
     let mut worst = (0.0f64, [0.0f64; 2]);

@@ -1,5 +1,5 @@
 //! Visible-slope moments: the mean and covariance of the visible-slope distribution D_s of a
-//! Gaussian slope distribution (seed 002, eq 12–46), by every route, against 2-D adaptive
+//! Gaussian slope distribution (document 002, eq 12–46), by every route, against 2-D adaptive
 //! cubature of their defining integrals (eq 16, 19–23), for regular, near-singular and
 //! back-facing (mean facet facing away at grazing incidence) cases.
 
@@ -19,7 +19,7 @@ const SOURCE: &str = "seed 002 eq 12–16 (D_s(s) = p_s(s) W(s) H(s) / N, W = ω
 
 /// Below this z₀ = (cot θ − s̄_o)/σ_o the mean facet faces away from the view and D_s lives in
 /// the Gaussian's tail: such cases are checked as `ds.visible_moments_backfacing`, where the
-/// transcribed printed formulas cancel (ERRATA.md seed 002, numerical limits).
+/// transcribed printed formulas cancel (ERRATA.md document 002, numerical limits).
 const BACKFACING_Z0: f64 = -3.0;
 
 /// The components of a D_s moment set, in the order of [`components`].
@@ -184,7 +184,7 @@ pub fn plan(model: Arc<dyn Model>, profile: Profile, theta_max: f64, why: &str) 
                 .map(Arc::from)
         };
         // The profile's grazing incidence π/2 − 1e-6 is for Λ, G1 and G2; the D_s moments of
-        // seed 002 (and their expected-failure bounds) are measured up to θ = 1.5.
+        // document 002 (and their expected-failure bounds) are measured up to θ = 1.5.
         let thetas = profile.thetas(theta_max.min(1.5));
         for theta in thetas {
             for &phi in phis(profile) {

@@ -1,4 +1,4 @@
-//! Limits: the Student-t family tends to Beckmann as γ → ∞ (seed 001 §4), at the measured rate
+//! Limits: the Student-t family tends to Beckmann as γ → ∞ (document 001 §4), at the measured rate
 //! O(1/γ), for D and Λ. Each record carries the fitted exponent (the verdict) and the constant
 //! of the rate: max over γ of γ × (relative D error) or γ × (absolute Λ error).
 

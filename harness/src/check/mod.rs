@@ -3,7 +3,7 @@
 //! panics and never asserts; only the audit's verdicts decide.
 //!
 //! **Layout.** A family of several concepts is a folder: `sampling/` (the normal sampler in
-//! `sampling.rs`, the KS marginals in `ks.rs`, visible normals in `visible.rs`, seed 001's
+//! `sampling.rs`, the KS marginals in `ks.rs`, visible normals in `visible.rs`, document 001's
 //! pseudo-VNIS in `pseudo_vnis.rs`, a batch sampler against its scalar one in
 //! `batch_agrees.rs`); `bsdf/` (a whole BSDF, planned from the `Bsdf` capability at normal,
 //! oblique and grazing incidences and, when it transmits, from inside and beyond the critical

@@ -1,5 +1,5 @@
 //! Slope moments: ν₂ₖ, variance and excess kurtosis against integrals of P2, the marginal
-//! P2 = ∫P22 dp, and the normalization ∫P2 dq = 1 (seed 001 eq 4, 6–7, 15; seed 002 eq 2–10).
+//! P2 = ∫P22 dp, and the normalization ∫P2 dq = 1 (document 001 eq 4, 6–7, 15; document 002 eq 2–10).
 
 use super::{compare, covers, PlannedCheck};
 use crate::check::{need, Check};

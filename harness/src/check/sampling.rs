@@ -3,7 +3,7 @@
 //! own), `pdf_wm` against D(m)(m·n) at the sampled normals, and a Monte Carlo estimate of Λ through the sampler
 //! (E[⟨−w·m⟩⁺/(m·n)] = Λ(w) cos θ) against the closed form; for visible-normal samplers the
 //! chi-square of `sample_wm_visible` against `pdf_wm_visible` at fixed incidences and the
-//! normalization of `pdf_wm_visible`; for STD materials sampled by the pseudo-VNIS of seed 001
+//! normalization of `pdf_wm_visible`; for STD materials sampled by the pseudo-VNIS of document 001
 //! §7.2, the bias of its estimator with the weight of eq 43 as printed and with the unbiased one.
 //!
 //! One concept a file: the normal sampler's checks here (chi-square, pdf consistency, Λ by Monte

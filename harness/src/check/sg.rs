@@ -1,4 +1,4 @@
-//! Spherical Gaussians (seed 003): SG identities and closed forms (evaluation, integral, inner
+//! Spherical Gaussians (document 003): SG identities and closed forms (evaluation, integral, inner
 //! and vector products, cap integral, ε-support, lobe warp, clamped-cosine fit), circular
 //! Gaussians (von Mises integral, products, the SG decomposition) and ASGs (evaluation,
 //! integral, product, ASG–SG convolution), each against sphere quadrature or its definition.
@@ -46,7 +46,7 @@ pub const CLOSED_FORMS: &[&str] = &[
     "sg/asg_sg_convolution/exact",
 ];
 
-/// Library forms of seed 003 that `mfh eval` does not expose, also covered here.
+/// Library forms of document 003 that `mfh eval` does not expose, also covered here.
 pub const LIBRARY_FORMS: &[&str] = &[
     "sg/epsilon_support/default",
     "sg/clamped_cosine/default",

@@ -46,7 +46,7 @@ fn spherical(theta: f64, (st, ct): (f64, f64), (sp, cp): (f64, f64)) -> Vec3 {
 }
 
 /// The mean slope along azimuth φ: mean · (cos φ, sin φ) (non-zero for Gaussian slopes with
-/// a mean, seed 002).
+/// a mean, document 002).
 fn mean_slope(subject: &Subject, phi: f64) -> f64 {
     let mean = subject.mean_slope();
     mean[0] * phi.cos() + mean[1] * phi.sin()
@@ -280,7 +280,7 @@ pub fn plan_white_furnace<'a>(
                 // the piecewise-linear NDF) once keeps it out of the integrand.
                 let g1 = smith.g1(w, [0.0, 0.0, 1.0]);
                 let e = projected_area(&m, w, g1);
-                // With a mean slope q̄ along w's azimuth (Gaussian slopes, seed 002), the
+                // With a mean slope q̄ along w's azimuth (Gaussian slopes, document 002), the
                 // microsurface is tilted, ∫ m D dm ≠ n, and the constraint becomes
                 // G1 (∫⟨w·m⟩⁺D dm + sin θ q̄) = cos θ: in slope space ∫⟨w·m⟩⁺D dm =
                 // sin θ ∫_{−∞}^{μ}(μ − q)P2 dq = cos θ (1 + Λ) − sin θ q̄ (μ = cot θ).

@@ -3,7 +3,7 @@
 //! and heat maps (PNG).
 
 use super::{resolve_seed, SamplingArg, EXIT_BAD_INPUT, EXIT_FAIL, EXIT_PASS};
-use crate::oracle::chi2::{Chi2Result, Verdict};
+use crate::oracle::chi2::{Chi2Result, TestOutcome};
 use crate::sampler_chi2::{self, Chi2Request};
 use clap::Args;
 
@@ -313,7 +313,7 @@ fn report(
                 r.samples_per_second(),
                 r.sampling_seconds,
                 r.integration_seconds,
-                if r.verdict == Verdict::Pass {
+                if r.verdict == TestOutcome::Pass {
                     "pass"
                 } else {
                     "FAIL"
@@ -332,8 +332,8 @@ fn report(
         return code;
     }
     match result.verdict {
-        Verdict::Pass => EXIT_PASS,
-        Verdict::Fail => EXIT_FAIL,
+        TestOutcome::Pass => EXIT_PASS,
+        TestOutcome::Fail => EXIT_FAIL,
     }
 }
 

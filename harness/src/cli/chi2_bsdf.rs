@@ -5,7 +5,7 @@
 
 use super::chi2::{bad, Chi2Args};
 use super::{EXIT_FAIL, EXIT_PASS};
-use crate::oracle::chi2::Verdict;
+use crate::oracle::chi2::TestOutcome;
 use crate::sampler_chi2::bsdf::{self as bsdf_chi2, BsdfChi2Request};
 use crate::sampler_chi2::SamplingKind;
 use std::io::Write;
@@ -94,7 +94,7 @@ pub fn run(
                 r.mass_error_bound(),
                 r.sampling_seconds,
                 r.integration_seconds,
-                if r.verdict == Verdict::Pass {
+                if r.verdict == TestOutcome::Pass {
                     "pass"
                 } else {
                     "FAIL"
@@ -116,7 +116,7 @@ pub fn run(
         return code;
     }
     match result.verdict {
-        Verdict::Pass => EXIT_PASS,
-        Verdict::Fail => EXIT_FAIL,
+        TestOutcome::Pass => EXIT_PASS,
+        TestOutcome::Fail => EXIT_FAIL,
     }
 }

@@ -2,22 +2,22 @@
 //! routes are compared on, and the reference each is measured against (never one of the routes
 //! under test).
 //!
-//! - STD Λ (seed 001): every route of `student_lambda::ROUTES` per γ, against the certified
+//! - STD Λ (document 001): every route of `student_lambda::ROUTES` per γ, against the certified
 //!   double-double Λ (`oracle::precise`, relative bound ≤ 1e-25…1e-20) at the same f64 argument
 //!   x = cot θ / (α √(γ − 1)).
-//! - GTR G1 (seed 004): every route of `gtr_lambda::ROUTES` (closed forms, the printed forms,
+//! - GTR G1 (document 004): every route of `gtr_lambda::ROUTES` (closed forms, the printed forms,
 //!   the implementation's G1, the spline — clamped to γ = 4 above 4 — and the exact numeric
 //!   route), against the certified GGX Λ at γ = 2 (GTR γ = 2 is GGX) and `oracle::gtr::g1`
 //!   (harness quadrature of the definition) elsewhere.
-//! - Piecewise-linear G1 (seed 000): GGX discretized with n pieces, the domain split with the
+//! - Piecewise-linear G1 (document 000): GGX discretized with n pieces, the domain split with the
 //!   document's trapezoid rule (eq 28) and with adaptive quadrature, against the exact route
 //!   (eq 10–13 by adaptive quadrature; the audit checks it against the harness's Λ oracle,
 //!   which costs seconds per angle on these models).
-//! - Spherical Gaussians (seed 003): the SG inner product (closed form, as printed), the ASG
+//! - Spherical Gaussians (document 003): the SG inner product (closed form, as printed), the ASG
 //!   integral (the document's form, its large-bandwidth form), the ASG–SG convolution (the
 //!   document's approximation, quadrature to a tolerance), against the reference crate's
 //!   adaptive quadrature to 1e-12…1e-13.
-//! - Gaussian visible-slope moments (seed 002): in `super::visible_moments`.
+//! - Gaussian visible-slope moments (document 002): in `super::visible_moments`.
 
 use super::{Candidate, Selection, Sweep};
 use crate::oracle::precise::student_lambda_standardized;
@@ -53,7 +53,7 @@ pub const THETAS: [f64; 13] = [
 ];
 
 /// The GTR shapes: non-integer (no closed form), integer 2 (every route), 5 (the spline clamped
-/// to γ = 4, seed 004 §6).
+/// to γ = 4, document 004 §6).
 pub const GTR_GAMMAS: [f64; 3] = [0.5, 2.0, 5.0];
 
 /// Pieces of the piecewise-linear discretization of GGX.
@@ -110,7 +110,7 @@ fn thetas_text() -> String {
     t.join(", ")
 }
 
-/// STD Λ at shape γ: every route of seed 001 against the certified double-double value.
+/// STD Λ at shape γ: every route of document 001 against the certified double-double value.
 pub fn student(c: f64) -> Sweep<'static> {
     let s = ALPHA * (c - 1.0).sqrt();
     let xs: Rc<Vec<f64>> = Rc::new(THETAS.iter().map(|t| t.cos() / t.sin() / s).collect());
@@ -161,8 +161,8 @@ pub fn student(c: f64) -> Sweep<'static> {
 /// nested quadrature (~10⁵ evaluations, seconds per angle).
 pub const GTR_THETAS: [f64; 4] = [0.05, 0.5, 1.0, 1.5];
 
-/// GTR G1 = 1/(1 + Λ) at shape γ: every route of seed 004. The reference: at γ = 2, where GTR
-/// is GGX (D = α²/(π(1 + (α² − 1) cos²θ)²), seed 004 eq 1** with c = α²), the certified
+/// GTR G1 = 1/(1 + Λ) at shape γ: every route of document 004. The reference: at γ = 2, where GTR
+/// is GGX (D = α²/(π(1 + (α² − 1) cos²θ)²), document 004 eq 1** with c = α²), the certified
 /// double-double GGX Λ; elsewhere `oracle::gtr::g1` (harness nested quadrature of the
 /// definition, relative bound 1e-9).
 pub fn gtr(gamma: f64, quick: bool) -> Sweep<'static> {
@@ -240,7 +240,7 @@ fn ggx_profile(theta: f64) -> f64 {
     a2 / (std::f64::consts::PI * t * t)
 }
 
-/// Piecewise-linear G1 (seed 000) of GGX (α = 0.5) discretized with n pieces: the document's
+/// Piecewise-linear G1 (document 000) of GGX (α = 0.5) discretized with n pieces: the document's
 /// domain split with the trapezoid rule of eq 28, and the exact route, against the Λ oracle.
 pub fn piecewise() -> Sweep<'static> {
     let thetas = [0.05, 0.3, 0.6, 0.9, 1.2, 1.4, 1.5, 1.57];
@@ -327,7 +327,7 @@ fn sg_pair(i: usize) -> (Sg, Sg) {
     (first, second)
 }
 
-/// The SG inner product (seed 003): the closed form, and the form as printed.
+/// The SG inner product (document 003): the closed form, and the form as printed.
 pub fn sg_inner() -> Sweep<'static> {
     let refs: Vec<f64> = (0..SG_PAIRS.len())
         .map(|i| {
@@ -379,7 +379,7 @@ fn asg(i: usize) -> Asg {
     .expect("valid ASG")
 }
 
-/// The ASG integral (seed 003 §3.2.1): the document's form and its large-bandwidth form.
+/// The ASG integral (document 003 §3.2.1): the document's form and its large-bandwidth form.
 pub fn asg_integral() -> Sweep<'static> {
     let refs: Vec<f64> = (0..BANDWIDTHS.len())
         .map(|i| asg(i).integral_exact())
@@ -404,7 +404,7 @@ pub fn asg_integral() -> Sweep<'static> {
     }
 }
 
-/// The ASG–SG convolution (seed 003 §3.3): the document's approximation, and quadrature to a
+/// The ASG–SG convolution (document 003 §3.3): the document's approximation, and quadrature to a
 /// few tolerances (the knob of the exact route).
 pub fn asg_convolution() -> Sweep<'static> {
     let sg_of = |i: usize| {

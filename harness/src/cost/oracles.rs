@@ -3,7 +3,7 @@
 //! costs in time.
 //!
 //! - Quadrature: Λ of STD γ = 3.5 by `oracle::quadrature::integrate_upper` of its definition
-//!   (seed 001 eq 5), asked for relative tolerances 1e-2 … 1e-12, against the certified
+//!   (document 001 eq 5), asked for relative tolerances 1e-2 … 1e-12, against the certified
 //!   double-double Λ: the achieved error next to the tolerance asked.
 //! - Monte Carlo: ∫ D cos θ dω = 1 of GGX (α = 0.5) by `oracle::monte_carlo::estimate` with
 //!   directions uniform on the hemisphere, N = 10³ … 10⁶, over 4 seeds: the largest |mean − 1|
@@ -196,7 +196,7 @@ pub fn chi2_power(quick: bool, seed: u64, timed: bool) -> Quantity {
         for &eps in &distortions {
             let (r, t) = test(eps);
             seconds.push(t);
-            if r.verdict == crate::oracle::chi2::Verdict::Fail {
+            if r.verdict == crate::oracle::chi2::TestOutcome::Fail {
                 caught = Some(eps);
             } else {
                 break;
@@ -227,7 +227,7 @@ pub fn chi2_power(quick: bool, seed: u64, timed: bool) -> Quantity {
                     None => format!("no distortion down to ε = {} caught", distortions[0]),
                 },
                 correct.p_value,
-                if correct.verdict == crate::oracle::chi2::Verdict::Pass {
+                if correct.verdict == crate::oracle::chi2::TestOutcome::Pass {
                     "passes"
                 } else {
                     "FAILS: a false alarm"

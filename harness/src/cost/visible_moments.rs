@@ -1,9 +1,9 @@
-//! The visible-slope moments of Gaussian slopes (seed 002, D_s): the closed forms against
+//! The visible-slope moments of Gaussian slopes (document 002, D_s): the closed forms against
 //! numerical cubature with n × n points, the trade a renderer that filters slopes makes.
 //!
 //! - Routes: the model's closed form (eq 42–46 in the stable form of
 //!   `GaussianSlopes::visible_moments`), the document's pseudocode with its erratum corrected,
-//!   the equations as printed (eq 59's sign of E₁; ERRATA.md seed 002), and tensor Gauss–Hermite
+//!   the equations as printed (eq 59's sign of E₁; ERRATA.md document 002), and tensor Gauss–Hermite
 //!   cubature of the defining integrals with n ∈ {4, 8, 16, 32, 64} points per axis.
 //! - Reference: `oracle::visible_moments::visible_moments_oracle`, adaptive cubature of the
 //!   definition D_s ∝ p_s(s)(w_z − s·w_xy)⁺ to relative 1e-11 (never one of the routes).

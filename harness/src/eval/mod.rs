@@ -170,7 +170,7 @@ pub fn evaluate(line: &str) -> Result<Value, EvalError> {
     let obj = query
         .as_object()
         .ok_or_else(|| EvalError::Parse("a query must be a JSON object".into()))?;
-    // Spherical-Gaussian quantities (seed 003) take no "model": see [`sg`]; nor do the BSDF
+    // Spherical-Gaussian quantities (document 003) take no "model": see [`sg`]; nor do the BSDF
     // quantities, which take a "bsdf" spec: see [`bsdf`].
     if let Some(quantity) = obj.get("quantity").and_then(Value::as_str) {
         if let Some(known) = bsdf::arguments(quantity) {

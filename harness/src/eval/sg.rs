@@ -1,4 +1,4 @@
-//! `mfh eval` for spherical Gaussians and anisotropic spherical Gaussians (seed 003): the
+//! `mfh eval` for spherical Gaussians and anisotropic spherical Gaussians (document 003): the
 //! quantities `sg_eval`, `sg_inner`, `sg_product`, `sg_integral`, `sg_warp`, `asg_eval`,
 //! `asg_integral` and `asg_sg_convolution`. These queries carry no `"model"`.
 //!
@@ -337,7 +337,7 @@ mod tests {
 
     #[test]
     fn sg_warp_is_the_library_warp() {
-        // Seed 003 §2.1: the lobe warp from half vectors to light directions for view o.
+        // Document 003 §2.1: the lobe warp from half vectors to light directions for view o.
         let a = Sg::new([0.0, 0.0, 1.0], 10.0, 2.0).unwrap();
         let o = [0.6, 0.0, 0.8];
         let w = value(&format!(

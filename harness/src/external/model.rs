@@ -379,7 +379,7 @@ impl Smith for ExternalModel {
     }
 }
 
-/// The trait's default G1 (seed 001, eq 16), for a child without `g1`.
+/// The trait's default G1 (document 001, eq 16), for a child without `g1`.
 fn default_g1(s: &ExternalModel, w: Vec3, m: Vec3) -> f64 {
     if w[2] <= 0.0 || w[0] * m[0] + w[1] * m[1] + w[2] * m[2] <= 0.0 {
         return 0.0;
@@ -387,7 +387,7 @@ fn default_g1(s: &ExternalModel, w: Vec3, m: Vec3) -> f64 {
     1.0 / (1.0 + s.lambda(w))
 }
 
-/// The trait's default G2 (seed 001, eq 22 / 23), for a child without `g2`.
+/// The trait's default G2 (document 001, eq 22 / 23), for a child without `g2`.
 fn default_g2(s: &ExternalModel, wo: Vec3, wi: Vec3, m: Vec3, masking: Masking) -> f64 {
     match masking {
         Masking::Uncorrelated => default_g1(s, wo, m) * default_g1(s, wi, m),

@@ -117,7 +117,7 @@ fn product_rule(f: &impl Fn(f64, f64) -> f64, x: [f64; 2], y: [f64; 2]) -> (f64,
 /// The accuracy asked of [`integrate_rectangle`]: the larger of an absolute error and a
 /// relative error (relative to the first K15 × K15 estimate of the whole rectangle).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Tolerance {
+pub struct AccuracyGoal {
     /// Absolute error.
     pub absolute: f64,
     /// Relative error.
@@ -131,7 +131,7 @@ pub fn integrate_rectangle(
     f: &impl Fn(f64, f64) -> f64,
     x: [f64; 2],
     y: [f64; 2],
-    tolerance: Tolerance,
+    tolerance: AccuracyGoal,
 ) -> Estimate {
     fn go(
         f: &impl Fn(f64, f64) -> f64,
@@ -239,7 +239,7 @@ fn evaluate(f: &BatchFn2<'_>, nodes: &mut [Node]) {
 /// pays a round trip per level and 1024 rectangles, not per rectangle.
 pub fn integrate_rectangles_batch(
     f: &BatchFn2<'_>,
-    rectangles: &[([f64; 2], [f64; 2], Tolerance)],
+    rectangles: &[([f64; 2], [f64; 2], AccuracyGoal)],
 ) -> Vec<Estimate> {
     integrate_rectangles_batch_budgeted(f, rectangles).0
 }
@@ -261,7 +261,7 @@ pub struct BudgetHit {
 /// [`integrate_rectangles_batch`], and whether [`MAX_RECTANGLES`] stopped the bisection.
 pub fn integrate_rectangles_batch_budgeted(
     f: &BatchFn2<'_>,
-    rectangles: &[([f64; 2], [f64; 2], Tolerance)],
+    rectangles: &[([f64; 2], [f64; 2], AccuracyGoal)],
 ) -> (Vec<Estimate>, Option<BudgetHit>) {
     let mut nodes: Vec<Node> = rectangles
         .iter()
@@ -356,8 +356,8 @@ pub fn integrate_rectangles_batch_budgeted(
 mod tests {
     use super::*;
 
-    fn abs(t: f64) -> Tolerance {
-        Tolerance {
+    fn abs(t: f64) -> AccuracyGoal {
+        AccuracyGoal {
             absolute: t,
             relative: 0.0,
         }
@@ -420,7 +420,7 @@ mod tests {
             (
                 [-0.5, 0.7],
                 [0.1, 0.9],
-                Tolerance {
+                AccuracyGoal {
                     absolute: 0.0,
                     relative: 1e-10,
                 },

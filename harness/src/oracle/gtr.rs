@@ -1,4 +1,4 @@
-//! GTR (seed 004) oracles from the definition of D alone: the normalization, P2 and Λ by nested
+//! GTR (document 004) oracles from the definition of D alone: the normalization, P2 and Λ by nested
 //! harness quadrature of D_GTR(θ) = c / (π (1 + (α² − 1) cos²θ)^γ) (eq 1**), without the
 //! reference crate's closed forms, P2 or Λ routes.
 
@@ -6,7 +6,7 @@ use super::quadrature::{integrate, integrate_upper, Accuracy};
 use super::Estimate;
 use std::f64::consts::PI;
 
-/// G1⁰ of seed 004 §3.1: 2/(1 + √(1/μ² + 1)) (γ = 0: D ≡ 1/π, α-free).
+/// G1⁰ of document 004 §3.1: 2/(1 + √(1/μ² + 1)) (γ = 0: D ≡ 1/π, α-free).
 pub fn g1_gamma0(mu: f64) -> f64 {
     2.0 / (1.0 + (1.0 / (mu * mu) + 1.0).sqrt())
 }

@@ -27,7 +27,7 @@
 //!
 //! Limit: a lobe narrower than the survey's azimuthal spacing (2π/K along the arc) *and* so
 //! narrow that p underflows to 0 at every survey point can be missed — the integrals then find a
-//! mass far from 1 and the tests fail (never a silent pass). Pass `seeds` (e.g. a few sampled
+//! mass far from 1 and the tests fail (never a silent pass). Pass `start_points` (e.g. a few sampled
 //! normals) to [`measure_with`] to start the mode search there.
 
 use mfh_reference::Vec3;
@@ -105,7 +105,7 @@ pub struct Lobe {
     pub widest_azimuth: f64,
     /// The mode of the density when it is away from the pole.
     pub mode: Option<Mode>,
-    /// Further off-axis modes, climbed to from the seeds ([`Options::seeds`]) that lead
+    /// Further off-axis modes, climbed to from the start points ([`Options::start_points`]) that lead
     /// elsewhere than `mode` (a BSDF's ring of directions refracted through near-horizontal
     /// microfacets beside its refraction lobe, a lobe whose density is below the other's):
     /// the integrals are cut about each as about `mode`. At most [`MAX_EXTRA_MODES`].
@@ -124,7 +124,7 @@ pub struct Options<'a> {
     pub hint: Option<f64>,
     /// Directions where the density is known to have mass (e.g. sampled normals): extra start
     /// points of the mode search.
-    pub seeds: &'a [Vec3],
+    pub start_points: &'a [Vec3],
 }
 
 /// The direction at (θ, φ) about +z (φ from +x).
@@ -152,12 +152,12 @@ pub fn measure_density(p: &(dyn Fn(Vec3) -> f64 + Sync)) -> Lobe {
     measure_with(p, &Options::default())
 }
 
-/// [`measure_density`] with a hint and seeds.
+/// [`measure_density`] with a hint and start points.
 pub fn measure_with(p: &(dyn Fn(Vec3) -> f64 + Sync), options: &Options<'_>) -> Lobe {
     if let Some(h) = options.hint.filter(|h| h.is_finite() && *h > 0.0) {
         let lo = (h * 1e-3).max(THETA_MIN);
         let hi = (h * 1e3).min(FRAC_PI_2);
-        let lobe = survey(p, lo, hi, 48, options.seeds);
+        let lobe = survey(p, lo, hi, 48, options.start_points);
         // A scale on the window's edge (or none at all) may be a lobe outside it.
         let ratio = (hi / lo).powf(1.0 / 47.0);
         let inside = lobe.theta_scale.iter().all(|&s| {
@@ -166,11 +166,11 @@ pub fn measure_with(p: &(dyn Fn(Vec3) -> f64 + Sync), options: &Options<'_>) -> 
         if inside && lobe.theta_scale.iter().any(|s| s.is_finite()) {
             return lobe;
         }
-        let mut full = survey(p, THETA_MIN, FRAC_PI_2, THETA_STEPS, options.seeds);
+        let mut full = survey(p, THETA_MIN, FRAC_PI_2, THETA_STEPS, options.start_points);
         full.evaluations += lobe.evaluations;
         return full;
     }
-    survey(p, THETA_MIN, FRAC_PI_2, THETA_STEPS, options.seeds)
+    survey(p, THETA_MIN, FRAC_PI_2, THETA_STEPS, options.start_points)
 }
 
 /// [`measure_with`] for a batch density (`p(m, out)` writes p(m\[i\]) into out\[i\]): the survey
@@ -244,7 +244,7 @@ fn survey(
     lo: f64,
     hi: f64,
     steps: usize,
-    seeds: &[Vec3],
+    start_points: &[Vec3],
 ) -> Lobe {
     let mut evaluations = 0u64;
     let log_lo = lo.ln();
@@ -308,7 +308,7 @@ fn survey(
         narrowest = (FALLBACK_WIDTH, 0.0);
         widest = (FALLBACK_WIDTH, 0.0);
     }
-    for &m in seeds {
+    for &m in start_points {
         if m.iter().all(|c| c.is_finite()) && m[2] >= 0.0 {
             let (t, phi) = angles(m);
             let v = clean(p, t, phi);
@@ -328,10 +328,10 @@ fn survey(
             mode = Some(m);
         }
     }
-    // The seeds that climb elsewhere: further modes.
+    // The start points that climb elsewhere: further modes.
     let mut extra_modes: Vec<Mode> = Vec::new();
     let mut starts: Vec<(f64, f64, f64)> = Vec::new();
-    for &m in seeds {
+    for &m in start_points {
         if m.iter().all(|c| c.is_finite()) && m[2] >= 0.0 {
             let (t, phi) = angles(m);
             let v = clean(p, t, phi);

@@ -5,7 +5,7 @@
 //! directions refracted through the least tilted microfacets that still transmit.
 //!
 //! The whole-sphere integrals of a BSDF's pdf and eval start their lobe measurement there
-//! ([`crate::oracle::lobe::Options::seeds`]): a lobe narrower than the survey's spacing — a
+//! ([`crate::oracle::lobe::Options::start_points`]): a lobe narrower than the survey's spacing — a
 //! conductor at α 1e-4 off the surveyed azimuths, a reflection or transmission lobe at α 1e-7,
 //! or the transmission lobe of η → 1, whose width in wo is about α·|η − 1| — is otherwise found
 //! only where a survey point happens to fall on it, and its cells integrate to 0 with a bound

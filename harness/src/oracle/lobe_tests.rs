@@ -122,7 +122,7 @@ fn lobe_anisotropic_1_to_100() {
 #[test]
 fn lobe_off_axis_gaussian_slopes() {
     // Slopes N((0.5, −0.2), diag(0.01, 0.0004)): the mode of D cos θ is near tan θ = |s̄|,
-    // φ = atan2(0.2, −0.5) (the slope sign of seed 002 eq 11: m ∝ (−s̄x, −s̄y, 1)).
+    // φ = atan2(0.2, −0.5) (the slope sign of document 002 eq 11: m ∝ (−s̄x, −s̄y, 1)).
     let json = r#"{"family":"gaussian_slopes","mean":[0.5,-0.2],"cov":[[0.01,0.0],[0.0,0.0004]]}"#;
     let l = lobe_of(json);
     let m = model(json);
@@ -197,7 +197,7 @@ fn lobe_hint_speeds_up_and_never_misleads() {
         &p,
         &Options {
             hint: Some(1e-3),
-            seeds: &[],
+            start_points: &[],
         },
     );
     assert!(close(hinted.narrowest, full.narrowest, 0.02), "{hinted:?}");
@@ -207,16 +207,16 @@ fn lobe_hint_speeds_up_and_never_misleads() {
         &p,
         &Options {
             hint: Some(1e-7),
-            seeds: &[],
+            start_points: &[],
         },
     );
     assert!(close(wrong.narrowest, full.narrowest, 1e-12), "{wrong:?}");
 }
 
 #[test]
-fn lobe_seeds_find_a_lobe_the_survey_misses() {
+fn lobe_start_points_find_a_lobe_the_survey_misses() {
     // A narrow off-axis lobe (slope σ = 1e-3) half-way between two surveyed azimuths: p
-    // underflows to 0 at every survey point; one seed in the lobe finds it.
+    // underflows to 0 at every survey point; one start point in the lobe finds it.
     let json = r#"{"family":"gaussian_slopes","mean":[0.4,0.08],"cov":[[1e-6,0.0],[0.0,1e-6]]}"#;
     let m = model(json);
     let p = |v: Vec3| m.d(v) * v[2];
@@ -230,11 +230,11 @@ fn lobe_seeds_find_a_lobe_the_survey_misses() {
         &p,
         &Options {
             hint: None,
-            seeds: &[centre],
+            start_points: &[centre],
         },
     );
     eprintln!("blind {:?}\nseeded {:?}", blind.mode, seeded.mode);
-    let mode = seeded.mode.expect("found from the seed");
+    let mode = seeded.mode.expect("found from the start point");
     assert!(
         (mode.theta - 0.4f64.hypot(0.08).atan()).abs() < 1e-3,
         "{mode:?}"

@@ -20,7 +20,7 @@
 //! p-value, `components.rs` the statistic's smooth and remaining parts). A BSDF's chi-square
 //! over the whole sphere: `sphere_chi2.rs`, its masses by the globally adaptive cubature of
 //! `cubature/global.rs` (for densities with steps), its cells found by `sphere_finder.rs`. The
-//! cell grids: `domain.rs` (its cell finder runs under the batch samplers' SIMD dispatch), with
+//! cell grids: `hemisphere_grid.rs` (its cell finder runs under the batch samplers' SIMD dispatch), with
 //! the branch-free edge search of `edge_table.rs`. The KS test: `ks/`. Where a density's lobe
 //! is, from the density alone: `lobe.rs`; the chi-square and KS oracles also cut their
 //! integrals at the polar kinks a reference family states (`FamilySpec::theta_kinks`, passed
@@ -30,10 +30,10 @@
 
 pub mod chi2;
 pub mod cubature;
-pub mod domain;
 pub mod double_exponential;
 mod edge_table;
 pub mod gtr;
+pub mod hemisphere_grid;
 pub mod ks;
 pub mod lobe;
 pub mod lobe_centres;

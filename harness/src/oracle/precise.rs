@@ -4,7 +4,7 @@
 //!
 //! # What is computed
 //!
-//! Λ is the Smith integral of the slope marginal (seed 001 eq 5, with P2 of eq 15):
+//! Λ is the Smith integral of the slope marginal (document 001 eq 5, with P2 of eq 15):
 //!
 //! ```text
 //! Λ(θ) = (1/μ) ∫_μ^∞ (q − μ) P2(q) dq,   μ = cot θ
@@ -34,7 +34,7 @@
 //! 1/N_C = (1/(C − 1)) ∫₀¹ (1 − w^{1/(C−1)})^{−1/2} dw. Every difference that could cancel
 //! (t − x, 1 − w^m) is formed as expm1 / ln1p of the node's exact distance to its end point.
 //!
-//! D (seed 001 eq 2, 10, and Table 1) is elementary and evaluated directly in double-double,
+//! D (document 001 eq 2, 10, and Table 1) is elementary and evaluated directly in double-double,
 //! at the direction m/|m|.
 //!
 //! # Precision claim and how it is certified
@@ -203,11 +203,11 @@ impl Certified {
 /// The families the precise path covers.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Family {
-    /// Beckmann (seed 001, Table 1, γ → ∞).
+    /// Beckmann (document 001, Table 1, γ → ∞).
     Beckmann,
-    /// GGX (seed 001, Table 1, γ = 2).
+    /// GGX (document 001, Table 1, γ = 2).
     Ggx,
-    /// STD with shape γ (seed 001, §1.1: C = γ, s = α √(γ − 1)).
+    /// STD with shape γ (document 001, §1.1: C = γ, s = α √(γ − 1)).
     Std {
         /// The shape γ ∈ (1, 1e8] (Λ needs γ > 3/2).
         gamma: f64,
@@ -338,7 +338,7 @@ impl PreciseModel {
         }
     }
 
-    /// Smith Λ(w) for w in the upper hemisphere (seed 001 eq 5): 0 at normal incidence, an
+    /// Smith Λ(w) for w in the upper hemisphere (document 001 eq 5): 0 at normal incidence, an
     /// error at or below the horizon.
     pub fn lambda(&self, w: Vec3) -> Result<Certified, PreciseError> {
         let mu = cotangent(w)?;
@@ -397,7 +397,7 @@ impl PreciseModel {
         }
     }
 
-    /// D(m) (seed 001 eq 2, 10; Table 1), at the unit direction m/|m|; 0 below the horizon.
+    /// D(m) (document 001 eq 2, 10; Table 1), at the unit direction m/|m|; 0 below the horizon.
     pub fn d(&self, m: Vec3) -> Result<Certified, PreciseError> {
         if !m.iter().all(|v| v.is_finite()) || m == [0.0; 3] {
             return Err(PreciseError::Direction {
@@ -458,7 +458,7 @@ fn ln_of_node(w: DoubleDouble, complement: DoubleDouble) -> DoubleDouble {
     }
 }
 
-/// N_C = Γ(C − ½)/(√π Γ(C − 1)) of seed 001 eq 15, from its definition as a normalization:
+/// N_C = Γ(C − ½)/(√π Γ(C − 1)) of document 001 eq 15, from its definition as a normalization:
 /// 1/N_C = ∫ (1 + t²)^{½ − C} dt = B(C − 1, ½) = (1/(C − 1)) ∫₀¹ (1 − w^m)^{−½} dw,
 /// m = 1/(C − 1), C ∈ (1, 1e8].
 pub fn student_norm(c: f64) -> Result<Certified, PreciseError> {

@@ -1,4 +1,4 @@
-//! The oracle of Smith Λ (seed 001 eq 5; seed 000 eq 10–13; seed 004 §2): for a model with a
+//! The oracle of Smith Λ (document 001 eq 5; document 000 eq 10–13; document 004 §2): for a model with a
 //! slope distribution, (1/μ)∫_μ^∞ (q − μ) P2(q) dq by quadrature along the azimuth of w (or the
 //! Student-t partial expectation of [`crate::oracle::student_t`] for tails quadrature cannot
 //! reach); otherwise the back-facing projected area ∫⟨−w·m⟩⁺ D(m) dm / cos θ over the lune of

@@ -56,9 +56,9 @@
 use crate::oracle::chi2::cells::{self, Layout};
 use crate::oracle::chi2::components::Components;
 use crate::oracle::chi2::{
-    expected_mass_global_until, pearson_test, Chi2Config, Expected, Verdict,
+    expected_mass_global_until, pearson_test, Chi2Config, Expected, TestOutcome,
 };
-use crate::oracle::domain::HemisphereGrid;
+use crate::oracle::hemisphere_grid::HemisphereGrid;
 use crate::oracle::lobe;
 use crate::oracle::sphere_finder::SphereFinder;
 use crate::random::stream;
@@ -125,7 +125,7 @@ pub struct SphereChi2Result {
     /// The level the verdict was taken at.
     pub alpha: f64,
     /// Pass or fail.
-    pub verdict: Verdict,
+    pub verdict: TestOutcome,
     /// Why it failed (a sanity failure or the rejection), if it did.
     pub reason: Option<String>,
     /// Whether the failure is a sanity failure (no p-value).
@@ -470,7 +470,7 @@ fn expected_hemisphere_until(
         .collect();
     let options = lobe::Options {
         hint: None,
-        seeds: &seeds,
+        start_points: &seeds,
     };
     let lobe = lobe::measure_with_batch(&mirrored, &options);
     let (grid, placed) = match cells {
@@ -734,7 +734,7 @@ pub fn sphere_chi2_against(
         p_value: 0.0,
         components: None,
         alpha: config.alpha,
-        verdict: Verdict::Fail,
+        verdict: TestOutcome::Fail,
         reason: None,
         sanity_failure: true,
         samples: config.samples,
@@ -775,7 +775,7 @@ pub fn sphere_chi2_against(
         result.statistic = 0.0;
         result.dof = 0;
         result.p_value = 1.0;
-        result.verdict = Verdict::Pass;
+        result.verdict = TestOutcome::Pass;
         return result;
     };
     result.sanity_failure = false;
@@ -784,7 +784,7 @@ pub fn sphere_chi2_against(
     result.components = test.components;
     result.p_value = test.p_value;
     result.verdict = test.verdict;
-    if test.verdict == Verdict::Fail {
+    if test.verdict == TestOutcome::Fail {
         result.reason = Some(format!(
             "p-value {:.3e} below α = {:.3e}",
             result.p_value, config.alpha
@@ -832,7 +832,7 @@ fn no_success(r: &mut SphereChi2Result) {
     r.dof = 0;
     r.p_value = p;
     if p >= r.alpha {
-        r.verdict = Verdict::Pass;
+        r.verdict = TestOutcome::Pass;
     } else {
         r.reason = Some(format!(
             "every one of {} samples failed against a pdf mass of {:.3e} (± {:.1e}): p {p:.3e} \
@@ -853,7 +853,7 @@ fn sanity(r: &SphereChi2Result) -> Option<String> {
             "{} sampled directions are non-finite or not of unit length (within {}); the \
              first, sample {index}: {w:?}",
             o.invalid,
-            crate::oracle::domain::UNIT_TOLERANCE
+            crate::oracle::hemisphere_grid::UNIT_TOLERANCE
         ));
     }
     let masses = r.expected_upper.mass.iter().chain(&r.expected_lower.mass);
@@ -895,7 +895,7 @@ mod sphere_mass_tests;
 mod tests {
     use super::*;
     use crate::check::bsdf::pdf_at;
-    use crate::oracle::domain::CellFinder;
+    use crate::oracle::hemisphere_grid::CellFinder;
 
     /// The reference GGX dielectric at grazing incidence (cos θi = 0.05), whose pdf steps where
     /// half vectors cross the horizon: the masses for a chi-square of 10⁶ samples meet the

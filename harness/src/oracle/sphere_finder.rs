@@ -22,16 +22,16 @@
 //! Counted by [`EdgeTable`]s with the margins of [`CellFinder::cells_of`] ([`ROW_MARGIN`],
 //! [`COLUMN_MARGIN`]), a clear count is the count of every value within the margin — of z / |m|,
 //! which the grids compare, and of the true azimuth, within the estimate's error bound — so it
-//! is the cell [`CellFinder::cell_of`] finds; the rest (outside the domain, near an edge or the
+//! is the cell [`CellFinder::cell_of`] finds; the rest (not a unit direction, near an edge or the
 //! pole) go through it. A grid without given edges (equal-area) counts its edges k/R and
 //! 2πj/2R the same way. Either way the cell is a function of the direction alone, whatever the
 //! block, the thread or the dispatch path (tested).
 
-use crate::oracle::domain::{
-    accepted_squared_lengths, approximate_azimuth, finish_cells, CellFinder, DomainError,
+use crate::oracle::edge_table::EdgeTable;
+use crate::oracle::hemisphere_grid::{
+    accepted_squared_lengths, approximate_azimuth, finish_cells, CellFinder, DirectionError,
     HemisphereGrid, COLUMN_MARGIN, FIND_BLOCK, POLE_CLEARANCE, ROW_MARGIN,
 };
-use crate::oracle::edge_table::EdgeTable;
 use mfh_reference::bsdf::Directions;
 use mfh_reference::geometry::Vec3;
 use std::f64::consts::{PI, TAU};
@@ -98,8 +98,8 @@ impl SphereFinder {
 
     /// The cell of a direction: the upper grid's for z ≥ 0, the lower grid's (of (x, y, −z),
     /// after the upper's) for z < 0 or NaN, as [`CellFinder::cell_of`] finds them; or why it
-    /// is not in the domain.
-    pub fn cell_of(&self, w: Vec3) -> Result<usize, DomainError> {
+    /// is not a unit direction.
+    pub fn cell_of(&self, w: Vec3) -> Result<usize, DirectionError> {
         if w[2] >= 0.0 {
             self.upper.cell_of(w)
         } else {
@@ -110,7 +110,7 @@ impl SphereFinder {
 
     /// The cells of a block of sampled directions: `cells[k]` is [`SphereFinder::cell_of`]
     /// of `w[k]`, or [`SphereFinder::failed_cell`] where it is `None`; returns whether every
-    /// direction was in the domain (if not, the cells of those outside are unspecified:
+    /// direction was a unit direction (if not, the cells of those outside are unspecified:
     /// callers redo the block one by one for the errors). One vectorized pass (see the module
     /// documentation) through `pulp`'s safe runtime dispatch.
     ///

@@ -1,9 +1,9 @@
-//! The Student-t partial expectation: an oracle of Λ for the Student-t slope family (seed 001)
+//! The Student-t partial expectation: an oracle of Λ for the Student-t slope family (document 001)
 //! that needs no quadrature, for shapes where quadrature cannot reach the tail.
 //!
 //! Near γ = 3/2 the integrand (q − μ)P2(q) of Λ decays like q^{−1−2(C−3/2)}: at C = 3/2 + 1e-9
 //! half of Λ lies beyond q ≈ e^{3e8}, out of reach of any substitution in double precision.
-//! The slope marginal is a scaled Student-t, q = σX with X ~ t_ν, ν = 2C − 2 (seed 001 eq 15:
+//! The slope marginal is a scaled Student-t, q = σX with X ~ t_ν, ν = 2C − 2 (document 001 eq 15:
 //! P2 ∝ (1 + (q/s)²)^{1/2 − C}), and E[(X − k)⁺] = (ν + k²)/(ν − 1) f_ν(k) − k(1 − F_ν(k)),
 //! with f_ν and F_ν from `statrs` (regularized incomplete beta): independent of the ₂F₁
 //! routes of the reference, and exact in the 1/(ν − 1) = 1/(2C − 3) blow-up.

@@ -4,7 +4,7 @@
 //! ([`lobe::measure`]); a sampler of α off by 5 % still fails. The CI subset is the extremes
 //! (α = 1e-4 and 2 isotropic, and GGX 1e-4 : 1e-2); `MFH_EXTENSIVE=1` runs all 36.
 
-use super::chi2::{chi2_test_in, Chi2Config, Verdict};
+use super::chi2::{chi2_test_in, Chi2Config, TestOutcome};
 use super::ks::{ks_test_lobe, KsConfig, Marginal};
 use super::lobe::{self, Lobe};
 use super::quadrature::{integrate_hemisphere_lobe, Accuracy};
@@ -111,11 +111,11 @@ fn run(json: &str, sampler_json: &str, seed: u64) -> Row {
     Row {
         json: json.to_string(),
         chi2_p: chi2.p_value,
-        chi2_pass: chi2.verdict == Verdict::Pass,
+        chi2_pass: chi2.verdict == TestOutcome::Pass,
         ks_p: [ks[0].p_value, ks[1].p_value],
         ks_pass: [
-            ks[0].verdict == Verdict::Pass,
-            ks[1].verdict == Verdict::Pass,
+            ks[0].verdict == TestOutcome::Pass,
+            ks[1].verdict == TestOutcome::Pass,
         ],
         normalization_error: (norm.value - 1.0).abs(),
         normalization_bound: norm.error_bound,

@@ -1,8 +1,8 @@
-//! The visible-slope moments of a Gaussian slope distribution (seed 002's D_s) by harness
-//! cubature of their definition, D_s ∝ p_s(s)(w_z − s·w_xy)⁺: the one oracle of seed 002's
+//! The visible-slope moments of a Gaussian slope distribution (document 002's D_s) by harness
+//! cubature of their definition, D_s ∝ p_s(s)(w_z − s·w_xy)⁺: the one oracle of document 002's
 //! closed forms and its pseudocode (`check::ds`, `check::errata`, `mfh cost`).
 
-use super::cubature::{integrate_rectangle, Tolerance as CubatureTolerance};
+use super::cubature::{integrate_rectangle, AccuracyGoal};
 use super::Estimate;
 use mfh_reference::geometry::from_spherical;
 use mfh_reference::slopes::gaussian::GaussianSlopes;
@@ -73,7 +73,7 @@ pub fn z0(mean: [f64; 2], cov: [[f64; 2]; 2], w: Vec3) -> f64 {
 }
 
 /// The mean and covariance of D_s seen from `w`, by 2-D adaptive cubature of their definitions
-/// (seed 002, eq 16, 19–23), with p_s of eq 1 written in the frame that factorizes it (the
+/// (document 002, eq 16, 19–23), with p_s of eq 1 written in the frame that factorizes it (the
 /// marginal of s_o times the conditional of s_⊥; evaluating the model's own p22 there instead
 /// adds rounding noise of ~1e-12 across the thin direction of a near-singular Σ, which the
 /// cubature then chases to its depth limit):
@@ -127,7 +127,7 @@ pub fn oracle(mean: [f64; 2], cov: [[f64; 2]; 2], w: Vec3) -> Result<Oracle, Str
             &|u, t| f(u, t),
             [lo, hi],
             [-WINDOW, WINDOW],
-            CubatureTolerance {
+            AccuracyGoal {
                 absolute,
                 relative: 1e-11,
             },

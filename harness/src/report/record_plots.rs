@@ -218,7 +218,7 @@ struct LambdaPoint {
 }
 
 /// Λ of the model against the oracle over θ (one series per route and φ), with the relative
-/// error on a log axis below; then G1 = 1/(1 + Λ) (seed 001 eq 16) of the same records,
+/// error on a log axis below; then G1 = 1/(1 + Λ) (document 001 eq 16) of the same records,
 /// likewise. Each route is a curve on a dense θ grid ([`model_curve`]; the records' points
 /// joined where the model cannot be built), the oracle's values are dots at the records' θ,
 /// and in the error panel the records that failed, or failed as expected, are crosses of

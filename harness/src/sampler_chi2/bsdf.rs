@@ -236,7 +236,7 @@ mod tests {
         let result = run(&plan);
         assert_eq!(
             result.verdict,
-            crate::oracle::chi2::Verdict::Pass,
+            crate::oracle::chi2::TestOutcome::Pass,
             "{:?}",
             result.reason
         );

@@ -114,7 +114,7 @@ pub enum Defect {
     },
     /// D_s: the cross covariance dropped (cov_xy = 0).
     DsCrossDropped,
-    /// D_s: E₁ with its sign flipped (seed 002 eq 59 as printed, through eq 61–69).
+    /// D_s: E₁ with its sign flipped (document 002 eq 59 as printed, through eq 61–69).
     DsE1Flipped,
     /// D_s: the mean multiplied by 1 + `e`.
     DsMeanScale {
@@ -129,7 +129,7 @@ pub enum Defect {
     },
 }
 
-/// The SG vector product G₁ ⊗ G₂ (seed 003 §1) with `defect` applied.
+/// The SG vector product G₁ ⊗ G₂ (document 003 §1) with `defect` applied.
 pub fn sg_product(a: &Sg, b: &Sg, defect: Defect) -> Sg {
     let p = a.product(b);
     match defect {

@@ -14,14 +14,14 @@
 //! (the point reflection, which equals the mirror (w_x, w_y, −w_z) for the centrally symmetric
 //! NDFs — all elliptic ones — and is the right one for those with a mean slope). With it
 //! (Walter 2007 eq 23, and the Smith G1 and G2 of Heitz 2014, "Understanding the
-//! masking-shadowing function in microfacet-based BRDFs", JCGT 3(2), §5 and §6, as seed 001
+//! masking-shadowing function in microfacet-based BRDFs", JCGT 3(2), §5 and §6, as document 001
 //! eq 16, 22 and 23 print them for reflection):
 //!
 //! ```text
 //! G1(w, m)         = χ⁺((w·m)/(w·n)) / (1 + Λ(w⁺))
-//! G2 uncorrelated  = G1(wi, m) G1(wo, m)              (Walter eq 23; seed 001 eq 22)
+//! G2 uncorrelated  = G1(wi, m) G1(wo, m)              (Walter eq 23; document 001 eq 22)
 //! G2 height-corr.  = χ⁺((wi·m)/(wi·n)) χ⁺((wo·m)/(wo·n)) / (1 + Λ(wi⁺) + Λ(wo⁺))
-//!                                                      (Heitz 2014 §6; seed 001 eq 23)
+//!                                                      (Heitz 2014 §6; document 001 eq 23)
 //! ```
 //!
 //! The height-correlated form is used for refraction too, as pbrt-v4 does. Heitz 2014 §6.2
@@ -36,7 +36,7 @@
 //!   wi⁺·m ≤ 0 (back-facing, which no refraction or reflection of wi can use) fails.
 //! - [`Sampling::VisibleNormals`]: m ∼ D_{wi⁺}(m) = G1(wi⁺, m)⟨wi⁺·m⟩ D(m)/(wi⁺·n) (Heitz &
 //!   d'Eon 2014, eq 2; the NDF's `sample_wm_visible` at wi⁺).
-//! - [`Sampling::PseudoVnis`]: seed 001 §7.2's pseudo-VNIS for the STD (Algorithm 1 picks GGX's
+//! - [`Sampling::PseudoVnis`]: document 001 §7.2's pseudo-VNIS for the STD (Algorithm 1 picks GGX's
 //!   or Beckmann's visible normals, or the STD's own normals, with the STD's roughness;
 //!   `ndf::student_vnis`), with the density of the proxy it picked in closed form, so that the
 //!   BSDF's weight eval/pdf is unbiased (not eq 43's printed G2/G1, which assumes the STD's own
@@ -58,7 +58,7 @@ pub enum Sampling {
     /// m ∼ the distribution of normals visible from wi⁺ (Heitz & d'Eon 2014).
     #[default]
     VisibleNormals,
-    /// Seed 001 §7.2's pseudo-VNIS (STD only).
+    /// Document 001 §7.2's pseudo-VNIS (STD only).
     PseudoVnis,
 }
 

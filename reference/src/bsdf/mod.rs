@@ -1,6 +1,6 @@
 //! Reference microfacet BSDFs: a rough conductor (reflection only) and a rough dielectric
 //! (reflection and refraction) after Walter, Marschner, Li & Torrance 2007, "Microfacet models
-//! for refraction through rough surfaces" (EGSR 2007; seed 001 cites it as \[13\]; "Walter" below),
+//! for refraction through rough surfaces" (EGSR 2007; document 001 cites it as \[13\]; "Walter" below),
 //! built on any NDF that has a Smith Λ, and the [`Bsdf`] capability a renderer's own BSDF
 //! implements to be audited the same way.
 //!
@@ -79,7 +79,7 @@
 //! - [`fresnel`]: exact dielectric Fresnel (Walter eq 22), exact conductor Fresnel of a complex
 //!   index, Schlick's approximation.
 //! - [`microfacet`]: D, the Smith G1/G2 of both hemispheres, and the samplers of microfacet
-//!   normals (by normals, by visible normals, seed 001's pseudo-VNIS) with their densities.
+//!   normals (by normals, by visible normals, document 001's pseudo-VNIS) with their densities.
 //! - [`conductor`] and [`dielectric`]: the BSDFs.
 //! - [`spec`]: the serde description `{"bsdf": "dielectric", "eta": 1.5, "ndf": {...}, …}`,
 //!   validated with typed errors, built into `Arc<dyn Bsdf>`.

@@ -4,8 +4,8 @@
 //! harness's `errata.printed_formula` demonstrations both evaluate these functions, so each
 //! printed formula is written once.
 
-pub mod seed000;
-pub mod seed001;
-pub mod seed002;
-pub mod seed003;
-pub mod seed004;
+pub mod document000;
+pub mod document001;
+pub mod document002;
+pub mod document003;
+pub mod document004;

@@ -1,4 +1,4 @@
-//! The angular profile of seed 000 (eq 4): an isotropic D_iso(θ) given by its values at
+//! The angular profile of document 000 (eq 4): an isotropic D_iso(θ) given by its values at
 //! breakpoints, the data a piecewise-linear NDF (`ndf::piecewise`) is built from. Named for
 //! what it is, a function of the polar angle (the audit's check profiles are another thing).
 
@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
 
 /// An isotropic profile D_iso(θ) given by its values at breakpoints θ₀ = 0 < θ₁ < … < θₙ = π/2
-/// (seed 000, eq 4), linear in between. The values need not be normalized: the model divides
+/// (document 000, eq 4), linear in between. The values need not be normalized: the model divides
 /// them by c_iso (eq 5).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -39,7 +39,7 @@ impl AngularProfile {
         Self { theta, value }
     }
 
-    /// An isotropic NDF discretized at `n` equally spaced breakpoints (seed 000 §1.2: "D_x and
+    /// An isotropic NDF discretized at `n` equally spaced breakpoints (document 000 §1.2: "D_x and
     /// D_y can be discretized from any common NDFs"). `d_of_theta` gives D(θ).
     pub fn discretize(d_of_theta: &dyn Fn(f64) -> f64, n: usize) -> Self {
         let grid = Self::uniform(vec![0.0; n]).theta;

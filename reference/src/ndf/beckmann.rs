@@ -1,4 +1,4 @@
-//! The Beckmann NDF, isotropic and anisotropic: the γ → ∞ limit of STD (seed 001, §2, Table 1).
+//! The Beckmann NDF, isotropic and anisotropic: the γ → ∞ limit of STD (document 001, §2, Table 1).
 
 use crate::error::{ParamError, QueryError};
 use crate::family::{resolve_roughness, roughness_fields, FamilyInfo, FamilySpec, SamplerCost};
@@ -12,7 +12,7 @@ pub use crate::spec::BeckmannSpec;
 use crate::spec::ModelSpec;
 use std::f64::consts::PI;
 
-/// Beckmann NDF with roughness `alpha_x`, `alpha_y` (seed 001, Table 1, row γ → ∞):
+/// Beckmann NDF with roughness `alpha_x`, `alpha_y` (document 001, Table 1, row γ → ∞):
 ///
 /// ```text
 /// D(m)   = exp(−tan²θ (cos²φ/αx² + sin²φ/αy²)) / (π αx αy cos⁴θ)
@@ -57,7 +57,7 @@ impl Beckmann {
         crate::special::student_tail::beckmann_lambda(a)
     }
 
-    /// Seed 001, Table 1, row γ → ∞, evaluated as printed:
+    /// Document 001, Table 1, row γ → ∞, evaluated as printed:
     /// `½ (σ e^{−μ²/σ²}/(μ √π) + erf(μ/σ) − 1)` with a = μ/σ. Correct, but it subtracts
     /// nearly equal numbers near normal incidence (kept to measure that loss).
     pub fn lambda_table1(a: f64) -> f64 {
@@ -119,7 +119,7 @@ impl Smith for Beckmann {
 }
 
 impl NormalSampler for Beckmann {
-    /// Slope-space inversion (seed 001, eq 40 with the quadrant fixed, and eq 42 in the limit
+    /// Slope-space inversion (document 001, eq 40 with the quadrant fixed, and eq 42 in the limit
     /// γ → ∞): φ from u1 and tan²θ A(φ) = −ln(1 − u2).
     fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
         let (dx, dy) = elliptic_direction(self.alpha_x, self.alpha_y, u[0]);
@@ -148,7 +148,7 @@ impl NormalSampler for Beckmann {
 impl VisibleNormalSampler for Beckmann {
     /// Heitz & d'Eon 2014, "Importance Sampling Microfacet-Based BSDFs using the Distribution of
     /// Visible Normals", CGF 33(4), §4 and supplement (not one of the five source documents;
-    /// seed 001 §7 cites it as \[9\]), with the visible-slope cdf inverted numerically as in Jakob
+    /// document 001 §7 cites it as \[9\]), with the visible-slope cdf inverted numerically as in Jakob
     /// 2014, "An Improved Visible Normal Sampling Routine for the Beckmann Distribution":
     /// stretch `wi` to unit roughness, at polar angle θ and azimuth φ; draw the slope x̃ along
     /// the incidence plane from the visible-slope density and ỹ across it from the Gaussian
@@ -257,7 +257,7 @@ impl SlopeDistribution for Beckmann {
         (-(q / s).powi(2)).exp() / (s * PI.sqrt())
     }
 
-    /// ν₂ₖ = α(φ)^{2k} Γ(k + ½)/√π = α(φ)^{2k} (2k−1)!!/2^k (the γ → ∞ limit of seed 001 eq 7).
+    /// ν₂ₖ = α(φ)^{2k} Γ(k + ½)/√π = α(φ)^{2k} (2k−1)!!/2^k (the γ → ∞ limit of document 001 eq 7).
     fn slope_moment(&self, k: u32, phi: f64) -> Option<f64> {
         let s2 = scale_along(self.alpha_x, self.alpha_y, phi).powi(2);
         Some((1..=k).fold(1.0, |acc, j| acc * s2 * (2 * j - 1) as f64 / 2.0))

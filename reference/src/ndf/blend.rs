@@ -1,4 +1,4 @@
-//! Eq 1 of seed 000 (Ribardière et al., "A Piecewise-Linear NDF") applied to two analytic
+//! Eq 1 of document 000 (Ribardière et al., "A Piecewise-Linear NDF") applied to two analytic
 //! isotropic NDFs, e.g. GGX along x and Beckmann along y.
 
 use crate::error::{ParamError, QueryError};
@@ -14,7 +14,7 @@ use crate::spec::ModelSpec;
 /// at small θ converge faster with a few fixed cuts.
 const CUTS: [f64; 7] = [0.01, 0.03, 0.1, 0.3, 0.6, 1.0, 1.3];
 
-/// The anisotropic blend of two normalized isotropic NDFs (seed 000, eq 1–3):
+/// The anisotropic blend of two normalized isotropic NDFs (document 000, eq 1–3):
 ///
 /// ```text
 /// D(m) = (cos²φ D_x(θ) D_y(0) + sin²φ D_y(θ) D_x(0)) / c,   c = (D_x(0) + D_y(0)) / 2
@@ -186,7 +186,7 @@ impl Model for Blend {
 }
 
 impl BlendSpec {
-    /// The registry entry of the blend of seed 000 eq 1 ([`crate::registry`], which finds it through the spec type).
+    /// The registry entry of the blend of document 000 eq 1 ([`crate::registry`], which finds it through the spec type).
     pub const INFO: FamilyInfo = FamilyInfo {
         name: "blend",
         documents: &["000"],

@@ -44,7 +44,7 @@ pub fn p2_marginal(slopes: &dyn SlopeDistribution, q: f64, phi: f64, scale: f64)
     integrate_line(&f, scale, 1e-13)
 }
 
-/// Smith Λ(w) from its definition (seed 001 eq 17): (1/μ) ∫_μ^∞ (q − μ) P2(q) dq, μ = cot θ,
+/// Smith Λ(w) from its definition (document 001 eq 17): (1/μ) ∫_μ^∞ (q − μ) P2(q) dq, μ = cot θ,
 /// with P2 along the azimuth of w.
 pub fn lambda_integral(slopes: &dyn SlopeDistribution, w: Vec3, scale: f64) -> f64 {
     let sin_theta = (w[0] * w[0] + w[1] * w[1]).sqrt();

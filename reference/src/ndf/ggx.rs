@@ -1,4 +1,4 @@
-//! The GGX (Trowbridge–Reitz) NDF, isotropic and anisotropic: STD at γ = 2 (seed 001, Table 1).
+//! The GGX (Trowbridge–Reitz) NDF, isotropic and anisotropic: STD at γ = 2 (document 001, Table 1).
 
 use crate::error::{ParamError, QueryError};
 use crate::family::{resolve_roughness, roughness_fields, FamilyInfo, FamilySpec, SamplerCost};
@@ -13,7 +13,7 @@ pub use crate::spec::GgxSpec;
 use crate::spec::ModelSpec;
 use std::f64::consts::PI;
 
-/// GGX NDF with roughness `alpha_x`, `alpha_y` (seed 001, Table 1, row γ = 2):
+/// GGX NDF with roughness `alpha_x`, `alpha_y` (document 001, Table 1, row γ = 2):
 ///
 /// ```text
 /// D(m)   = 1 / (π αx αy cos⁴θ (1 + tan²θ (cos²φ/αx² + sin²φ/αy²))²)
@@ -47,7 +47,7 @@ impl Ggx {
         1.0 / (2.0 * a * a + 2.0 * a * (a * a + 1.0).sqrt())
     }
 
-    /// Seed 001, Table 1, row γ = 2, evaluated as printed: ½ (√(μ² + σ²)/μ − 1) with
+    /// Document 001, Table 1, row γ = 2, evaluated as printed: ½ (√(μ² + σ²)/μ − 1) with
     /// a = μ/σ, i.e. ½ (√(1 + 1/a²) − 1). Correct; loses relative accuracy as a grows.
     pub fn lambda_table1(a: f64) -> f64 {
         0.5 * ((1.0 + 1.0 / (a * a)).sqrt() - 1.0)
@@ -104,7 +104,7 @@ impl Smith for Ggx {
 }
 
 impl NormalSampler for Ggx {
-    /// Slope-space inversion (seed 001, eq 40 with the quadrant fixed, eq 42 at γ = 2):
+    /// Slope-space inversion (document 001, eq 40 with the quadrant fixed, eq 42 at γ = 2):
     /// tan²θ A(φ) = u2 / (1 − u2).
     fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
         let (dx, dy) = elliptic_direction(self.alpha_x, self.alpha_y, u[0]);
@@ -183,14 +183,14 @@ impl SlopeDistribution for Ggx {
         1.0 / (PI * self.alpha_x * self.alpha_y * t * t)
     }
 
-    /// P2(q) = 1 / (2 α(φ) (1 + q²/α(φ)²)^{3/2}) (seed 001 eq 15 at γ = 2).
+    /// P2(q) = 1 / (2 α(φ) (1 + q²/α(φ)²)^{3/2}) (document 001 eq 15 at γ = 2).
     fn p2(&self, q: f64, phi: f64) -> f64 {
         let s = scale_along(self.alpha_x, self.alpha_y, phi);
         let t = 1.0 + (q / s).powi(2);
         1.0 / (2.0 * s * t * t.sqrt())
     }
 
-    /// Only ν₀ = 1 exists (seed 001 eq 7 needs C > 1 + k with C = 2).
+    /// Only ν₀ = 1 exists (document 001 eq 7 needs C > 1 + k with C = 2).
     fn slope_moment(&self, k: u32, _phi: f64) -> Option<f64> {
         (k == 0).then_some(1.0)
     }

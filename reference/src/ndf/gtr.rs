@@ -1,4 +1,4 @@
-//! The Generalized-Trowbridge-Reitz (GTR) NDF of Burley 2012, with the Smith Λ / G1 of seed 004
+//! The Generalized-Trowbridge-Reitz (GTR) NDF of Burley 2012, with the Smith Λ / G1 of document 004
 //! (Dimov 2015) for every γ ≥ 0: isotropic, shape `gamma`, roughness `alpha`.
 
 use crate::error::{ParamError, QueryError};
@@ -15,12 +15,12 @@ use crate::spec::ModelSpec;
 use crate::special::gauss_kronrod;
 use std::f64::consts::{FRAC_PI_2, PI};
 
-/// The largest γ accepted (seed 004 §6: "values greater than 10 are impractical").
+/// The largest γ accepted (document 004 §6: "values greater than 10 are impractical").
 pub const GAMMA_MAX: f64 = 10.0;
 /// The smallest α accepted; every quantity is tested down to here.
 pub const ALPHA_MIN: f64 = 1e-4;
 
-/// The GTR NDF (seed 004 eq 1** and 4**, after Burley 2012), normalized so that
+/// The GTR NDF (document 004 eq 1** and 4**, after Burley 2012), normalized so that
 /// ∫ D(m) cos θ_m dω = 1:
 ///
 /// ```text
@@ -35,7 +35,7 @@ pub const ALPHA_MIN: f64 = 1e-4;
 ///
 /// The printed constant (1**) is 0/0 at γ = 1 and at α = 1; the evaluated form is continuous
 /// through both (its limits are (4**) and 1/π). γ = 0 is admissible: D ≡ 1/π for every α (the
-/// cosine-weighted uniform NDF, seed 004 §3.1), and so is α = 1: D ≡ 1/π for every γ.
+/// cosine-weighted uniform NDF, document 004 §3.1), and so is α = 1: D ≡ 1/π for every γ.
 ///
 /// Domain: 0 ≤ γ ≤ 10, 1e-4 ≤ α ≤ 1. Tails: P22 ~ c r⁻⁴ for every γ, so the slope mean is finite
 /// (Λ exists for every γ ≥ 0) and the slope variance diverges (logarithmically).
@@ -118,7 +118,7 @@ impl Gtr {
         self.c
     }
 
-    /// μ = cot θ of a direction (seed 004 eq 44*, signed: negative below the horizon).
+    /// μ = cot θ of a direction (document 004 eq 44*, signed: negative below the horizon).
     pub fn mu(w: Vec3) -> f64 {
         standardized_cotangent(1.0, 1.0, w)
     }

@@ -1,4 +1,4 @@
-//! The routes to Smith Λ and G1 of the GTR NDF (seed 004, Dimov 2015): the numerical default
+//! The routes to Smith Λ and G1 of the GTR NDF (document 004, Dimov 2015): the numerical default
 //! valid for every γ, the §3 closed forms for γ = 0, 1, 2, 3, 4 (rearranged without
 //! cancellation, and as printed), the §3 "implementation" G1 forms, and the §5–6 spline in γ;
 //! also D's normalization constant c, which the numerical route integrates against (the model,
@@ -12,7 +12,7 @@ use crate::error::QueryError;
 use crate::special::gauss_kronrod;
 use std::f64::consts::PI;
 
-/// The normalization constant c of D_GTR (seed 004 eq 1**, 4**) in the form
+/// The normalization constant c of D_GTR (document 004 eq 1**, 4**) in the form
 /// c = expm1(L) / (π · expm1(sL)/s), s = 1 − γ, L = log α², with the limits expm1(sL)/s → L at
 /// s = 0 (γ = 1, eq 4**) and c → 1/π at L = 0 (α = 1). No 0/0 anywhere; relative accuracy a few
 /// ulps for 0 ≤ γ ≤ 10, 1e-4 ≤ α ≤ 1.
@@ -125,7 +125,7 @@ const MU_SMALL: f64 = 1e-100;
 /// Above this μ the exact route uses Λ = cπ/(4μ²) (1 + O(γ/μ²)), exact in f64.
 const MU_LARGE: f64 = 1e9;
 
-/// The default route: Smith Λ of GTR from its definition (seed 004 eq 48*,
+/// The default route: Smith Λ of GTR from its definition (document 004 eq 48*,
 /// Λ = (1/μ) ∫_μ^∞ (q − μ) P2(q) dq with P2 = ∫ P22 dp), reduced to one integral. In polar
 /// slope coordinates (r, φ), ∫∫_{q>μ} (q − μ) P22 = 2 ∫_μ^∞ r P22(r) (√(r² − μ²) − μ acos(μ/r))
 /// dr, and with r = μ / cos ψ:
@@ -263,7 +263,7 @@ fn i_odd(alpha: f64, mu: f64) -> [f64; 3] {
     [i3, i5, i7]
 }
 
-/// Seed 004 §3.1–3.5, Λ^γ for γ = 0, 1, 2, 3, 4. The printed forms are correct (the tests check
+/// Document 004 §3.1–3.5, Λ^γ for γ = 0, 1, 2, 3, 4. The printed forms are correct (the tests check
 /// each against the integral of its printed P2); here they are rearranged so that no step
 /// cancels. With S = √(μ² + α²), S₁ = √(μ² + 1), β = 1 − α², L = ln α²:
 ///
@@ -314,7 +314,7 @@ pub fn lambda_closed_form(k: u8, alpha: f64, mu: f64) -> f64 {
     }
 }
 
-/// Seed 004 §3.1–3.5, Λ^γ evaluated exactly as printed (formulas in `lambda_closed_form`).
+/// Document 004 §3.1–3.5, Λ^γ evaluated exactly as printed (formulas in `lambda_closed_form`).
 /// Mathematically correct; the printed arithmetic subtracts nearly equal terms as μ grows
 /// (near normal incidence): e.g. Λ² = (√(μ²+α²) − μ)/(2μ) has relative error ≈ 1e-16 · 4μ²/α²,
 /// and Λ³, Λ⁴ cancel in their numerators likewise. Λ¹ is 0/0 at α = 1.
@@ -349,7 +349,7 @@ pub fn lambda_closed_form_printed(k: u8, alpha: f64, mu: f64) -> f64 {
     }
 }
 
-/// Seed 004 §3: the G1 forms "of the implementation", exactly as printed:
+/// Document 004 §3: the G1 forms "of the implementation", exactly as printed:
 ///
 /// ```text
 /// γ = 0:  G1⁰ = 2 / (1 + √(1/μ² + 1))                                         (§3.1)
@@ -400,7 +400,7 @@ pub fn g1_implementation(k: u8, alpha: f64, mu: f64) -> f64 {
     }
 }
 
-/// Seed 004 §5–6: G1 for any γ ≥ 0 by spline interpolation in γ of the closed-form G1^γ at
+/// Document 004 §5–6: G1 for any γ ≥ 0 by spline interpolation in γ of the closed-form G1^γ at
 /// γ = 0, 1, 2, 3, 4 (at the same α and μ), with γ > 4 clamped to 4 ("In the current
 /// implementation γ is clamped up to 4"):
 ///

@@ -26,7 +26,7 @@ const ALPHAS: [f64; 6] = [1e-3, 0.05, 0.3, 0.9, 0.999, 1.0];
 /// θ from near normal incidence to just above the horizon.
 const THETAS: [f64; 8] = [1e-3, 0.05, 0.3, 0.8, 1.2, 1.5, 1.57, FRAC_PI_2 - 1e-6];
 
-/// Seed 004 §3: P2^γ as printed, γ = 0…4; `literal_q2` reads the printed "4α²q2" of §3.5
+/// Document 004 §3: P2^γ as printed, γ = 0…4; `literal_q2` reads the printed "4α²q2" of §3.5
 /// literally (4α²·q·2) instead of 4α²q².
 fn p2_printed(k: u8, alpha: f64, q: f64, literal_q2: bool) -> f64 {
     let (a2, q2) = (alpha * alpha, q * q);
@@ -40,13 +40,13 @@ fn p2_printed(k: u8, alpha: f64, q: f64, literal_q2: bool) -> f64 {
         }
         2 => a2 / (2.0 * (q2 + a2).powf(1.5)),
         3 => a2 * a2 * (a2 + 4.0 * q2 + 3.0) / (4.0 * (a2 + 1.0) * (q2 + a2).powf(2.5)),
-        4 if literal_q2 => crate::errata::seed004::p2_gamma4_printed(alpha, q),
-        4 => crate::errata::seed004::p2_gamma4_corrected(alpha, q),
+        4 if literal_q2 => crate::errata::document004::p2_gamma4_printed(alpha, q),
+        4 => crate::errata::document004::p2_gamma4_corrected(alpha, q),
         _ => f64::NAN,
     }
 }
 
-/// Seed 004 §3: P22^γ as printed, γ = 0…4 (r² = p² + q²).
+/// Document 004 §3: P22^γ as printed, γ = 0…4 (r² = p² + q²).
 fn p22_printed(k: u8, alpha: f64, r2: f64) -> f64 {
     let a2 = alpha * alpha;
     match k {
@@ -63,7 +63,7 @@ fn p22_printed(k: u8, alpha: f64, r2: f64) -> f64 {
 }
 
 /// A slope distribution whose P2 is the document's printed P2^γ: the oracle for the closed
-/// forms of Λ (seed 004 eq 48* applied to the printed P2).
+/// forms of Λ (document 004 eq 48* applied to the printed P2).
 struct PrintedP2 {
     k: u8,
     alpha: f64,
@@ -127,7 +127,7 @@ fn d_is_the_printed_formula_and_p22_over_cos4() {
             }
         }
     }
-    // γ = 2 is GGX (seed 004 §3.3), D, Λ and the sampler.
+    // γ = 2 is GGX (document 004 §3.3), D, Λ and the sampler.
     for &a in &[1e-3, 0.2, 0.8] {
         let (m, ggx) = (gtr(2.0, a), Ggx::new(a, a).unwrap());
         for &theta in &[0.0, 0.3, 1.1, 1.55] {
@@ -467,7 +467,7 @@ fn report(label: &str, r: &SplineError) {
 
 #[test]
 fn spline_in_gamma_error_against_the_exact_route() {
-    // Seed 004 §5 claims "ca. 0.1 %" ("mean difference 0.001" in G1); its plots cover
+    // Document 004 §5 claims "ca. 0.1 %" ("mean difference 0.001" in G1); its plots cover
     // α ∈ (0.1, 0.5), μ ∈ (0, 5). Measured on that domain and on α ∈ [0.01, 0.99].
     let inner: Vec<f64> = (1..40)
         .map(|i| i as f64 * 0.1)
@@ -730,7 +730,7 @@ fn stable_at_the_edges_of_the_domain() {
     }
 }
 
-/// The accuracy table of seed 004: for every route, the max relative error
+/// The accuracy table of document 004: for every route, the max relative error
 /// against an independent numerical integral over a grid of γ (columns), α and θ.
 ///
 /// Oracles: Λ from its definition (eq 48*), (1/μ)∫_μ^∞ (q − μ) P2(q) dq by
@@ -799,7 +799,7 @@ mod accuracy_table {
     #[test]
     #[cfg_attr(not(mfh_extensive), ignore = "extensive tier: set MFH_EXTENSIVE=1")]
     fn accuracy_table_gtr() {
-        let mut out = ReportTable::new("seed004");
+        let mut out = ReportTable::new("document004");
         // route label, quantity compared ("Λ" or "G1").
         let rows = [
             ("exact", "Λ"),

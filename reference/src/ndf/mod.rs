@@ -1,7 +1,7 @@
 //! Normal distribution functions, one model per file.
 //!
 //! Beside the models: their Λ routes (`student_lambda.rs`, `gtr_lambda.rs`,
-//! `piecewise_lambda.rs`), seed 001's pseudo-VNIS (`student_vnis.rs`), and the batch samplers —
+//! `piecewise_lambda.rs`), document 001's pseudo-VNIS (`student_vnis.rs`), and the batch samplers —
 //! `batch.rs`, the one block loop the elliptic normal samplers (GGX, Beckmann, Student) share,
 //! each giving only its radius kernel, compiled for AVX-512 or AVX2 + FMA by `pulp`'s safe
 //! runtime dispatch where the CPU has it and bit for bit the scalar result on every path (so a

@@ -1,4 +1,4 @@
-//! The piecewise-linear NDF of seed 000 (Ribardière et al., "A Piecewise-Linear NDF"):
+//! The piecewise-linear NDF of document 000 (Ribardière et al., "A Piecewise-Linear NDF"):
 //! isotropic profiles linear between breakpoints (eq 4–5), their anisotropic blend (eq 1–3),
 //! importance sampling (eq 6–9, Algorithms 1–2); the Smith Λ routes (eq 10–34) and the model's
 //! `Smith` implementation are in `piecewise_lambda`, which builds on this file.
@@ -13,11 +13,11 @@ use crate::spec::ModelSpec;
 pub use crate::spec::PiecewiseSpec;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
-/// The default inversion tolerance of the samplers: the largest accepted |cdf(x) − ξ| (seed 000
+/// The default inversion tolerance of the samplers: the largest accepted |cdf(x) − ξ| (document 000
 /// Algorithms 1–2 print 1e-5).
 pub const DEFAULT_TOLERANCE: f64 = 1e-12;
 
-/// The piecewise-linear NDF of seed 000 with one profile (isotropic) or two (the anisotropic
+/// The piecewise-linear NDF of document 000 with one profile (isotropic) or two (the anisotropic
 /// blend of eq 1).
 ///
 /// ```text
@@ -178,7 +178,7 @@ impl PiecewiseLinear {
         0.5 * (self.kx * vx * (1.0 + cos2phi) + self.ky * vy * (1.0 - cos2phi))
     }
 
-    /// (D_x, D_y) (normalized profiles, seed 000 eq 4) at θ = π/2 − ε, given the co-angle
+    /// (D_x, D_y) (normalized profiles, document 000 eq 4) at θ = π/2 − ε, given the co-angle
     /// ε ∈ [0, π/2]: the segment's fraction is taken from its upper end,
     /// (ε − (π/2 − θᵢ₊₁))/(θᵢ₊₁ − θᵢ), so the
     /// values keep their relative accuracy where a profile vanishes at the horizon (from θ,
@@ -222,7 +222,7 @@ impl PiecewiseLinear {
         lerp(g[i], g[i + 1], t)
     }
 
-    /// The marginal cdf of φ (seed 000, eq 7):
+    /// The marginal cdf of φ (document 000, eq 7):
     ///
     /// ```text
     /// cdf(φ) = φ/2π + (D_y(0) − D_x(0)) / (4π (D_y(0) + D_x(0))) sin 2φ
@@ -235,7 +235,7 @@ impl PiecewiseLinear {
         phi / TAU + kappa * (2.0 * phi).sin() / (2.0 * TAU)
     }
 
-    /// The conditional cdf of θ given φ (seed 000, eq 8–9 corrected, ERRATA-000 E1), normalized
+    /// The conditional cdf of θ given φ (document 000, eq 8–9 corrected, ERRATA-000 E1), normalized
     /// to 1 at θ = π/2:
     ///
     /// ```text
@@ -258,7 +258,7 @@ impl PiecewiseLinear {
         (self.kx * c * c, self.ky * s * s)
     }
 
-    /// Seed 000 Algorithm 1: φ with cdf(φ) = ξ, by Newton's method safeguarded by the quadrant
+    /// Document 000 Algorithm 1: φ with cdf(φ) = ξ, by Newton's method safeguarded by the quadrant
     /// bracket [kπ/2, (k+1)π/2] (cdf(kπ/2) = k/4); a Newton step that leaves the bracket, or
     /// a vanishing derivative (κ = ±1 at the quadrant ends), falls back to bisection. Stops when
     /// |cdf(φ) − ξ| ≤ tolerance or the bracket has collapsed.
@@ -272,7 +272,7 @@ impl PiecewiseLinear {
         newton_bracketed(value, derivative, TAU * xi, &mut a, &mut c, self.tolerance)
     }
 
-    /// Seed 000 Algorithm 2 (eq 9, corrected per ERRATA-000 E1–E3): θ with cdf(θ | φ) = ξ. The
+    /// Document 000 Algorithm 2 (eq 9, corrected per ERRATA-000 E1–E3): θ with cdf(θ | φ) = ξ. The
     /// segment is found in the cumulative tables (skipping segments without mass), then
     /// ∫_{θᵢ}^θ g(t) cos t sin t dt = ξ·total − Tᵢ is solved by Newton's method safeguarded by
     /// the segment bracket (bisection where the derivative g(θ) cos θ sin θ vanishes).
@@ -311,7 +311,7 @@ impl PiecewiseLinear {
         newton_bracketed(value, derivative, start, &mut a, &mut b, self.tolerance)
     }
 
-    /// Seed 000 eq 33 as printed: G(i, o, m) = 1 / (1 + Λ(i) + Λ(o)), without the χ⁺(i·m)
+    /// Document 000 eq 33 as printed: G(i, o, m) = 1 / (1 + Λ(i) + Λ(o)), without the χ⁺(i·m)
     /// χ⁺(o·m) factors of the general height-correlated form (ERRATA-000 E9): it does not
     /// vanish for back-facing microfacets. Equal to `g2(.., HeightCorrelated)` wherever both
     /// directions see m and are above the horizon.
@@ -320,7 +320,7 @@ impl PiecewiseLinear {
     }
 }
 
-/// c_iso by seed 000 eq 5 exactly as printed (a difference of end-point terms per segment;
+/// c_iso by document 000 eq 5 exactly as printed (a difference of end-point terms per segment;
 /// correct, but it cancels for short segments). `profile` is raw (unnormalized).
 pub fn c_iso_eq5_printed(profile: &AngularProfile) -> f64 {
     let (t, v) = (&profile.theta, &profile.value);
@@ -335,7 +335,7 @@ pub fn c_iso_eq5_printed(profile: &AngularProfile) -> f64 {
     PI / 4.0 * sum
 }
 
-/// Validates a profile (seed 000 eq 4 domain) and returns its c_iso (eq 5).
+/// Validates a profile (document 000 eq 4 domain) and returns its c_iso (eq 5).
 fn validate(axis: &'static str, p: &AngularProfile) -> Result<f64, ParamError> {
     let bad = |index: usize, requirement: &'static str, value: f64| ParamError::InvalidProfile {
         axis,
@@ -459,7 +459,7 @@ fn midpoint_form(t0: f64, t1: f64, g0: f64, g1: f64) -> Option<[f64; 4]> {
     (h != 0.0).then_some([h, 0.5 * (t0 + t1), 0.5 * (g0 + g1), 0.5 * (g1 - g0)])
 }
 
-/// ∫_{t0}^{t1} g(θ) cos θ sin θ dθ for g linear from g0 at t0 to g1 at t1 (seed 000 eq 5 per
+/// ∫_{t0}^{t1} g(θ) cos θ sin θ dθ for g linear from g0 at t0 to g1 at t1 (document 000 eq 5 per
 /// segment, in midpoint form: m = (t0+t1)/2, h = (t1−t0)/2, ḡ = (g0+g1)/2, δ = (g1−g0)/2):
 ///
 /// ```text
@@ -472,7 +472,7 @@ pub(super) fn segment_cos_sin(t0: f64, t1: f64, g0: f64, g1: f64) -> f64 {
     0.5 * (gm * (2.0 * m).sin() * (2.0 * h).sin() + d / h * (2.0 * m).cos() * s3(h))
 }
 
-/// ∫_{t0}^{t1} g(θ) sin²θ dθ for g linear (seed 000 eq 15 per segment, midpoint form):
+/// ∫_{t0}^{t1} g(θ) sin²θ dθ for g linear (document 000 eq 15 per segment, midpoint form):
 ///
 /// ```text
 /// ∫ = ½ [ḡ (2h − sin 2h + 2 sin²m sin 2h) + (δ/h) sin 2m (sin 2h / 2 − h cos 2h)]
@@ -550,7 +550,7 @@ impl Ndf for PiecewiseLinear {
 }
 
 impl NormalSampler for PiecewiseLinear {
-    /// φ by Algorithm 1 from `u[0]`, θ given φ by Algorithm 2 from `u[1]` (seed 000 §2).
+    /// φ by Algorithm 1 from `u[0]`, θ given φ by Algorithm 2 from `u[1]` (document 000 §2).
     fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
         let phi = self.sample_phi(u[0]);
         let theta = self.sample_theta(u[1], phi);

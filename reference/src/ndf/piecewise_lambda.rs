@@ -1,4 +1,4 @@
-//! Smith Λ of the eq-1 blends of seed 000 (piecewise-linear and analytic profiles): the exact
+//! Smith Λ of the eq-1 blends of document 000 (piecewise-linear and analytic profiles): the exact
 //! back-facing integral, the document's domain split (eq 10–29, 34) and the slope-space form
 //! (eq 30–32).
 //!
@@ -76,7 +76,7 @@ pub(crate) fn k2(g: f64) -> f64 {
     sum
 }
 
-/// Λ of an eq-1 blend by adaptive quadrature of the back-facing projected area (seed 000
+/// Λ of an eq-1 blend by adaptive quadrature of the back-facing projected area (document 000
 /// eq 10–13: ∫⟨o·m⟩D dm = cos θ_o (1 + Λ), and ∫(o·m)D dm = cos θ_o since D(θ, φ + π) =
 /// D(θ, φ), so Λ is the back-facing part alone, with no cancellation near normal incidence):
 ///
@@ -151,7 +151,7 @@ pub enum Remaining {
     Adaptive,
 }
 
-/// The parts of seed 000's domain split of ∫⟨o·m⟩D dm (eq 13, 19) and the results.
+/// The parts of document 000's domain split of ∫⟨o·m⟩D dm (eq 13, 19) and the results.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DomainSplit {
     /// I₁₁ = I₁ − cos θ_o / 2 (eq 16, 34).
@@ -166,7 +166,7 @@ pub struct DomainSplit {
     pub g1: f64,
 }
 
-/// Seed 000's domain split (eq 13–29) of ∫⟨o·m⟩D dm, combined by eq 34:
+/// Document 000's domain split (eq 13–29) of ∫⟨o·m⟩D dm, combined by eq 34:
 ///
 /// ```text
 /// I₁₁  = sin θ_o [k_x (3 + cos 2φ_o)/3 A_xⁿ + k_y (3 − cos 2φ_o)/3 A_yⁿ]            (eq 15–16)
@@ -252,7 +252,7 @@ pub fn domain_split(
     }
 }
 
-/// P₂(q) along the azimuth with cos 2φ = `cos2phi` (seed 000 eq 30–31, with the slopes
+/// P₂(q) along the azimuth with cos 2φ = `cos2phi` (document 000 eq 30–31, with the slopes
 /// rotated so that q runs along φ and p across it, ERRATA-000 E8):
 ///
 /// ```text
@@ -306,7 +306,7 @@ fn p2_co(p: &PiecewiseLinear, q: f64, eq: f64, cos2phi: f64, rel: f64) -> f64 {
     integrate(&f, &vs, rel, 0.0).value
 }
 
-/// Λ by the slope-space form (seed 000 eq 32 with the lower limit corrected to μ, ERRATA-000
+/// Λ by the slope-space form (document 000 eq 32 with the lower limit corrected to μ, ERRATA-000
 /// E7):
 ///
 /// ```text

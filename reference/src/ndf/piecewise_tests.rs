@@ -131,7 +131,7 @@ fn hemisphere_integral(m: &PiecewiseLinear) -> f64 {
         / n as f64
 }
 
-/// Λ(o) from its definition with D alone (seed 000 eq 10; Heitz 2014 §5):
+/// Λ(o) from its definition with D alone (document 000 eq 10; Heitz 2014 §5):
 /// ∫⟨o·m⟩ D dm = cos θ_o (1 + Λ) and ∫(o·m) D dm = cos θ_o, so
 /// Λ = ∫ max(0, −o·m) D(m) dm / cos θ_o. The back-facing set is θ_m > π/2 − θ_o,
 /// |φ_m − φ_o − π| < arccos(cot θ_o cot θ_m).
@@ -179,7 +179,7 @@ pub(crate) fn d_co(m: &PiecewiseLinear, eps: f64, phi: f64) -> f64 {
     }
 }
 
-/// Λ(o) as the back-facing projected area (seed 000 eq 10, as `lambda_integral`), in
+/// Λ(o) as the back-facing projected area (document 000 eq 10, as `lambda_integral`), in
 /// the co-angle δ = θ_m − (π/2 − θ_o) ∈ [0, θ_o]: cos θ_m = sin(θ_o − δ) and
 /// sin θ_m = cos(θ_o − δ) keep their relative accuracy near the horizon, where θ_m
 /// itself (next to π/2) resolves cos θ_m to ~1e-16 absolute only (`lambda_integral`
@@ -609,10 +609,10 @@ fn printed_eq8_is_the_marginal_not_the_conditional() {
     assert!((printed - 1.0).abs() < 1e-12);
     assert!((stated - 1.0).abs() > 0.05, "stated {stated}");
     // The conditional of θ given φ differs from the marginal eq 8 describes; the named printed
-    // form (`errata::seed000`, which the harness demonstrates) is this marginal.
+    // form (`errata::document000`, which the harness demonstrates) is this marginal.
     let t = 0.5;
     let marginal = eq8(t);
-    let named = crate::errata::seed000::eq8_theta_cdf_printed(&m, t);
+    let named = crate::errata::document000::eq8_theta_cdf_printed(&m, t);
     assert!(rel_err(named, marginal) < 1e-9, "{named} vs {marginal}");
     let conditional = m.cdf_theta(t, phi_m);
     assert!(
@@ -636,8 +636,8 @@ fn printed_b_aniso_uses_the_x_profile_twice() {
     let m = pl(x.clone(), Some(y.clone()));
     let (phi, k) = (0.9f64, 1usize);
     let (wx, wy) = (m.kx * phi.cos().powi(2), m.ky * phi.sin().powi(2));
-    let right = crate::errata::seed000::b_aniso_segment_corrected(&m, phi, k);
-    let printed = crate::errata::seed000::b_aniso_segment_printed(&m, phi, k);
+    let right = crate::errata::document000::b_aniso_segment_corrected(&m, phi, k);
+    let printed = crate::errata::document000::b_aniso_segment_printed(&m, phi, k);
     let mass = (wx * (m.tx[k + 1] - m.tx[k])) + wy * (m.ty[k + 1] - m.ty[k]);
     assert!(rel_err(right, mass) < 1e-12, "{right} {mass}");
     assert!(rel_err(printed, mass) > 1e-2, "{printed} {mass}");
@@ -892,8 +892,9 @@ fn printed_eq23_partial_segment_and_its_extracted_y_line() {
     let (a, b, tk, theta_o, phi_o) = (0.7f64, 0.4f64, 0.2f64, 0.9f64, 0.3f64);
     let e = FRAC_PI_2 - theta_o;
     let want = de(&|t: f64| (a * t + b) * t.sin().powi(2), tk, e, 1e-15);
-    let right = crate::errata::seed000::eq23_partial_segment_corrected(a, b, tk, theta_o);
-    let printed = crate::errata::seed000::eq23_partial_segment_printed(a, b, tk, theta_o, phi_o);
+    let right = crate::errata::document000::eq23_partial_segment_corrected(a, b, tk, theta_o);
+    let printed =
+        crate::errata::document000::eq23_partial_segment_printed(a, b, tk, theta_o, phi_o);
     assert!(rel_err(right, want) < 1e-13);
     assert!(rel_err(printed, want) > 1e-2);
 }
@@ -915,13 +916,13 @@ fn eq34_display_is_i11_not_i1() {
     assert!(rel_err(ds.i11, display) < 1e-15);
     let exact = m.lambda(from_spherical(t, phi));
     assert!((ds.lambda - exact).abs() < 1e-13);
-    let misread = crate::errata::seed000::eq34_lambda_printed(t, display, ds.i2_1, ds.i2_2);
+    let misread = crate::errata::document000::eq34_lambda_printed(t, display, ds.i2_1, ds.i2_2);
     assert!((misread - exact - 0.5).abs() < 1e-13);
-    let right = crate::errata::seed000::eq34_lambda_corrected(t, display, ds.i2_1, ds.i2_2);
+    let right = crate::errata::document000::eq34_lambda_corrected(t, display, ds.i2_1, ds.i2_2);
     assert!((right - exact).abs() < 1e-13);
 }
 
-/// The accuracy table of seed 000: for each closed form and route, the max error
+/// The accuracy table of document 000: for each closed form and route, the max error
 /// against an independent numerical integral of its definition, per model (columns), over
 /// θ_o ∈ {1e-6, 1e-3, 0.05, 0.3, 0.8, 1.2, 1.5, 1.57, π/2 − 1e-6}, φ_o ∈ {0, 0.7, π/2}
 /// (Λ, G1) and ξ ∈ {1e-9, 0.1, 0.37, 0.5, 0.81, 1 − 1e-9} (samplers).
@@ -985,7 +986,7 @@ mod accuracy_table {
     #[test]
     #[cfg_attr(not(mfh_extensive), ignore = "extensive tier: set MFH_EXTENSIVE=1")]
     fn accuracy_table_piecewise() {
-        let mut out = ReportTable::new("seed000");
+        let mut out = ReportTable::new("document000");
         let models: Vec<(&str, PiecewiseLinear)> =
             small_models().into_iter().chain(big_models()).collect();
         let blend = Blend::new(

@@ -1,4 +1,4 @@
-//! The Student-t family of NDFs (seed 001): the general D^G(B, C), STD, Hyper-Cauchy and the
+//! The Student-t family of NDFs (document 001): the general D^G(B, C), STD, Hyper-Cauchy and the
 //! fixed-variance member, isotropic and anisotropic.
 
 use crate::error::{ParamError, QueryError};
@@ -22,20 +22,20 @@ use std::f64::consts::PI;
 /// `gamma: "inf"` (Beckmann, exactly) beyond.
 pub const GAMMA_MAX: f64 = 1e8;
 
-/// Which member of the family, i.e. how B depends on σ and γ (seed 001, §1.1: B = f/σ²).
+/// Which member of the family, i.e. how B depends on σ and γ (document 001, §1.1: B = f/σ²).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Member {
-    /// STD, f = 1/(γ − 1) (seed 001, §1.1, §2–6).
+    /// STD, f = 1/(γ − 1) (document 001, §1.1, §2–6).
     Std,
-    /// Hyper-Cauchy, f = 1 (seed 001, eq 8).
+    /// Hyper-Cauchy, f = 1 (document 001, eq 8).
     HyperCauchy,
-    /// Fixed variance σ²/2, f = 1/(γ − 2) (seed 001, eq 9); needs γ > 2.
+    /// Fixed variance σ²/2, f = 1/(γ − 2) (document 001, eq 9); needs γ > 2.
     FixedVariance,
-    /// The general isotropic D^G(B, C) (seed 001, eq 1–2), given by B and C directly.
+    /// The general isotropic D^G(B, C) (document 001, eq 1–2), given by B and C directly.
     General,
 }
 
-/// A Student-t NDF: the bivariate Student's t-distribution of slopes (seed 001, eq 1–3, 10,
+/// A Student-t NDF: the bivariate Student's t-distribution of slopes (document 001, eq 1–3, 10,
 /// 13). With C = γ and per-axis Student scales s_x = σx/√f, s_y = σy/√f (s = 1/√B for the
 /// general member):
 ///
@@ -130,7 +130,7 @@ impl Student {
         ))
     }
 
-    /// The general isotropic D^G(B, C) of seed 001 eq 2 (B > 0, 1 < C ≤ 1e8).
+    /// The general isotropic D^G(B, C) of document 001 eq 2 (B > 0, 1 < C ≤ 1e8).
     pub fn general(b: f64, c: f64) -> Result<Self, ParamError> {
         if !(b > 0.0 && b.is_finite()) {
             return Err(ParamError::OutOfRange {
@@ -188,7 +188,7 @@ impl Student {
         standardized_cotangent(self.sx, self.sy, w)
     }
 
-    /// The printed seed 001 eq 11 / 40 for φ: arctan((σy/σx) tan(2π u1)), without quadrant
+    /// The printed document 001 eq 11 / 40 for φ: arctan((σy/σx) tan(2π u1)), without quadrant
     /// handling. Kept to demonstrate the erratum: its range is (−π/2, π/2), so every sampled
     /// normal has m_x ≥ 0 (see ERRATA.md).
     pub fn sample_wm_printed(&self, u: [f64; 2]) -> Vec3 {
@@ -292,7 +292,7 @@ impl Smith for Student {
 }
 
 impl NormalSampler for Student {
-    /// Seed 001 eq 11–12 / 40–42 in slope space, with the quadrant of φ fixed (ERRATA.md):
+    /// Document 001 eq 11–12 / 40–42 in slope space, with the quadrant of φ fixed (ERRATA.md):
     /// the slope is √r (s_x cos 2πu₁, s_y sin 2πu₁) with r = (1 − u₂)^{1/(1−C)} − 1.
     fn sample_wm(&self, u: [f64; 2]) -> Vec3 {
         let (dx, dy) = elliptic_direction(self.sx, self.sy, u[0]);
@@ -329,7 +329,7 @@ impl SlopeDistribution for Student {
         self.p2_norm / s * ((0.5 - self.c) * (q / s).powi(2).ln_1p()).exp()
     }
 
-    /// Seed 001 eq 7 with Γ(C−1)/Γ(C−1−k) = ∏_{j=1..k} (C−1−j) and Γ(k+½)/√π = (2k−1)!!/2^k,
+    /// Document 001 eq 7 with Γ(C−1)/Γ(C−1−k) = ∏_{j=1..k} (C−1−j) and Γ(k+½)/√π = (2k−1)!!/2^k,
     /// exact for every C (no Γ of large arguments).
     fn slope_moment(&self, k: u32, phi: f64) -> Option<f64> {
         if !(self.c > 1.0 + k as f64) {
@@ -344,7 +344,7 @@ impl SlopeDistribution for Student {
 
 /// Implements [`FamilySpec`] for the spec type of a Student member parameterized by γ and
 /// roughness (STD, Hyper-Cauchy, fixed variance: the same fields, a different member;
-/// `beckmann_at_inf` says whether `gamma: "inf"` builds the Beckmann limit, seed 001 §4).
+/// `beckmann_at_inf` says whether `gamma: "inf"` builds the Beckmann limit, document 001 §4).
 macro_rules! student_family_spec {
     ($spec:ident, $member:expr, $variant:ident, beckmann_at_inf: $inf:expr) => {
         impl FamilySpec for $spec {
@@ -364,7 +364,7 @@ macro_rules! student_family_spec {
                 student_smith_limit("gamma", self.gamma)
             }
 
-            /// γ (seed 001 eq 7–9); none at γ = ∞ (Beckmann: no heavy tail).
+            /// γ (document 001 eq 7–9); none at γ = ∞ (Beckmann: no heavy tail).
             fn tail_exponent(&self) -> Option<f64> {
                 Some(self.gamma).filter(|g| g.is_finite())
             }
@@ -390,7 +390,7 @@ impl FamilySpec for GeneralSpec {
         student_smith_limit("c", self.c)
     }
 
-    /// C (seed 001 eq 2).
+    /// C (document 001 eq 2).
     fn tail_exponent(&self) -> Option<f64> {
         Some(self.c)
     }
@@ -715,7 +715,7 @@ mod tests {
 
     #[test]
     fn printed_eq11_covers_half_the_azimuths() {
-        // Erratum (ERRATA.md, seed 001 eq 11/40): arctan without the quadrant puts every normal
+        // Erratum (ERRATA.md, document 001 eq 11/40): arctan without the quadrant puts every normal
         // in m_x ≥ 0; the corrected sampler fills both halves equally.
         let m = std(2.5, 0.1, 0.4);
         let (mut printed_neg, mut fixed_neg) = (0, 0);
@@ -748,7 +748,7 @@ mod tests {
 
     #[test]
     fn converges_to_beckmann_at_rate_one_over_gamma() {
-        // Seed 001 §2: STD → Beckmann as γ → ∞. The error of D and Λ falls like 1/γ.
+        // Document 001 §2: STD → Beckmann as γ → ∞. The error of D and Λ falls like 1/γ.
         let b = Beckmann::new(0.3, 0.3).unwrap();
         let w_d = from_spherical(0.4, 0.0);
         let w_l = from_spherical(1.2, 0.0);

@@ -1,9 +1,9 @@
-//! Demonstrations of the errata of seed 001 found in derivation steps (equations that no route
+//! Demonstrations of the errata of document 001 found in derivation steps (equations that no route
 //! evaluates): each test evaluates the printed formula and the corrected one against an
 //! independent integral, and asserts that the printed one fails and the corrected one holds.
 //! The errata of evaluated routes are demonstrated beside them (ERRATA.md names every test).
 
-use crate::errata::seed001;
+use crate::errata::document001;
 use crate::ndf::student_lambda::eq33_prefactor;
 use crate::special::gamma_ratio::gamma_half_ratio;
 use crate::special::hyp2f1::student_norm;
@@ -44,8 +44,8 @@ fn eq20_has_a_spurious_half_on_the_2f1_term() {
     // integral as √π Γ(γ−1)/(2Γ(γ−½)) − (μ/2) ₂F₁(…)/√((γ−1)σ²); it is … − t0 ₂F₁(…).
     for &(g, sigma, mu) in &[(2.5f64, 0.3f64, 0.4f64), (4.0, 0.5, 0.2), (7.5, 0.2, 0.3)] {
         let t0 = mu / ((g - 1.0) * sigma * sigma).sqrt();
-        let printed = seed001::eq20_tail_printed(g, sigma, mu);
-        let corrected = seed001::eq20_tail_corrected(g, sigma, mu);
+        let printed = document001::eq20_tail_printed(g, sigma, mu);
+        let corrected = document001::eq20_tail_corrected(g, sigma, mu);
         let truth = tail_integral(g, t0);
         shown(printed, corrected, truth, 1e-11, &format!("γ={g}, eq 20"));
     }
@@ -58,8 +58,8 @@ fn eq28_last_line_misplaces_the_square_root() {
     for &(g, sigma, mu) in &[(3.0f64, 0.3f64, 0.4f64), (5.0, 0.6, 0.5)] {
         let t0 = mu / ((g - 1.0).sqrt() * sigma);
         let truth = tail_integral(g, t0);
-        let printed = seed001::eq28_tail_printed(g as u64, sigma, mu);
-        let corrected = seed001::eq28_tail_corrected(g as u64, sigma, mu);
+        let printed = document001::eq28_tail_printed(g as u64, sigma, mu);
+        let corrected = document001::eq28_tail_corrected(g as u64, sigma, mu);
         shown(printed, corrected, truth, 1e-11, &format!("γ={g}, eq 28"));
     }
 }
@@ -116,9 +116,9 @@ fn table1_anisotropic_beckmann_d_lacks_tan2_theta() {
             let f = |theta: f64| -> f64 {
                 let (s, c) = theta.sin_cos();
                 let d = if printed {
-                    seed001::table1_aniso_beckmann_printed(sx, sy, theta, phi)
+                    document001::table1_aniso_beckmann_printed(sx, sy, theta, phi)
                 } else {
-                    seed001::table1_aniso_beckmann_corrected(sx, sy, theta, phi)
+                    document001::table1_aniso_beckmann_corrected(sx, sy, theta, phi)
                 };
                 d * c * s
             };
@@ -134,7 +134,7 @@ fn table1_anisotropic_beckmann_d_lacks_tan2_theta() {
     assert!(norm(true) > 1.1, "printed: {}", norm(true));
 }
 
-// Eq 41–42 (formerly ERRATA 001-11) are right as a pair: `errata::seed001::tests::
+// Eq 41–42 (formerly ERRATA 001-11) are right as a pair: `errata::document001::tests::
 // eq41_and_eq42_as_printed_sample_the_conditional_cdf`.
 
 /// P2 of §7.1 (σ = 1): (γ−1)^γ Γ(γ−½) / (√π Γ(γ) (γ − 1 + p²)^{γ−½}).
@@ -158,8 +158,8 @@ fn sec71_visible_slope_cdf_has_the_wrong_sign_of_exponent() {
     };
     let g1 = 1.0 / (1.0 + lam);
     let truth = g1 * integrate_tail(&|u: f64| density(p - u), 0.0, 1.0, 1e-13);
-    let printed = seed001::sec71_cdf_printed(g, theta, p);
-    let corrected = seed001::sec71_cdf_corrected(g, theta, p);
+    let printed = document001::sec71_cdf_printed(g, theta, p);
+    let corrected = document001::sec71_cdf_corrected(g, theta, p);
     shown(printed, corrected, truth, 1e-10, "§7.1 visible-slope cdf");
 }
 
@@ -173,8 +173,8 @@ fn sec71_conditional_cdf_substitution_is_wrong() {
         below / all
     };
     let truth = cdf(&|s: f64| (1.0 + p * p / (g - 1.0) + s * s / (g - 1.0)).powf(-g));
-    let printed = cdf(&|s: f64| seed001::sec71_kernel_printed(g, p, s));
-    let corrected = cdf(&|s: f64| seed001::sec71_kernel_corrected(g, p, s));
+    let printed = cdf(&|s: f64| document001::sec71_kernel_printed(g, p, s));
+    let corrected = cdf(&|s: f64| document001::sec71_kernel_corrected(g, p, s));
     assert!(rel_err(corrected, truth) < 1e-10);
     assert!(rel_err(printed, truth) > 1e-3, "{printed} vs {truth}");
 }

@@ -1,4 +1,4 @@
-//! The routes to Smith Λ of the Student-t family (seed 001): the stable default, the ₂F₁ form
+//! The routes to Smith Λ of the Student-t family (document 001): the stable default, the ₂F₁ form
 //! (eq 21), the incomplete-beta cross-check, the integer-γ (eq 29–30) and half-integer-γ
 //! (eq 36–37) finite sums, and the Table 1 rows, printed and corrected.
 //!
@@ -225,7 +225,7 @@ pub fn route_domain(name: &str, c: f64, x: f64) -> Result<(), QueryError> {
 /// the harness shows that rather than hiding it.
 pub const INTEGER_MAX: f64 = 1000.0;
 
-/// N_C = Γ(C − ½)/(√π Γ(C − 1)), the constant of the standardized P2 (seed 001 eq 15 with
+/// N_C = Γ(C − ½)/(√π Γ(C − 1)), the constant of the standardized P2 (document 001 eq 15 with
 /// σ√(γ−1) = 1), accurate to a few ulps for every C > 1 (`special::hyp2f1::student_norm`).
 pub fn p2_norm(c: f64) -> f64 {
     hyp2f1::student_norm(c)
@@ -255,7 +255,7 @@ fn eq21_first_term(c: f64, x: f64) -> f64 {
     p2_norm(c) * ((1.5 - c) * (x * x).ln_1p()).exp() / ((2.0 * c - 3.0) * x)
 }
 
-/// Seed 001 eq 21 (also eq 5 for D^G):
+/// Document 001 eq 21 (also eq 5 for D^G):
 ///
 /// ```text
 /// Λ = Γ(γ−½)/(Γ(γ)√π) ( (γ−1)^γ/(2γ−3) · σ((γ−1) + μ²/σ²)^{3/2−γ}/μ
@@ -272,7 +272,7 @@ pub fn lambda_2f1(c: f64, x: f64) -> f64 {
     eq21_first_term(c, x) + p2_norm(c) * x * hyp2f1::hyp2f1_lambda(c, -x * x) - 0.5
 }
 
-/// Eq 21 with ₂F₁ evaluated by seed 001 §8 Algorithm 2 as printed (with the general Gauss
+/// Eq 21 with ₂F₁ evaluated by document 001 §8 Algorithm 2 as printed (with the general Gauss
 /// series in place of GSL): kept to measure where that algorithm fails (integer γ hits the
 /// poles of Γ(1 − γ) and Γ(2 − γ)).
 pub fn lambda_2f1_algorithm2(c: f64, x: f64) -> f64 {
@@ -315,7 +315,7 @@ fn binomials(n: u64) -> impl Iterator<Item = f64> {
     })
 }
 
-/// Seed 001 eq 28 (and A2 of eq 30): Σ_{k=0}^{n} C(n, k) (−1)^k/(2k+1) (1 − s^{2k+1}), which
+/// Document 001 eq 28 (and A2 of eq 30): Σ_{k=0}^{n} C(n, k) (−1)^k/(2k+1) (1 − s^{2k+1}), which
 /// equals ∫_{t0}^∞ (1 + t²)^{½−γ} dt for integer γ = n + 2 when s = t0/√(1 + t0²) = sin(arctan t0)
 /// (the last line of eq 28 prints a different s: ERRATA.md 001-4). An alternating sum: it
 /// cancels for large n.
@@ -329,7 +329,7 @@ pub fn alternating_tail_sum(n: u64, s: f64) -> f64 {
         .sum()
 }
 
-/// Seed 001 eq 33 (half-integer γ = n + 3/2): the prefactor of the bracket of eq 31, as
+/// Document 001 eq 33 (half-integer γ = n + 3/2): the prefactor of the bracket of eq 31, as
 /// printed and as corrected (ERRATA.md 001-6):
 ///
 /// ```text
@@ -353,7 +353,7 @@ pub fn eq33_prefactor(gamma: f64, sigma: f64, mu: f64, printed: bool) -> f64 {
     }
 }
 
-/// Seed 001 eq 29–30, integer γ ≥ 2, as printed (they are correct):
+/// Document 001 eq 29–30, integer γ ≥ 2, as printed (they are correct):
 ///
 /// ```text
 /// Λ  = (γ−1) A1 ( (σ/μ)√(γ−1) (1 + μ²/((γ−1)σ²))^{3/2−γ} / (2γ−3) − A2 )
@@ -375,7 +375,7 @@ pub fn lambda_integer(c: f64, x: f64) -> f64 {
     (c - 1.0) * a1 * (first - a2)
 }
 
-/// Seed 001 eq 29 with eq 36–37, half-integer γ = n + 3/2, n ≥ 1, corrected (ERRATA.md: the
+/// Document 001 eq 29 with eq 36–37, half-integer γ = n + 3/2, n ≥ 1, corrected (ERRATA.md: the
 /// printed arctan(μ/√((γ−1)σ)) is arctan(μ/(σ√(γ−1))) = arctan x):
 ///
 /// ```text
@@ -390,7 +390,7 @@ pub fn lambda_half_integer(c: f64, x: f64) -> f64 {
     half_integer_with_angle(c, x, x.atan())
 }
 
-/// Seed 001 eq 36–37 as printed, with arctan(μ/√((γ−1)σ)) = arctan(x √σ)
+/// Document 001 eq 36–37 as printed, with arctan(μ/√((γ−1)σ)) = arctan(x √σ)
 /// (μ = cot θ, x = μ/(σ√(γ−1))): right only where σ = 1. Kept to demonstrate the erratum.
 pub fn lambda_half_integer_printed(c: f64, x: f64, sigma: f64) -> f64 {
     half_integer_with_angle(c, x, (x * sigma.sqrt()).atan())
@@ -422,7 +422,7 @@ fn half_integer_with_angle(c: f64, x: f64, x0: f64) -> f64 {
     (c - 1.0) * a1 * (first - a2)
 }
 
-/// Seed 001 Table 1, Λ rows for γ = 2, 5/2, 3, 7/2, 4, corrected where the printed row is
+/// Document 001 Table 1, Λ rows for γ = 2, 5/2, 3, 7/2, 4, corrected where the printed row is
 /// wrong (γ = 7/2, ERRATA.md). With a = μ/σ = x√(γ−1):
 ///
 /// ```text
@@ -444,7 +444,7 @@ pub fn lambda_table1(c: f64, x: f64) -> f64 {
     lambda_table1_printed(c, x)
 }
 
-/// Seed 001 Table 1, Λ rows exactly as printed (a = μ/σ = x√(γ−1)); the γ = 7/2 row is wrong:
+/// Document 001 Table 1, Λ rows exactly as printed (a = μ/σ = x√(γ−1)); the γ = 7/2 row is wrong:
 ///
 /// ```text
 /// γ = 7/2 (printed): arctan(√(2/5) a)/(3π) − 1 + 5√(5/2) (−6a⁴ + 17a² + 8) / (6π a (2a² + 5))

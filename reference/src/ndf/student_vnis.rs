@@ -1,4 +1,4 @@
-//! The pseudo-VNIS of seed 001 §7.2 for STD: Algorithm 1's choice of a proxy visible-normal
+//! The pseudo-VNIS of document 001 §7.2 for STD: Algorithm 1's choice of a proxy visible-normal
 //! sampler (GGX, Beckmann or plain normal sampling), its samples and density, and the weight of
 //! eq 43 as printed next to the unbiased one.
 
@@ -8,10 +8,10 @@ use crate::model::{visible_domain, Masking, Ndf, NormalSampler, Smith, VisibleNo
 use crate::ndf::student::{Member, Student};
 use crate::ndf::{Beckmann, Ggx};
 
-/// The sampler Algorithm 1 of seed 001 §7.2 picks.
+/// The sampler Algorithm 1 of document 001 §7.2 picks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Proxy {
-    /// Plain normal sampling of the STD itself (seed 001 §6, eq 40–42): lines 2 and 13.
+    /// Plain normal sampling of the STD itself (document 001 §6, eq 40–42): lines 2 and 13.
     Normals,
     /// Visible normals of GGX with the STD's roughness: line 9.
     Ggx,
@@ -30,7 +30,7 @@ impl Proxy {
     }
 }
 
-/// Algorithm 1 of seed 001 §7.2, as printed, for STD with roughness σ and shape γ:
+/// Algorithm 1 of document 001 §7.2, as printed, for STD with roughness σ and shape γ:
 ///
 /// ```text
 /// 1:  if σ ≤ 0.01: normal sampling (§6)
@@ -61,7 +61,7 @@ pub fn algorithm1(gamma: f64, sigma: f64) -> Proxy {
     }
 }
 
-/// The pseudo-VNIS of seed 001 §7.2 for an STD material: samples microfacet normals for an
+/// The pseudo-VNIS of document 001 §7.2 for an STD material: samples microfacet normals for an
 /// incident direction `wi` from the proxy Algorithm 1 picks (with the STD's roughness), and
 /// weights them for the estimator of the reflected energy with F = 1,
 ///
@@ -165,7 +165,7 @@ impl PseudoVnis {
         c * self.std.d(m) / (wi[2] * (1.0 + self.std.lambda(wi)))
     }
 
-    /// Eq 43 of seed 001 as printed, `weight(v) = G/G1(v)`: G2(wo, wi, m)/G1(wi, m) with the
+    /// Eq 43 of document 001 as printed, `weight(v) = G/G1(v)`: G2(wo, wi, m)/G1(wi, m) with the
     /// STD's G1 and G2 (`masking` picks G2), on the VNIS branches of Algorithm 1; on its
     /// normal-sampling branches, the §6 weight G2⟨wi·m⟩/(cos θi cos θm). 0 where G1(wi, m) = 0.
     pub fn weight_printed(&self, wi: Vec3, wo: Vec3, m: Vec3, masking: Masking) -> f64 {

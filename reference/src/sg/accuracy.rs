@@ -1,4 +1,4 @@
-//! The accuracy table of seed 003: every SG, ASG and circular-Gaussian closed form,
+//! The accuracy table of document 003: every SG, ASG and circular-Gaussian closed form,
 //! approximation and `_exact` route against an independent numerical integral (the test
 //! oracle `sg::oracle`, double-exponential quadrature), over sharpness 1e-3 … 1e4.
 //!
@@ -315,7 +315,7 @@ fn circular_rows() -> Vec<Row> {
 
 #[test]
 fn accuracy_table_sg() {
-    let mut out = ReportTable::new("seed003");
+    let mut out = ReportTable::new("document003");
     let sg = sg_rows();
     let asg = asg_rows();
     let circular = circular_rows();

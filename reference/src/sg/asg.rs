@@ -1,4 +1,4 @@
-//! Anisotropic spherical Gaussians (seed 003, §3, after Xu et al. 2013): evaluation, the
+//! Anisotropic spherical Gaussians (document 003, §3, after Xu et al. 2013): evaluation, the
 //! integral over the sphere, the ASG × ASG product and the ASG–SG convolution.
 
 use super::circular::bessel_i0_scaled;
@@ -12,7 +12,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 /// Relative accuracy asked of the `_exact` (quadrature) routes.
 const EXACT_REL: f64 = 1e-12;
 
-/// An anisotropic spherical Gaussian in geometric form (seed 003, §3.1):
+/// An anisotropic spherical Gaussian in geometric form (document 003, §3.1):
 ///
 /// ```text
 /// G(v; [x, y, z], [λ, μ], c) = c · max(v·z, 0) · e^{−λ (v·x)² − μ (v·y)²}
@@ -31,7 +31,7 @@ pub struct Asg {
     amplitude: f64,
 }
 
-/// F(a) of the ASG integral (seed 003, §3.2.1):
+/// F(a) of the ASG integral (document 003, §3.2.1):
 ///
 /// ```text
 /// F(a) = ∫₀^{2π} e^{−a cos²φ} dφ = 2π e^{−a/2} I₀(a/2)
@@ -118,7 +118,7 @@ impl Asg {
         self.amplitude
     }
 
-    /// G(v) = c · max(v·z, 0) · e^{−λ(v·x)² − μ(v·y)²} (seed 003, §3.1).
+    /// G(v) = c · max(v·z, 0) · e^{−λ(v·x)² − μ(v·y)²} (document 003, §3.1).
     pub fn eval(&self, v: Vec3) -> f64 {
         let s = dot(v, self.z);
         if !(s > 0.0) {
@@ -128,7 +128,7 @@ impl Asg {
         self.amplitude * s * (-self.bandwidths[0] * a * a - self.bandwidths[1] * b * b).exp()
     }
 
-    /// The document's approximation of the integral over the sphere (seed 003, §3.2.1, Xu et
+    /// The document's approximation of the integral over the sphere (document 003, §3.2.1, Xu et
     /// al. 2013), with λ ≥ μ (the bandwidths are swapped otherwise):
     ///
     /// ```text
@@ -156,7 +156,7 @@ impl Asg {
         Ok(self.amplitude * (PI / (l * m).sqrt() - tail))
     }
 
-    /// The document's large-bandwidth approximation of the integral (seed 003, §3.2.1: "if
+    /// The document's large-bandwidth approximation of the integral (document 003, §3.2.1: "if
     /// λ, μ > 5, the terms involving F become small"):
     ///
     /// ```text
@@ -222,7 +222,7 @@ impl Asg {
         a
     }
 
-    /// The document's approximation of the product of two ASGs (seed 003, §3.2.2):
+    /// The document's approximation of the product of two ASGs (document 003, §3.2.2):
     ///
     /// ```text
     /// G₁(v) G₂(v) = S(v; z₁) S(v; z₂) e^{−vᵀ(A₁ + A₂)v}
@@ -276,7 +276,7 @@ impl Asg {
         self.eval(v) * other.eval(v)
     }
 
-    /// The document's approximation of the convolution of the ASG with an SG (seed 003,
+    /// The document's approximation of the convolution of the ASG with an SG (document 003,
     /// §3.2.3, Xu et al. 2013). With the SG written G_iso(v; p, ν) = e^{2ν(v·p − 1)} (so
     /// ν = half the [`Sg`] sharpness) and amplitude a:
     ///
@@ -706,7 +706,7 @@ pub(crate) mod tests {
         (num / den).sqrt()
     }
 
-    // ERRATA.md, E5. Seed 003 §3.2.3: "When λ, μ > 3, the L2-error is less than 0.2 %.
+    // ERRATA.md, E5. Document 003 §3.2.3: "When λ, μ > 3, the L2-error is less than 0.2 %.
     // When λ, μ > 1, the error is bounded by 2.8 %." Measured as the relative L2 error over the
     // SG's axis p ∈ S² (`convolution_l2_error`), both claims fail unless the SG is sharp: the
     // error falls roughly as 1/ν.

@@ -1,5 +1,5 @@
 //! Circular Gaussians, the von Mises integral 2π I₀(κ), and the decomposition of a spherical
-//! Gaussian into two circular Gaussians (seed 003, §4.1 and §4.3, after Iwasaki et al. 2014).
+//! Gaussian into two circular Gaussians (document 003, §4.1 and §4.3, after Iwasaki et al. 2014).
 
 use crate::error::{ParamError, QueryError};
 use crate::geometry::Vec3;
@@ -55,7 +55,7 @@ pub fn bessel_i0_scaled(x: f64) -> f64 {
     }
 }
 
-/// The von Mises integral (seed 003, §4.3):
+/// The von Mises integral (document 003, §4.3):
 ///
 /// ```text
 /// ∫₀^{2π} exp(κ cos(x − μ)) dx = 2π I₀(κ)
@@ -87,7 +87,7 @@ pub fn von_mises_integral_scaled(kappa: f64) -> f64 {
     2.0 * PI * bessel_i0_scaled(kappa)
 }
 
-/// A circular Gaussian on angles (seed 003, §4.1):
+/// A circular Gaussian on angles (document 003, §4.1):
 ///
 /// ```text
 /// g^c(x; μ, σ) = exp( (2/σ²) (cos(x − μ) − 1) )
@@ -144,7 +144,7 @@ impl CircularGaussian {
         (-2.0 * self.kappa() * s * s).exp()
     }
 
-    /// The product of two circular Gaussians is a scaled circular Gaussian (seed 003, §4.3,
+    /// The product of two circular Gaussians is a scaled circular Gaussian (document 003, §4.3,
     /// used but not written out there; this is the analogue of the SG vector product):
     ///
     /// ```text
@@ -173,7 +173,7 @@ impl CircularGaussian {
         Ok((alpha, g))
     }
 
-    /// The integral over a whole period (seed 003, §4.3, by the von Mises integral):
+    /// The integral over a whole period (document 003, §4.3, by the von Mises integral):
     ///
     /// ```text
     /// ∫₀^{2π} g^c(x; μ, σ) dx = e^{−κ} 2π I₀(κ),   κ = 2/σ²
@@ -184,7 +184,7 @@ impl CircularGaussian {
         von_mises_integral_scaled(self.kappa())
     }
 
-    /// The document's route to ∫_a^b g^c (seed 003, §4.3, the θ integral over [−π/2, π/2]):
+    /// The document's route to ∫_a^b g^c (document 003, §4.3, the θ integral over [−π/2, π/2]):
     /// g^c is replaced by the canonical Gaussian g(x; μ, σ) = exp(−(x − μ)²/σ²), whose integral
     /// is
     ///
@@ -225,7 +225,7 @@ impl CircularGaussian {
     }
 }
 
-/// The direction of fibre coordinates (seed 003, §4.1; x is the fibre's tangent):
+/// The direction of fibre coordinates (document 003, §4.1; x is the fibre's tangent):
 ///
 /// ```text
 /// ω(θ, φ) = (sin θ, cos θ cos φ, cos θ sin φ),   θ ∈ [−π/2, π/2] longitudinal, φ azimuthal
@@ -236,7 +236,7 @@ pub fn fiber_direction(theta: f64, phi: f64) -> Vec3 {
     [st, ct * cp, ct * sp]
 }
 
-/// The decomposition of an SG into two circular Gaussians (seed 003, §4.1):
+/// The decomposition of an SG into two circular Gaussians (document 003, §4.1):
 ///
 /// ```text
 /// G(ω; ξ, σ) = exp((2/σ²)(ω·ξ − 1)) = g^c(θ; θ', σ) · g^c(φ; φ', σ / √(cos θ cos θ'))

@@ -1,4 +1,4 @@
-//! Isotropic spherical Gaussians (seed 003, §1–§2, after Wang et al. 2009): evaluation,
+//! Isotropic spherical Gaussians (document 003, §1–§2, after Wang et al. 2009): evaluation,
 //! integral, inner and vector products, ε-support, the clamped-cosine fit, the lobe warp from
 //! half vectors to light directions, and the spherical-cap integral.
 
@@ -11,7 +11,7 @@ use std::f64::consts::{FRAC_PI_2, LN_10, PI};
 /// Relative accuracy asked of the `_exact` (quadrature) routes.
 const EXACT_REL: f64 = 1e-12;
 
-/// A spherical Gaussian (seed 003, §1):
+/// A spherical Gaussian (document 003, §1):
 ///
 /// ```text
 /// G(v; p, λ, μ) = μ e^{λ (v·p − 1)}
@@ -30,9 +30,9 @@ pub struct Sg {
     amplitude: f64,
 }
 
-/// The sharpness of the clamped-cosine fit C*(v; n) = G(v; n, 2.133, 1.170) (seed 003, §2.4).
+/// The sharpness of the clamped-cosine fit C*(v; n) = G(v; n, 2.133, 1.170) (document 003, §2.4).
 pub const CLAMPED_COSINE_SHARPNESS: f64 = 2.133;
-/// The amplitude of the clamped-cosine fit (seed 003, §2.4).
+/// The amplitude of the clamped-cosine fit (document 003, §2.4).
 pub const CLAMPED_COSINE_AMPLITUDE: f64 = 1.170;
 
 /// The measured maximum relative error of [`Sg::clamped_cosine_inner`] against the exact
@@ -41,7 +41,7 @@ pub const CLAMPED_COSINE_AMPLITUDE: f64 = 1.170;
 pub const CLAMPED_COSINE_MAX_REL_ERROR_60: f64 = 0.195;
 
 /// `f_h(θ_d, λ)`, the integral of the unit-amplitude SG over the spherical cap of half-angle
-/// θ_d around its axis (seed 003, §2.2):
+/// θ_d around its axis (document 003, §2.2):
 ///
 /// ```text
 /// f_h(θ_d, λ) = ∫₀^{θ_d} ∫₀^{2π} e^{λ(cos θ − 1)} sin θ dφ dθ = 2π (1 − e^{−λ (1 − cos θ_d)}) / λ
@@ -60,7 +60,7 @@ pub fn f_h(theta_d: f64, lambda: f64) -> f64 {
 }
 
 /// `f_a(λ)`: the solid angle where a unit SG of sharpness λ is ≥ 0.1, the lobe's "mass" in Wang
-/// et al. (seed 003, §1):
+/// et al. (document 003, §1):
 ///
 /// ```text
 /// f_a(λ) = −2π ln 0.1 / λ = 2π ln 10 / λ      λ ≥ ln(10)/2;   4π below
@@ -121,7 +121,7 @@ impl Sg {
         self.amplitude
     }
 
-    /// G(v; p, λ, μ) = μ e^{λ(v·p − 1)} (seed 003, §1).
+    /// G(v; p, λ, μ) = μ e^{λ(v·p − 1)} (document 003, §1).
     ///
     /// The SG is a function on the sphere: v is normalized, and the exponent is evaluated as
     /// −λ‖v̂ − p‖²/2 (= λ(v̂·p − 1) for unit vectors), which keeps its relative accuracy near the
@@ -138,7 +138,7 @@ impl Sg {
     /// ∫_{S²} G(v) dv = 2π μ (1 − e^{−2λ}) / λ        (4π μ at λ = 0)
     /// ```
     ///
-    /// Exact closed form (the inner-product formula of seed 003 §1 with a constant 1), evaluated
+    /// Exact closed form (the inner-product formula of document 003 §1 with a constant 1), evaluated
     /// with expm1: accurate for every λ ≥ 0.
     pub fn integral(&self) -> f64 {
         let l = self.sharpness;
@@ -176,7 +176,7 @@ impl Sg {
         (w, d, exponent)
     }
 
-    /// The inner product (seed 003, §1):
+    /// The inner product (document 003, §1):
     ///
     /// ```text
     /// G₁ · G₂ = ∫_{S²} G₁ G₂ dv = 4π μ₁μ₂ e^{−(λ₁+λ₂)} sinh(d_m)/d_m,   d_m = ‖λ₁p₁ + λ₂p₂‖
@@ -225,7 +225,7 @@ impl Sg {
         )
     }
 
-    /// The vector product G₁ ⊗ G₂, the pointwise product, which is an SG (seed 003, §1):
+    /// The vector product G₁ ⊗ G₂, the pointwise product, which is an SG (document 003, §1):
     ///
     /// ```text
     /// G₁(v) G₂(v) = G(v; p_m/‖p_m‖, λ_m ‖p_m‖, μ₁μ₂ e^{λ_m (‖p_m‖ − 1)})
@@ -246,7 +246,7 @@ impl Sg {
     }
 
     /// The solid angle of the ε-support, the region where the lobe is at least ε times its
-    /// peak (seed 003, §1, where it is defined for μ = 1):
+    /// peak (document 003, §1, where it is defined for μ = 1):
     ///
     /// ```text
     /// ∫_{G(v; p, λ, 1) ≥ ε} dv = −2π ln ε / λ        λ ≥ −ln(ε)/2;   4π below
@@ -261,7 +261,7 @@ impl Sg {
     }
 
     /// The cosine of the ε-support's half-angle around the axis, `max(1 + ln ε / λ, −1)`
-    /// (seed 003, §1). Domain: ε ∈ (0, 1].
+    /// (document 003, §1). Domain: ε ∈ (0, 1].
     pub fn epsilon_support_cos(&self, eps: f64) -> Result<f64, QueryError> {
         check_epsilon(eps)?;
         if self.sharpness == 0.0 {
@@ -270,7 +270,7 @@ impl Sg {
         Ok((1.0 + eps.ln() / self.sharpness).max(-1.0))
     }
 
-    /// The clamped-cosine fit of Wang et al. (seed 003, §2.4):
+    /// The clamped-cosine fit of Wang et al. (document 003, §2.4):
     ///
     /// ```text
     /// max(v·n, 0) ≈ C*(v; n) = G(v; n, 2.133, 1.170)
@@ -288,7 +288,7 @@ impl Sg {
     }
 
     /// The document's route to ∫ G(v) max(v·n, 0) dv: the inner product G · C*(·; n) with the
-    /// clamped-cosine fit (seed 003, §2.4). Error: see [`Sg::clamped_cosine`].
+    /// clamped-cosine fit (document 003, §2.4). Error: see [`Sg::clamped_cosine`].
     pub fn clamped_cosine_inner(&self, n: Vec3) -> Result<f64, ParamError> {
         Ok(self.inner(&Sg::clamped_cosine(n)?))
     }
@@ -308,7 +308,7 @@ impl Sg {
     }
 
     /// The lobe warp of Wang et al. from a lobe in half vectors h to one in light directions i
-    /// for the view direction o (seed 003, §2.1):
+    /// for the view direction o (document 003, §2.1):
     ///
     /// ```text
     /// i = ψ(h) = 2 (o·h) h − o,   di = 4 |h·o| dh
@@ -370,7 +370,7 @@ impl Sg {
         ))
     }
 
-    /// The integral over the spherical cap of half-angle θ_d around the axis (seed 003, §2.2,
+    /// The integral over the spherical cap of half-angle θ_d around the axis (document 003, §2.2,
     /// the "dot product" G · V' with the cap visibility V'):
     ///
     /// ```text
@@ -395,7 +395,7 @@ impl Sg {
         ))
     }
 
-    /// The document's vector product of the lobe with the cap visibility V' (seed 003, §2.2):
+    /// The document's vector product of the lobe with the cap visibility V' (document 003, §2.2):
     /// the same lobe, with its amplitude scaled
     ///
     /// ```text
@@ -672,7 +672,7 @@ mod tests {
 
     #[test]
     fn printed_cap_product_misses_the_cap_integral() {
-        // ERRATA.md, E2: seed 003 §2.2 scales the amplitude by f_h(θd, λ)/f_h(π/2, λ) "to
+        // ERRATA.md, E2: document 003 §2.2 scales the amplitude by f_h(θd, λ)/f_h(π/2, λ) "to
         // give the same integral value as the product"; the scaled lobe's integral is
         // μ f_h(θd, λ)(1 + e^{−λ}).
         let mut report = Vec::new();

@@ -1,5 +1,5 @@
 //! Spherical Gaussians (SG), anisotropic spherical Gaussians (ASG) and circular Gaussians, after
-//! seed 003 (P. Khungurn, "Spherical Gaussian Technology", 2016), which surveys Wang et al. 2009
+//! document 003 (P. Khungurn, "Spherical Gaussian Technology", 2016), which surveys Wang et al. 2009
 //! (SG shading), Xu et al. 2013 (ASG) and Iwasaki et al. 2012/2014 (circular Gaussians).
 //!
 //! Every approximation the document gives has a function for the document's route and an

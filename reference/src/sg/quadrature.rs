@@ -2,7 +2,7 @@
 //! (θ, φ) with breakpoints at the lobes' peaks: the `_exact` routes of the SG/ASG module.
 //!
 //! Why a quadrature inside the reference crate: `mfh eval` answers `"route": "exact"` for the
-//! approximations of seed 003 from this crate, which may depend neither on the harness (whose
+//! approximations of document 003 from this crate, which may depend neither on the harness (whose
 //! oracles must stay independent of the closed forms they check) nor on dev-dependencies (the
 //! `quadrature` crate is test-only here). The unit tests check these routes against that
 //! independent test quadrature (`crate::test_support`).
@@ -21,7 +21,7 @@ use std::f64::consts::PI;
 
 /// An integral's value and an estimate of its absolute error.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Estimate {
+pub(crate) struct LobeIntegral {
     /// The value.
     pub value: f64,
     /// The estimated absolute error.
@@ -125,7 +125,12 @@ const MAX_PIECES: usize = 4000;
 /// ∫ f over [breaks[0], breaks[last]], each interval between consecutive breakpoints a
 /// first piece, bisected adaptively until the summed error estimate is at most
 /// `max(rel·|I|, abs)`. Breakpoints must be increasing.
-pub(crate) fn integrate(f: &dyn Fn(f64) -> f64, breaks: &[f64], rel: f64, abs: f64) -> Estimate {
+pub(crate) fn integrate(
+    f: &dyn Fn(f64) -> f64,
+    breaks: &[f64],
+    rel: f64,
+    abs: f64,
+) -> LobeIntegral {
     let mut heap: BinaryHeap<Piece> = breaks
         .windows(2)
         .filter(|w| w[1] > w[0])
@@ -138,16 +143,16 @@ pub(crate) fn integrate(f: &dyn Fn(f64) -> f64, breaks: &[f64], rel: f64, abs: f
             .chain(done.iter())
             .fold((0.0, 0.0), |(v, e), p| (v + p.value, e + p.error));
         if !value.is_finite() {
-            return Estimate {
+            return LobeIntegral {
                 value,
                 error: f64::INFINITY,
             };
         }
         if error <= (rel * value.abs()).max(abs) || heap.len() + done.len() >= MAX_PIECES {
-            return Estimate { value, error };
+            return LobeIntegral { value, error };
         }
         let Some(worst) = heap.pop() else {
-            return Estimate { value, error };
+            return LobeIntegral { value, error };
         };
         let m = 0.5 * (worst.a + worst.b);
         if !(m > worst.a && m < worst.b) || worst.b - worst.a < 1e-15 * worst.a.abs().max(1.0) {

@@ -1,4 +1,4 @@
-//! The Gaussian slope distribution N(s̄, Σ) of seed 002 (eq 1, 11), its rotation into the view
+//! The Gaussian slope distribution N(s̄, Σ) of document 002 (eq 1, 11), its rotation into the view
 //! frame (eq 2–10) and the closed-form mean and covariance of its visible slopes D_s
 //! (eq 12–69), evaluated without cancellation from θ = 0 to π/2 and for near-singular Σ.
 
@@ -13,7 +13,7 @@ pub use crate::spec::GaussianSlopesSpec;
 use crate::spec::ModelSpec;
 use std::f64::consts::TAU;
 
-/// A Gaussian distribution of microfacet slopes (seed 002, §3, eq 1 and 11):
+/// A Gaussian distribution of microfacet slopes (document 002, §3, eq 1 and 11):
 ///
 /// ```text
 /// p_s(s)   = exp(−½ (s − s̄)ᵀ Σ⁻¹ (s − s̄)) / (2π √|Σ|)                          (eq 1)
@@ -38,7 +38,7 @@ use std::f64::consts::TAU;
 /// and `excess_kurtosis` the central one, 0 (a Gaussian), which differ from ν₂ and ν₄/ν₂² − 3
 /// when s̄ ≠ 0.
 ///
-/// Smith Λ: the integral above (Smith's 1-D form, seed 001 eq 17) in closed form; with s̄ = 0
+/// Smith Λ: the integral above (Smith's 1-D form, document 001 eq 17) in closed form; with s̄ = 0
 /// it is Beckmann's Λ with α_φ = √2 σ_φ. With s̄ ≠ 0 the distribution describes a tilted
 /// surface: ∫ (w·m) D(m) dm = cos θ − sin θ s̄_φ ≠ cos θ, so the premises of Smith's model
 /// relative to n = +z fail. Λ is then the integral by definition only; G1 = 1/(1 + Λ) does not
@@ -86,7 +86,7 @@ impl GaussianSlopes {
         self.cov
     }
 
-    /// The slope statistics rotated into the frame (o, ⊥) of azimuth `phi` (seed 002,
+    /// The slope statistics rotated into the frame (o, ⊥) of azimuth `phi` (document 002,
     /// eq 6–10): `mean = [s̄_o, s̄_⊥]`, `cov = [[σ_o², c_o⊥], [c_o⊥, σ_⊥²]]`.
     ///
     /// ```text
@@ -118,7 +118,7 @@ impl GaussianSlopes {
         self.norm * (-0.5 * q).exp()
     }
 
-    /// The mean and covariance of the visible slopes D_s seen from `w` (seed 002, eq 12–46),
+    /// The mean and covariance of the visible slopes D_s seen from `w` (document 002, eq 12–46),
     /// in the surface frame (x, y) and the slope sign of eq 11, i.e. in the same terms as
     /// [`GaussianSlopes::mean`] and [`GaussianSlopes::cov`] (so that the Gaussian
     /// approximation of D_s is `GaussianSlopes::new(m.mean, m.cov)`).
@@ -161,7 +161,7 @@ impl GaussianSlopes {
         })
     }
 
-    /// The moments of D_s by the source's own formulas, as printed or corrected (seed 002
+    /// The moments of D_s by the source's own formulas, as printed or corrected (document 002
     /// pseudocode; see `pseudocode::d_s` and reference/ERRATA.md). Defined for
     /// 0 < θ ≤ π/2 only (NaN at θ = 0).
     pub fn visible_moments_transcribed(
@@ -188,7 +188,7 @@ impl GaussianSlopes {
         self.visible_moments_transcribed(w, Transcription::PseudocodePrinted)
     }
 
-    /// The normalization N of D_s (seed 002, eq 16, 24): the projected area of the facets that
+    /// The normalization N of D_s (document 002, eq 16, 24): the projected area of the facets that
     /// face `w` (unit),
     ///
     /// ```text
@@ -322,7 +322,7 @@ impl VisibleSlopeMoments for GaussianSlopes {
         ]
     }
 
-    /// Routes: `default` (the stable form), `pseudocode` (seed 002's pseudocode with its
+    /// Routes: `default` (the stable form), `pseudocode` (document 002's pseudocode with its
     /// erratum fixed), `pseudocode_printed` (as printed), `equations_printed` (eq 59–69 as
     /// printed). The transcribed routes return NaN at θ = 0.
     fn visible_moments_route(&self, w: Vec3, route: &str) -> Result<VisibleMoments, QueryError> {
@@ -369,7 +369,7 @@ impl Model for GaussianSlopes {
     }
 }
 
-/// The mean and covariance of D_s for a positive *semi*-definite covariance (seed 002,
+/// The mean and covariance of D_s for a positive *semi*-definite covariance (document 002,
 /// eq 12–46, by the same closed form as [`GaussianSlopes::visible_moments`]).
 ///
 /// A singular Σ (|Σ| = 0, including Σ = 0: a perfectly smooth surface) has no density D but

@@ -1,5 +1,5 @@
 //! Unit tests of the Gaussian slope model: every closed form against adaptive quadrature of its
-//! definition, the printed forms of seed 002 against the corrected ones, parameter validation
+//! definition, the printed forms of document 002 against the corrected ones, parameter validation
 //! and stability at θ = 0 and π/2.
 
 use super::*;
@@ -50,7 +50,7 @@ fn regular_cases() -> Vec<Case> {
             correlated(0.3, 0.2, 0.5),
             &[],
         ),
-        // Seed 002, Table 3, rows 4 and 5.
+        // Document 002, Table 3, rows 4 and 5.
         case(
             "table 3 row 4",
             [1.0, 1.0],
@@ -438,7 +438,7 @@ fn smith_lambda_against_its_integral() {
         let model = GaussianSlopes::new(c.mean, c.cov).unwrap();
         for &theta in &thetas {
             for &phi in &phis {
-                // Smith's Λ by its definition (seed 001 eq 17): (1/μ) ∫_μ^∞ (q − μ) P2(q; φ) dq.
+                // Smith's Λ by its definition (document 001 eq 17): (1/μ) ∫_μ^∞ (q − μ) P2(q; φ) dq.
                 let w = from_spherical(theta, phi);
                 let mu = theta.cos() / theta.sin();
                 let r = model.rotated(phi);
@@ -562,7 +562,7 @@ fn erratum_pseudocode_lines_36_39_printed_fails() {
 /// the identity holds with −σ_⊥² ∂p_s/∂s_⊥ − c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s. Eq 51 is right.
 #[test]
 fn erratum_eq52_printed_fails() {
-    use crate::errata::seed002::{eq51, eq52_corrected, eq52_printed, ViewFramePoint};
+    use crate::errata::document002::{eq51, eq52_corrected, eq52_printed, ViewFramePoint};
     let model = GaussianSlopes::new([0.3, -0.2], correlated(0.5, 0.8, 0.4)).unwrap();
     let mut printed_worst: f64 = 0.0;
     for (phi, so, sp) in [(0.4, 0.2, 0.7), (1.9, -0.5, 0.1), (-2.2, 1.0, -0.9)] {
@@ -583,7 +583,7 @@ fn erratum_eq52_printed_fails() {
 /// and every derivative term vanishes, so the printed right side is s̄_o p_s ≠ 0.
 #[test]
 fn erratum_eq53_printed_fails() {
-    use crate::errata::seed002::{
+    use crate::errata::document002::{
         eq53_last_term_corrected, eq53_last_term_printed, ViewFramePoint,
     };
     let model = GaussianSlopes::new([0.3, -0.2], correlated(0.5, 0.8, 0.4)).unwrap();
@@ -832,7 +832,7 @@ fn corrected_pseudocode_fails_far_below_the_cut() {
     }
 }
 
-/// The accuracy table of seed 002: for every route to the moments of D_s, the max
+/// The accuracy table of document 002: for every route to the moments of D_s, the max
 /// error (`moment_error`: the mean in units of max(|s̄ᵢ|, σᵢ), variances relative, the
 /// covariance as a correlation) against 2-D quadrature of the definition (`oracle`), per case
 /// (columns: the regular and near-singular cases above), over θ ∈ {0, 1e-6, 0.3, 0.8, 1.2,
@@ -841,7 +841,7 @@ fn corrected_pseudocode_fails_far_below_the_cut() {
 /// Run: `MFH_EXTENSIVE=1 cargo test -p mfh-reference --release accuracy_table_gaussian_slopes -- --nocapture`.
 #[test]
 fn accuracy_table_gaussian_slopes() {
-    let mut out = ReportTable::new("seed002");
+    let mut out = ReportTable::new("document002");
     let thetas = [
         0.0,
         1e-6,

@@ -1,4 +1,4 @@
-//! Gaussian slope distributions (seed 002, §3–6): the model, its rotation into the view frame
+//! Gaussian slope distributions (document 002, §3–6): the model, its rotation into the view frame
 //! and the mean and covariance of its visible slopes D_s.
 
 pub mod gaussian;

@@ -1,4 +1,4 @@
-//! The D_s pseudocode of seed 002 (§6, lines 1–56) ported line by line: as printed, with each
+//! The D_s pseudocode of document 002 (§6, lines 1–56) ported line by line: as printed, with each
 //! erratum corrected, and with the equations' E₁ (eq 59) in place of the pseudocode's. Kept to
 //! show what the printed forms compute; the model's default route is `gaussian::visible_moments`.
 
@@ -17,7 +17,7 @@ pub enum Transcription {
     EquationsPrinted,
 }
 
-/// Seed 002, pseudocode lines 8–55, transcribed (variable names kept).
+/// Document 002, pseudocode lines 8–55, transcribed (variable names kept).
 ///
 /// ```text
 /// E1 = √(σ_o²/2π) exp(−(cot θ − s̄_o)²/(2σ_o²))        (line 23; eq 59 prints −σ_o/√(2π) …)

@@ -1,5 +1,5 @@
 //! The standard normal density weighted by a linear ramp and cut at a point: the
-//! one-dimensional core of the visible-slope moments (seed 002, eq 59–69) and of Smith Λ for
+//! one-dimensional core of the visible-slope moments (document 002, eq 59–69) and of Smith Λ for
 //! Gaussian slopes, evaluated without cancellation in every regime.
 //!
 //! With φ the standard normal density and

@@ -2,7 +2,7 @@
 //! G7/K15 nodes and weights every quadrature of the project shares.
 //!
 //! Why this lives in the reference crate: the "exact" and "slope_space" Smith Λ routes of the
-//! piecewise-linear and blended NDFs (seed 000, eq 10–13 and 30–32) have no closed form, so the
+//! piecewise-linear and blended NDFs (document 000, eq 10–13 and 30–32) have no closed form, so the
 //! model itself must integrate. The crate may not depend on the `quadrature` crate (it is a
 //! dev-dependency, kept for the independent test oracles), and the tests must stay independent
 //! of the code they check: the tests integrate with `test_support` (double-exponential), the
@@ -47,7 +47,7 @@ pub const WG: [f64; 4] = [
 
 /// The result of an adaptive integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Estimate {
+pub struct Integral {
     /// The integral.
     pub value: f64,
     /// The summed |K15 − G7| error estimate of the accepted intervals.
@@ -77,7 +77,7 @@ fn gk15(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
 /// ∫ f over `[breaks[0], breaks[last]]` with the integrand smooth between consecutive break
 /// points (which must be non-decreasing; empty intervals are skipped). Stops when the error
 /// estimate is ≤ max(rel·|I|, abs) or after `MAX_INTERVALS` intervals.
-pub fn integrate(f: &dyn Fn(f64) -> f64, breaks: &[f64], rel: f64, abs: f64) -> Estimate {
+pub fn integrate(f: &dyn Fn(f64) -> f64, breaks: &[f64], rel: f64, abs: f64) -> Integral {
     const MAX_INTERVALS: usize = 4000;
     // (a, b, value, error)
     let mut pieces: Vec<(f64, f64, f64, f64)> = Vec::with_capacity(2 * breaks.len() + 16);
@@ -103,7 +103,7 @@ pub fn integrate(f: &dyn Fn(f64) -> f64, breaks: &[f64], rel: f64, abs: f64) -> 
             .max_by(|x, y| x.1 .3.total_cmp(&y.1 .3))
             .map(|(i, _)| i);
         let Some(i) = worst.filter(|_| !done) else {
-            return Estimate {
+            return Integral {
                 value,
                 error,
                 evaluations,

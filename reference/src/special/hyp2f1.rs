@@ -1,5 +1,5 @@
 //! ₂F₁(½, C − ½; 3/2; z) for z ∈ (−∞, 0] and C > 1, the hypergeometric function in Λ of the
-//! Student family (seed 001, eq 21), plus the document's own §8 Algorithm 2, printed and
+//! Student family (document 001, eq 21), plus the document's own §8 Algorithm 2, printed and
 //! corrected, kept so that the harness can measure where it fails.
 //!
 //! Written by hand: no maintained Rust crate evaluates ₂F₁ over the whole negative half-line
@@ -31,7 +31,7 @@ pub const SWITCH: f64 = 1.5;
 /// The most terms or continued-fraction steps any evaluation takes before giving up (NaN).
 const MAX_TERMS: usize = 100_000;
 
-/// N_C = Γ(C − ½)/(√π Γ(C − 1)), the constant of the standardized Student P2 (seed 001 eq 15
+/// N_C = Γ(C − ½)/(√π Γ(C − 1)), the constant of the standardized Student P2 (document 001 eq 15
 /// with σ√(γ−1) = 1); accurate to a few ulps for every C > 1.
 pub fn student_norm(c: f64) -> f64 {
     gamma_half_ratio(c - 1.0) / PI.sqrt()
@@ -227,7 +227,7 @@ pub(crate) fn beta_cf_k(c: f64, s: f64, w: f64, delta: f64) -> f64 {
     c * (1.0 + delta) / beta_cf_k_denominator(c, s, w, delta)
 }
 
-/// ₂F₁(½, C − ½; 3/2; z) for z ≤ 0 and C > 1 (seed 001 eq 21 needs C > 3/2).
+/// ₂F₁(½, C − ½; 3/2; z) for z ≤ 0 and C > 1 (document 001 eq 21 needs C > 3/2).
 ///
 /// ```text
 /// ₂F₁(½, C−½; 3/2; −x²) = (1/x) ∫₀ˣ (1 + q²)^{½−C} dq
@@ -295,7 +295,7 @@ fn gamma(x: f64) -> f64 {
     statrs::function::gamma::gamma(x)
 }
 
-/// Seed 001 §8 Algorithm 2 **as printed** (a = ½, b = γ − ½, c = 3/2; GSL's 2F1 replaced by
+/// Document 001 §8 Algorithm 2 **as printed** (a = ½, b = γ − ½, c = 3/2; GSL's 2F1 replaced by
 /// `gauss_series`):
 ///
 /// ```text
@@ -372,7 +372,7 @@ pub fn algorithm2_terms_needed(x: f64) -> f64 {
     (1e-17 * one_minus_w).ln() / w.ln() + 1.0
 }
 
-/// Seed 001 §8 Algorithm 2 with its printed errors corrected (line 1 returns 1; line 6 is
+/// Document 001 §8 Algorithm 2 with its printed errors corrected (line 1 returns 1; line 6 is
 /// Γ(3/2)Γ(γ−1)/Γ(γ−½) (−z)^{−½}, the series ₂F₁(½, 0; 2−γ; 1/z) = 1; line 7 uses
 /// Γ(1−γ)/Γ(2−γ) = 1/(1−γ)), and with every series put in a form whose terms are all positive
 /// (the issue-12 defect: the Gauss series of line 15 and of line 7 alternate, and for γ = 50
@@ -418,7 +418,7 @@ pub fn lambda_edges(c: f64, x: f64) -> Option<f64> {
     }
 }
 
-/// Λ_C(x) by seed 001 eq 21 with ₂F₁ from the corrected Algorithm 2
+/// Λ_C(x) by document 001 eq 21 with ₂F₁ from the corrected Algorithm 2
 /// (`hyp2f1_lambda_algorithm2_corrected`), the difference of eq 21 taken where it cancels:
 ///
 /// In the 15.3.7 form, N x · Γ(3/2)Γ(γ−1)/Γ(γ−½) (−z)^{−½} = ½ exactly, so eq 21's − ½ cancels

@@ -1,10 +1,10 @@
 //! Smith Λ of the standardized Student slope distribution and of the Gaussian (Beckmann), free
 //! of the cancellation that the printed closed forms suffer near normal incidence.
 //!
-//! Written by hand: Λ is the small difference of two nearly equal terms (seed 001 eq 21, and
+//! Written by hand: Λ is the small difference of two nearly equal terms (document 001 eq 21, and
 //! ½(e^{−a²}/(a√π) − erfc a) for Beckmann); no crate evaluates that difference directly.
 //!
-//! Standardized form (seed 001 eq 15 and 21 with σ√(γ−1) = 1, C = γ): with
+//! Standardized form (document 001 eq 15 and 21 with σ√(γ−1) = 1, C = γ): with
 //! P2(q) = N (1+q²)^{½−C}, N = Γ(C−½)/(√π Γ(C−1)), w = 1/(1+x²),
 //!
 //! ```text
@@ -127,7 +127,7 @@ fn exp_minus_square(a: f64) -> f64 {
     (-hi).exp() * (1.0 - lo)
 }
 
-/// Beckmann Smith Λ(a), a = cot θ / α ≥ 0 (seed 001 Table 1, γ = ∞; Walter et al. 2007):
+/// Beckmann Smith Λ(a), a = cot θ / α ≥ 0 (document 001 Table 1, γ = ∞; Walter et al. 2007):
 ///
 /// ```text
 /// Λ(a) = ½ (e^{−a²}/(a√π) − erfc a)                          a < ½

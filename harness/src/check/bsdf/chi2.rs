@@ -3,7 +3,7 @@
 
 use super::{BsdfSubject, Incidence, Integrals, SOURCE};
 use crate::check::{applied, covers, Check, PlannedCheck, Profile};
-use crate::oracle::chi2::{Chi2Config, Verdict as Chi2Verdict};
+use crate::oracle::chi2::{Chi2Config, TestOutcome};
 use crate::oracle::sphere_chi2::{
     sphere_chi2_against, SphereChi2Result, MASS_BUDGET, MASS_NONCENTRALITY,
 };
@@ -79,7 +79,7 @@ pub fn plan<'a>(
                     dof: result.dof,
                     alpha: STATISTICAL_ALPHA.value,
                 });
-                r.verdict = if result.verdict == Chi2Verdict::Pass {
+                r.verdict = if result.verdict == TestOutcome::Pass {
                     Verdict::Pass
                 } else {
                     Verdict::Fail

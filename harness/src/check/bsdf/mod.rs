@@ -35,7 +35,7 @@ pub use chi2::{table as chi2_table, RESOLUTION as CHI2_RESOLUTION};
 
 use super::{PlannedCheck, Profile};
 use crate::oracle::chi2::Expected;
-use crate::oracle::domain::HemisphereGrid;
+use crate::oracle::hemisphere_grid::HemisphereGrid;
 use crate::oracle::lobe_centres::lobe_centres;
 use crate::oracle::sphere_chi2::{
     chi2_masses_about, draw_chunks, expected_sphere_about, SphereMasses,

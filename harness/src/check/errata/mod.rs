@@ -9,16 +9,16 @@
 //! route evaluates are transcribed here, each with its document and equation. The oracle is
 //! always harness code (`crate::oracle`), never the reference crate's `*_exact` routes.
 //!
-//! One file per document (`seed000.rs` … `seed004.rs`); this file holds the catalogue, the
+//! One file per document (`document000.rs` … `document004.rs`); this file holds the catalogue, the
 //! planning by [`Scope`] and the verdict. Forms the documents present as approximations are
 //! claims (`check::claims`), not errata.
 
+mod document000;
+mod document001;
+mod document002;
+mod document003;
+mod document004;
 mod scope;
-mod seed000;
-mod seed001;
-mod seed002;
-mod seed003;
-mod seed004;
 
 pub use scope::{Concern, Effect, Scope, STUDENT};
 
@@ -210,7 +210,7 @@ pub const NOT_DEMONSTRABLE: &[(&str, &str, Concern)] = &[
     ),
 ];
 
-/// The piecewise-linear family of seed 000.
+/// The piecewise-linear family of document 000.
 const PIECEWISE: &[&str] = &["piecewise_linear"];
 
 /// What a demonstration found: the printed and the corrected value against one oracle.
@@ -261,11 +261,11 @@ struct Demo(
 
 /// Every demonstration, document by document.
 fn demos() -> Vec<Demo> {
-    let mut out = seed001::demos();
-    out.extend(seed000::demos());
-    out.extend(seed002::demos());
-    out.extend(seed004::demos());
-    out.extend(seed003::demos());
+    let mut out = document001::demos();
+    out.extend(document000::demos());
+    out.extend(document002::demos());
+    out.extend(document004::demos());
+    out.extend(document003::demos());
     out
 }
 
@@ -386,14 +386,14 @@ mod tests {
     fn ids_in_errata_md() -> Vec<String> {
         let text = include_str!("../../../../reference/ERRATA.md");
         let mut out = Vec::new();
-        let mut seed = "";
+        let mut document = "";
         for line in text.lines() {
-            if let Some(rest) = line.strip_prefix("## Seed ") {
-                seed = &rest[..3];
+            if let Some(rest) = line.strip_prefix("## Document ") {
+                document = &rest[..3];
                 continue;
             }
             let t = line.trim();
-            if seed == "001" && t.starts_with("| ") {
+            if document == "001" && t.starts_with("| ") {
                 let cell = t[2..].split('|').next().unwrap_or("").trim();
                 if !cell.is_empty() && cell.chars().all(|c| c.is_ascii_digit()) {
                     out.push(format!("001-{cell}"));
@@ -401,13 +401,14 @@ mod tests {
             } else if let Some(rest) = t.strip_prefix("### ") {
                 let head = rest.split([' ', '—']).next().unwrap_or("");
                 let head = head.trim_end_matches('.');
-                if seed == "002" && head.chars().all(|c| c.is_ascii_digit()) && !head.is_empty() {
+                if document == "002" && head.chars().all(|c| c.is_ascii_digit()) && !head.is_empty()
+                {
                     out.push(format!("002-{head}"));
                 } else if (head.starts_with('E') || head.starts_with('S') || head.starts_with('U'))
                     && head.len() > 1
                     && head[1..].chars().all(|c| c.is_ascii_digit())
                 {
-                    out.push(format!("{seed}-{head}"));
+                    out.push(format!("{document}-{head}"));
                 }
             }
         }

@@ -16,13 +16,13 @@ pub enum Effect {
     SampleNormals,
     /// A material samples visible normals.
     SampleVisible,
-    /// A material samples by the pseudo-VNIS of seed 001 §7.2.
+    /// A material samples by the pseudo-VNIS of document 001 §7.2.
     PseudoVnis,
-    /// Gaussian-slope filtering (seed 002's visible-slope moments).
+    /// Gaussian-slope filtering (document 002's visible-slope moments).
     GaussianSlopes,
-    /// Spherical-Gaussian lighting (seed 003 §1–2, §4).
+    /// Spherical-Gaussian lighting (document 003 §1–2, §4).
     SphericalGaussians,
-    /// Anisotropic-spherical-Gaussian lighting (seed 003 §3).
+    /// Anisotropic-spherical-Gaussian lighting (document 003 §3).
     AnisotropicSphericalGaussians,
 }
 
@@ -41,7 +41,7 @@ impl Effect {
     }
 }
 
-/// The Student-t members of seed 001, which share its Λ, sampling and §7 derivations.
+/// The Student-t members of document 001, which share its Λ, sampling and §7 derivations.
 pub const STUDENT: &[&str] = &[
     "std",
     "hyper_cauchy",

@@ -1,4 +1,4 @@
-//! The pseudo-VNIS of seed 001 §7.2 for STD: the chi-square of Algorithm 1's proxy against its
+//! The pseudo-VNIS of document 001 §7.2 for STD: the chi-square of Algorithm 1's proxy against its
 //! density, and the bias of its estimator with eq 43's weight as printed and with the unbiased
 //! one.
 
@@ -44,7 +44,7 @@ fn std_parameters(spec: &ModelSpec) -> Result<(f64, f64, f64), String> {
 const PSEUDO_VNIS_SOURCE: &str = "seed 001 §7.2, Algorithm 1 and eq 43 (weight(v) = G/G1(v))";
 
 /// Plans `sampling.chi2_pseudo_vnis` and `sampling.pseudo_vnis` for one material sampled with
-/// the pseudo-VNIS of seed 001 §7.2 (scene `sampling: pseudo_vnis`): at each of
+/// the pseudo-VNIS of document 001 §7.2 (scene `sampling: pseudo_vnis`): at each of
 /// [`VISIBLE_INCIDENCES`], the chi-square of the proxy's samples against the proxy's density,
 /// and the Monte Carlo mean of
 /// the estimator of E(wi) = ∫ G2(wo, wi, m)⟨wi·m⟩⁺D(m)/cos θi dm (wo the mirror of wi about m,

@@ -171,5 +171,5 @@ fn a_wrong_visible_density_fails_the_chi_square() {
     // The normal sampler is not a visible-normal sampler.
     let s = a.model.as_sampler().unwrap();
     let r = chi2_test(&|u| s.sample_wm(u), &|m| va.pdf_wm_visible(wi, m), &config);
-    assert_eq!(r.verdict, crate::oracle::chi2::Verdict::Fail);
+    assert_eq!(r.verdict, crate::oracle::chi2::TestOutcome::Fail);
 }

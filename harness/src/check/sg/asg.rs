@@ -1,4 +1,4 @@
-//! Anisotropic spherical Gaussians of seed 003 §3 (evaluation, integral, product, ASG–SG
+//! Anisotropic spherical Gaussians of document 003 §3 (evaluation, integral, product, ASG–SG
 //! convolution), each against sphere quadrature or its definition.
 
 use super::{around, axis, compare_claim, compare_worst, cover, error};
@@ -29,7 +29,7 @@ const SRC_CONVOLUTION: &str = "seed 003 §3.2.3: C(p) ≈ c max(p·z, 0) e^{−�
 /// The SG sharpness where the convolution's claim is tight (ERRATA 003 E5).
 const SHARP_SG: f64 = 1e3;
 
-/// The tangent-plane integral the ASG–SG convolution formula stands for (seed 003 §3.2.3):
+/// The tangent-plane integral the ASG–SG convolution formula stands for (document 003 §3.2.3):
 /// `amplitude` · (p·z) · ∫∫ e^{−λX² − μY²} e^{−ν((X − p·x)² + (Y − p·y)²)} dX dY with
 /// ν = sharpness/2 (an SG e^{s(v·p − 1)} is e^{−(s/2)|v − p|²} near p), in the ASG's frame
 /// (x, y, z) = `frame_about(z)`, by quadrature of each factor over the line.

@@ -1,4 +1,4 @@
-//! Circular Gaussians of seed 003 §4 (von Mises integral, products, the SG decomposition),
+//! Circular Gaussians of document 003 §4 (von Mises integral, products, the SG decomposition),
 //! each against quadrature over the period or its definition.
 
 use super::{accuracy, compare_worst, cover, error};

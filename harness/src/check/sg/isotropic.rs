@@ -1,4 +1,4 @@
-//! SG identities and closed forms of seed 003 §1–2 (evaluation, integral, inner and vector
+//! SG identities and closed forms of document 003 §1–2 (evaluation, integral, inner and vector
 //! products, cap integral, ε-support, lobe warp, clamped-cosine fit), each against sphere
 //! quadrature or its definition.
 

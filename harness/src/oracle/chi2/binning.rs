@@ -2,7 +2,7 @@
 //! chunk by chunk, and binned into the cells of a [`HemisphereGrid`] in parallel, with counts
 //! independent of the thread count and of how the samples are batched.
 
-use crate::oracle::domain::{CellFinder, DomainError, HemisphereGrid};
+use crate::oracle::hemisphere_grid::{CellFinder, DirectionError, HemisphereGrid};
 use crate::random::stream;
 use mfh_reference::geometry::Vec3;
 use rayon::prelude::*;
@@ -13,15 +13,15 @@ pub const CHUNK: u64 = 1 << 16;
 /// do not depend on it).
 const BATCH: usize = 256;
 
-/// Observed counts per cell, with the samples that fell outside the domain.
+/// Observed counts per cell, with the samples that fell outside the upper hemisphere.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Observed {
     /// Counts per cell (row-major, row 0 at the horizon).
     pub counts: Vec<u64>,
-    /// Samples outside the domain.
+    /// Samples outside the upper hemisphere.
     pub outside: u64,
-    /// The first sample outside the domain (lowest index) and why.
-    pub first_outside: Option<(u64, DomainError)>,
+    /// The first sample outside the upper hemisphere (lowest index) and why.
+    pub first_outside: Option<(u64, DirectionError)>,
 }
 
 impl Observed {
@@ -124,7 +124,7 @@ where
                             acc.counts[cell] += 1;
                         }
                     } else {
-                        // A direction outside the domain in this block (rare): one by one.
+                        // A direction outside the upper hemisphere in this block (rare): one by one.
                         for (index, &m) in (first..).zip(&m[..n]) {
                             match finder.cell_of(m) {
                                 Ok(cell) => acc.counts[cell] += 1,

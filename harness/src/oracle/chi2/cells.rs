@@ -19,8 +19,10 @@
 
 use super::expected::in_angles;
 use super::BatchPdf;
-use crate::oracle::cubature::{gauss7_products, integrate_rectangles_batch, BatchFn2, Tolerance};
-use crate::oracle::domain::HemisphereGrid;
+use crate::oracle::cubature::{
+    gauss7_products, integrate_rectangles_batch, AccuracyGoal, BatchFn2,
+};
+use crate::oracle::hemisphere_grid::HemisphereGrid;
 use crate::oracle::lobe::Lobe;
 use crate::tolerance::{LAYOUT_ABSOLUTE_TOLERANCE, LAYOUT_RELATIVE_TOLERANCE};
 use std::f64::consts::{FRAC_PI_2, TAU};
@@ -154,7 +156,7 @@ fn strip_masses(
             .collect();
         return (masses, 49 * pieces as u64);
     }
-    let tolerance = Tolerance {
+    let tolerance = AccuracyGoal {
         absolute: LAYOUT_ABSOLUTE_TOLERANCE / pieces as f64,
         relative: LAYOUT_RELATIVE_TOLERANCE,
     };

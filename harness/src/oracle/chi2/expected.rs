@@ -4,9 +4,9 @@
 
 use super::BatchPdf;
 use crate::oracle::cubature::{
-    integrate_rectangle, integrate_rectangles_batch_budgeted, BudgetHit, Tolerance,
+    integrate_rectangle, integrate_rectangles_batch_budgeted, AccuracyGoal, BudgetHit,
 };
-use crate::oracle::domain::HemisphereGrid;
+use crate::oracle::hemisphere_grid::HemisphereGrid;
 use crate::oracle::lobe::{self, Lobe};
 use crate::oracle::Estimate;
 use crate::tolerance::{CELL_ABSOLUTE_TOLERANCE, CELL_RELATIVE_TOLERANCE};
@@ -106,7 +106,7 @@ where
         .map(|i| {
             crate::deadline::check(deadline);
             let (thetas, phis, pieces) = cell_pieces(&grid, i, &polar, &azimuth);
-            let tolerance = Tolerance {
+            let tolerance = AccuracyGoal {
                 absolute: CELL_ABSOLUTE_TOLERANCE / pieces as f64,
                 relative,
             };
@@ -166,7 +166,7 @@ pub fn expected_mass_in_batch(
     let mut per_cell = Vec::with_capacity(grid.cells());
     for i in 0..grid.cells() {
         let (thetas, phis, pieces) = cell_pieces(&grid, i, &polar, &azimuth);
-        let tolerance = Tolerance {
+        let tolerance = AccuracyGoal {
             absolute: absolute / pieces as f64,
             relative,
         };

@@ -4,8 +4,8 @@
 //! (`crate::oracle::sphere_chi2`) takes too.
 
 use super::components::{components, Components};
-use super::{Chi2Config, Chi2Result, Expected, Failure, Observed, OutsideDomain, Verdict};
-use crate::oracle::domain::{DomainError, HemisphereGrid};
+use super::{Chi2Config, Chi2Result, Expected, Failure, Observed, OutsideHemisphere, TestOutcome};
+use crate::oracle::hemisphere_grid::{DirectionError, HemisphereGrid};
 use crate::tolerance::{MASS_TOLERANCE, MIN_EXPECTED};
 
 /// The verdict from the observed and expected counts.
@@ -28,7 +28,7 @@ pub(super) fn judge(
         pooled_cells: 0,
         samples: config.samples,
         seed: config.seed,
-        verdict: Verdict::Fail,
+        verdict: TestOutcome::Fail,
         reason: None,
         expected_mass: expected.total,
         expected_error_bound: expected.error_bound * n,
@@ -41,9 +41,9 @@ pub(super) fn judge(
     };
     result.reason = sanity(&result, &expected, observed.outside, observed.first_outside);
     // Masses whose cubature ran out of budget above its target judge nothing (not even a
-    // mass off or a zero-pdf cell); samples outside the domain are wrong whatever they are.
+    // mass off or a zero-pdf cell); samples outside the upper hemisphere are wrong whatever they are.
     if let Some(hit) = expected.budget_hit.filter(|h| !(h.bound <= h.target)) {
-        if !matches!(result.reason, Some(Failure::OutsideDomain(_))) {
+        if !matches!(result.reason, Some(Failure::OutsideHemisphere(_))) {
             result.reason = Some(Failure::CubatureBudget {
                 rectangles: hit.rectangles,
                 budget: crate::oracle::cubature::MAX_RECTANGLES,
@@ -70,7 +70,7 @@ pub(super) fn judge(
     result.components = test.components;
     result.p_value = test.p_value;
     result.verdict = test.verdict;
-    if test.verdict == Verdict::Fail {
+    if test.verdict == TestOutcome::Fail {
         result.reason = Some(Failure::Rejected {
             p_value: result.p_value,
             alpha: config.alpha,
@@ -94,7 +94,7 @@ pub(crate) struct PearsonTest {
     /// The p-value: the two parts' combination, or Q(dof/2, statistic/2) without them.
     pub p_value: f64,
     /// Pass when the p-value is at least α.
-    pub verdict: Verdict,
+    pub verdict: TestOutcome,
 }
 
 /// Fewer than two bins after pooling: no statistic to judge.
@@ -131,9 +131,9 @@ pub(crate) fn pearson_test(
             .unwrap_or(f64::NAN),
     };
     let verdict = if p_value >= alpha {
-        Verdict::Pass
+        TestOutcome::Pass
     } else {
-        Verdict::Fail
+        TestOutcome::Fail
     };
     Ok(PearsonTest {
         statistic,
@@ -145,16 +145,16 @@ pub(crate) fn pearson_test(
     })
 }
 
-/// The sanity failures, in order: samples outside the domain, invalid or off mass, samples in
+/// The sanity failures, in order: samples outside the upper hemisphere, invalid or off mass, samples in
 /// zero-pdf cells.
 fn sanity(
     result: &Chi2Result,
     expected: &Expected,
     outside: u64,
-    first_outside: Option<(u64, DomainError)>,
+    first_outside: Option<(u64, DirectionError)>,
 ) -> Option<Failure> {
     if let Some((index, error)) = first_outside {
-        return Some(Failure::OutsideDomain(OutsideDomain {
+        return Some(Failure::OutsideHemisphere(OutsideHemisphere {
             index,
             error,
             count: outside,

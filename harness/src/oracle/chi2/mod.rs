@@ -16,7 +16,7 @@
 //!    ([`crate::oracle::lobe`]); every cell is integrated in (φ, θ), cut where the lobe varies,
 //!    by adaptive G7/K15 product cubature ([`crate::oracle::cubature`]) with a per-cell error
 //!    bound ([`expected_mass_in`]); the total mass and the summed error bound are reported.
-//! 3. **Sanity failures first** (no p-value): a sample outside the domain (non-finite, non-unit,
+//! 3. **Sanity failures first** (no p-value): a sample outside the upper hemisphere (non-finite, non-unit,
 //!    below the horizon), a total pdf mass off from 1 by more than [`MASS_TOLERANCE`], a
 //!    non-finite or negative cell mass, a sample in a cell of zero expected count.
 //! 4. **Pooling.** Cells with expected count < [`MIN_EXPECTED`] are pooled into one bin; if that
@@ -33,7 +33,7 @@
 //!
 //! [`MASS_TOLERANCE`]: crate::tolerance::MASS_TOLERANCE
 //! [`MIN_EXPECTED`]: crate::tolerance::MIN_EXPECTED
-//! [`CellFinder`]: crate::oracle::domain::CellFinder
+//! [`CellFinder`]: crate::oracle::hemisphere_grid::CellFinder
 //! [`KINKED_CELL_RELATIVE_TOLERANCE`]: crate::tolerance::KINKED_CELL_RELATIVE_TOLERANCE
 //! [`CELL_RELATIVE_TOLERANCE`]: crate::tolerance::CELL_RELATIVE_TOLERANCE
 //! [`CELL_ABSOLUTE_TOLERANCE`]: crate::tolerance::CELL_ABSOLUTE_TOLERANCE
@@ -50,7 +50,7 @@ pub use expected::{
     expected_mass_in_batch, expected_mass_to, Expected,
 };
 
-use crate::oracle::domain::{DomainError, HemisphereGrid};
+use crate::oracle::hemisphere_grid::{DirectionError, HemisphereGrid};
 use crate::oracle::lobe::{self, Lobe};
 use crate::tolerance::CELL_RELATIVE_TOLERANCE;
 use binning::scalar_batch;
@@ -77,7 +77,7 @@ pub struct Chi2Config {
 /// The outcome of a test.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Verdict {
+pub enum TestOutcome {
     /// Consistent with the pdf at level α.
     Pass,
     /// A sanity failure, or p < α.
@@ -87,12 +87,12 @@ pub enum Verdict {
 /// Samples outside the upper hemisphere (a sanity failure of the chi-square and KS tests):
 /// how many, and the first of them (in the seeded sequence) with what is wrong with it.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-#[error("{count} samples outside the domain; the first, sample {index}: {error}")]
-pub struct OutsideDomain {
+#[error("{count} samples outside the upper hemisphere; the first, sample {index}: {error}")]
+pub struct OutsideHemisphere {
     /// Index of the first offending sample (in the seeded sequence).
     pub index: u64,
     /// What is wrong with it.
-    pub error: DomainError,
+    pub error: DirectionError,
     /// How many samples were outside.
     pub count: u64,
 }
@@ -102,7 +102,7 @@ pub struct OutsideDomain {
 pub enum Failure {
     /// Samples lie outside the upper hemisphere.
     #[error(transparent)]
-    OutsideDomain(OutsideDomain),
+    OutsideHemisphere(OutsideHemisphere),
     /// The pdf does not integrate to 1 over the hemisphere.
     #[error("pdf mass {mass} (± {error_bound:.1e}) differs from 1 by more than {tolerance}")]
     MassOff {
@@ -194,7 +194,7 @@ pub struct Chi2Result {
     /// The seed of the random streams.
     pub seed: u64,
     /// Pass or fail.
-    pub verdict: Verdict,
+    pub verdict: TestOutcome,
     /// Why it failed, if it did.
     pub reason: Option<Failure>,
     /// The integrated pdf mass over the hemisphere.

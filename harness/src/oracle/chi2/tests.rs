@@ -1,5 +1,5 @@
 use super::*;
-use crate::oracle::domain::CellFinder;
+use crate::oracle::hemisphere_grid::CellFinder;
 use crate::random::stream;
 use mfh_reference::{Model, ModelSpec};
 
@@ -34,7 +34,7 @@ fn assert_passes(json: &str) -> Chi2Result {
         r.samples_per_second(),
         r.integration_seconds
     );
-    assert_eq!(r.verdict, Verdict::Pass, "{:?}", r.reason);
+    assert_eq!(r.verdict, TestOutcome::Pass, "{:?}", r.reason);
     assert!(r.p_value > 1e-4);
     assert!((r.expected_mass - 1.0).abs() < 1e-6);
     assert!(r.expected_error_bound < 1e-2);
@@ -79,7 +79,7 @@ fn chi2_narrow_lobes_pass() {
             "{json}: p = {:.3}, mass = {} ± {:.1e} counts, integration {:.3} s",
             r.p_value, r.expected_mass, r.expected_error_bound, r.integration_seconds
         );
-        assert_eq!(r.verdict, Verdict::Pass, "{json}: {:?}", r.reason);
+        assert_eq!(r.verdict, TestOutcome::Pass, "{json}: {:?}", r.reason);
         assert!(
             (r.expected_mass - 1.0).abs() < 1e-9,
             "{json}: {}",
@@ -110,7 +110,7 @@ fn chi2_wrong_roughness_fails() {
     let pdf = model(r#"{"family":"ggx","alpha":0.33}"#);
     let (s, p) = (sampler.as_sampler().unwrap(), pdf.as_sampler().unwrap());
     let r = chi2_test(&|u| s.sample_wm(u), &|m| p.pdf_wm(m), &config());
-    assert_eq!(r.verdict, Verdict::Fail);
+    assert_eq!(r.verdict, TestOutcome::Fail);
     assert!(r.p_value < 1e-12, "{r:?}");
     assert!(matches!(r.reason, Some(Failure::Rejected { .. })));
 }
@@ -128,7 +128,7 @@ fn chi2_printed_half_azimuth_sampler_fails() {
             ..config()
         },
     );
-    assert_eq!(r.verdict, Verdict::Fail);
+    assert_eq!(r.verdict, TestOutcome::Fail);
     assert_eq!(r.p_value, 0.0);
     assert!(matches!(r.reason, Some(Failure::Rejected { .. })));
 }
@@ -146,10 +146,10 @@ fn chi2_below_horizon_is_a_sanity_failure() {
         }
     };
     let r = chi2_test(&sample, &|w| s.pdf_wm(w), &config());
-    assert_eq!(r.verdict, Verdict::Fail);
+    assert_eq!(r.verdict, TestOutcome::Fail);
     match r.reason {
-        Some(Failure::OutsideDomain(OutsideDomain {
-            error: DomainError::BelowHorizon(_),
+        Some(Failure::OutsideHemisphere(OutsideHemisphere {
+            error: DirectionError::BelowHorizon(_),
             count,
             ..
         })) => assert!((5_000..15_000).contains(&count), "{count}"),
@@ -158,9 +158,9 @@ fn chi2_below_horizon_is_a_sanity_failure() {
     let nan = chi2_test(&|_| [f64::NAN; 3], &|w| s.pdf_wm(w), &config());
     assert!(matches!(
         nan.reason,
-        Some(Failure::OutsideDomain(OutsideDomain {
+        Some(Failure::OutsideHemisphere(OutsideHemisphere {
             index: 0,
-            error: DomainError::NotFinite(_),
+            error: DirectionError::NotFinite(_),
             ..
         }))
     ));
@@ -346,13 +346,13 @@ fn lobe_layout_balances_the_cells_and_catches_a_roughness_error() {
         )
     };
     let caught = run(w, Layout::FollowLobe);
-    assert_eq!(caught.verdict, Verdict::Fail, "{}", caught.p_value);
+    assert_eq!(caught.verdict, TestOutcome::Fail, "{}", caught.p_value);
     // The record's edges are the narrow lobe's: every row above cos θ = 0.999.
     assert!(caught.z_edges[1] > 0.999, "{:?}", caught.z_edges);
     let missed = run(w, Layout::EqualArea);
-    assert_eq!(missed.verdict, Verdict::Pass, "{}", missed.p_value);
+    assert_eq!(missed.verdict, TestOutcome::Pass, "{}", missed.p_value);
     let correct = run(s, Layout::FollowLobe);
-    assert_eq!(correct.verdict, Verdict::Pass, "{}", correct.p_value);
+    assert_eq!(correct.verdict, TestOutcome::Pass, "{}", correct.p_value);
 }
 
 #[test]

@@ -54,8 +54,8 @@ pub use table::{
     marginal_cdf_lobe_batch_at, CdfTable,
 };
 
-use crate::oracle::chi2::{BatchSampler, OutsideDomain, Verdict, CHUNK};
-use crate::oracle::domain::{validate, DomainError};
+use crate::oracle::chi2::{BatchSampler, OutsideHemisphere, TestOutcome, CHUNK};
+use crate::oracle::hemisphere_grid::{validate, DirectionError};
 use crate::oracle::lobe::{self, Lobe};
 use crate::oracle::quadrature::Accuracy;
 use crate::precision::Precision;
@@ -231,7 +231,7 @@ pub struct KsConfig {
 pub enum Failure {
     /// Samples lie outside the upper hemisphere.
     #[error(transparent)]
-    OutsideDomain(OutsideDomain),
+    OutsideHemisphere(OutsideHemisphere),
     /// The marginal density is negative or not finite somewhere.
     #[error("marginal density {value} at {at}")]
     InvalidDensity {
@@ -299,7 +299,7 @@ pub struct KsResult {
     /// The seed of the random streams.
     pub seed: u64,
     /// Pass or fail.
-    pub verdict: Verdict,
+    pub verdict: TestOutcome,
     /// Why it failed, if it did.
     pub reason: Option<Failure>,
     /// Knots of the CDF table.
@@ -316,11 +316,11 @@ pub struct KsResult {
     pub table_seconds: f64,
 }
 
-/// The drawn values of a marginal, or the samples outside the domain.
+/// The drawn values of a marginal, or the samples outside the upper hemisphere.
 struct Drawn {
     values: Vec<f64>,
     outside: u64,
-    first_outside: Option<(u64, DomainError)>,
+    first_outside: Option<(u64, DirectionError)>,
 }
 
 /// Draws `samples` normals with `sample` (seeded streams per chunk, as the chi-square test;
@@ -450,7 +450,7 @@ where
 {
     let options = lobe::Options {
         hint: Some(hints.width),
-        seeds: &[],
+        start_points: &[],
     };
     let lobe = lobe::measure_with(&|m| pdf(m), &options);
     ks_test_lobe(sample, pdf, marginal, &lobe, hints.theta_kinks, config)
@@ -494,7 +494,7 @@ where
 pub struct KsKept {
     /// The result.
     pub result: KsResult,
-    /// The drawn marginal values, sorted (samples outside the domain are not among them).
+    /// The drawn marginal values, sorted (samples outside the upper hemisphere are not among them).
     pub sorted: Vec<f64>,
     /// The model's CDF table of the marginal.
     pub table: CdfTable,
@@ -562,7 +562,7 @@ pub fn ks_test_lobe_batch_kept_at(
         at: f64::NAN,
         samples: config.samples,
         seed: config.seed,
-        verdict: Verdict::Fail,
+        verdict: TestOutcome::Fail,
         reason: None,
         knots: table.knots(),
         table_error_bound: table.error_bound(),
@@ -604,7 +604,7 @@ fn judge(result: &mut KsResult, values: &[f64], table: &CdfTable, config: &KsCon
     result.lambda = stephens_lambda(d, config.samples);
     result.p_value = kolmogorov_q(result.lambda);
     if result.p_value >= config.alpha {
-        result.verdict = Verdict::Pass;
+        result.verdict = TestOutcome::Pass;
     } else {
         result.reason = Some(Failure::Rejected {
             p_value: result.p_value,
@@ -613,11 +613,11 @@ fn judge(result: &mut KsResult, values: &[f64], table: &CdfTable, config: &KsCon
     }
 }
 
-/// The failures that leave no statistic: samples outside the domain, no samples, an invalid
+/// The failures that leave no statistic: samples outside the upper hemisphere, no samples, an invalid
 /// density or mass, a table too coarse for N.
 fn sanity(drawn: &Drawn, table: &CdfTable, samples: u64) -> Option<Failure> {
     if let Some((index, error)) = drawn.first_outside {
-        return Some(Failure::OutsideDomain(OutsideDomain {
+        return Some(Failure::OutsideHemisphere(OutsideHemisphere {
             index,
             error,
             count: drawn.outside,

@@ -488,7 +488,7 @@ pub fn marginal_cdf_batch(
 ) -> CdfTable {
     let options = lobe::Options {
         hint: Some(hints.width),
-        seeds: &[],
+        start_points: &[],
     };
     let lobe = lobe::measure_with_batch(pdf, &options);
     let mut table = marginal_cdf_lobe_batch(pdf, marginal, &lobe, hints.theta_kinks);

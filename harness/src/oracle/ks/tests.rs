@@ -144,7 +144,7 @@ fn passes(json: &str, samples: u64) {
     for marginal in [Marginal::CosTheta, Marginal::Phi] {
         let r = ks_test_sampler(s, marginal, &hints(width), &config(samples, 7));
         report(json, &r);
-        assert_eq!(r.verdict, Verdict::Pass, "{:?}", r.reason);
+        assert_eq!(r.verdict, TestOutcome::Pass, "{:?}", r.reason);
         assert!(r.p_value > 1e-3, "{r:?}");
     }
 }
@@ -170,7 +170,7 @@ fn ks_defects_of_one_percent_fail() {
         &config(1_000_000, 7),
     );
     report("α·1.02", &r);
-    assert_eq!(r.verdict, Verdict::Fail);
+    assert_eq!(r.verdict, TestOutcome::Fail);
     assert!(r.p_value < 1e-12, "{r:?}");
     assert!(matches!(r.reason, Some(Failure::Rejected { .. })));
     // φ = 2π·(1.01 u₁ mod 1) (GGX maps u₁ to the azimuth): 1 % of the azimuths wrapped
@@ -194,7 +194,7 @@ fn ks_defects_of_one_percent_fail() {
         &h,
         &config(1_000_000, 7),
     );
-    assert_eq!(r.verdict, Verdict::Pass, "{r:?}");
+    assert_eq!(r.verdict, TestOutcome::Pass, "{r:?}");
 }
 
 #[test]
@@ -218,10 +218,12 @@ fn ks_sanity_failures() {
     );
     assert!(matches!(
         r.reason,
-        Some(Failure::OutsideDomain(crate::oracle::chi2::OutsideDomain {
-            error: DomainError::BelowHorizon(_),
-            ..
-        }))
+        Some(Failure::OutsideHemisphere(
+            crate::oracle::chi2::OutsideHemisphere {
+                error: DirectionError::BelowHorizon(_),
+                ..
+            }
+        ))
     ));
     let half = ks_test(
         &|u| g.sample_wm(u),
@@ -257,7 +259,7 @@ fn ks_sanity_failures() {
         matches!(nan.reason, Some(Failure::MassOff { .. })),
         "{nan:?}"
     );
-    assert_eq!(nan.verdict, Verdict::Fail);
+    assert_eq!(nan.verdict, TestOutcome::Fail);
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! Seed 000 (piecewise-linear NDF): the derivation lines of eq 20 and eq 25 as printed and
+//! Document 000 (piecewise-linear NDF): the derivation lines of eq 20 and eq 25 as printed and
 //! corrected, eq 27/28's arccos as printed and guarded, and Algorithms 1–2 transcribed as
 //! printed (tolerance 1e-5, `while true`) with an iteration bound so that the instability can
 //! be shown without hanging.
@@ -24,7 +24,7 @@ pub struct Bounded {
 /// The printed tolerance of Algorithms 1 and 2 (`if |value| < 1e-5 then break`).
 pub const PRINTED_TOLERANCE: f64 = 1e-5;
 
-/// Seed 000 eq 8 as printed, read as the cdf of θ_m (ERRATA.md seed 000 E1): it integrates
+/// Document 000 eq 8 as printed, read as the cdf of θ_m (ERRATA.md document 000 E1): it integrates
 /// φ over [0, 2π], so it is the marginal cdf of θ, ∫₀^θ (k_x D_x + k_y D_y) cos t sin t dt
 /// normalized to 1 at π/2 (∫₀^{2π} cos²φ dφ = ∫₀^{2π} sin²φ dφ = π), not the conditional cdf
 /// of θ given φ_m that Algorithm 2 inverts. Equal weights on cos²φ and sin²φ are the
@@ -34,7 +34,7 @@ pub fn eq8_theta_cdf_printed(m: &PiecewiseLinear, theta: f64) -> f64 {
     m.cdf_theta(theta, std::f64::consts::FRAC_PI_4)
 }
 
-/// Seed 000 Algorithm 1 (φ_m by Newton's method in a quadrant bracket), line by line as
+/// Document 000 Algorithm 1 (φ_m by Newton's method in a quadrant bracket), line by line as
 /// printed, stopped after `max_iterations` (the printed loop is `while true`). With
 /// D_x(0) = D_y(0) = 0 the factor (D_y(0) − D_x(0))/(D_y(0) + D_x(0)) of line 18 is 0/0:
 /// `value` is NaN, the exit test never holds, and the loop never ends.
@@ -88,7 +88,7 @@ pub fn algorithm1_corrected(dx0: f64, dy0: f64, xi1: f64, max_iterations: usize)
 }
 
 /// ∫_{t0}^{t1} (aθ + b) cos θ sin θ dθ = (1/8)(2(at0 + b) cos 2t0 − 2(at1 + b) cos 2t1
-/// + a(sin 2t1 − sin 2t0)) (seed 000, the display before Algorithm 2, and eq 23).
+/// + a(sin 2t1 − sin 2t0)) (document 000, the display before Algorithm 2, and eq 23).
 pub fn segment_cos_sin_doc(a: f64, b: f64, t0: f64, t1: f64) -> f64 {
     (2.0 * (a * t0 + b) * (2.0 * t0).cos() - 2.0 * (a * t1 + b) * (2.0 * t1).cos()
         + a * ((2.0 * t1).sin() - (2.0 * t0).sin()))
@@ -96,7 +96,7 @@ pub fn segment_cos_sin_doc(a: f64, b: f64, t0: f64, t1: f64) -> f64 {
 }
 
 /// ∫_{t0}^{t1} (aθ + b) sin²θ dθ = (1/8)(a cos 2t0 − a cos 2t1 + 2(t1 − t0)(2b + a(t0 + t1))
-/// + 2(b + at0) sin 2t0 − 2(b + at1) sin 2t1) (seed 000 eq 15, one segment).
+/// + 2(b + at0) sin 2t0 − 2(b + at1) sin 2t1) (document 000 eq 15, one segment).
 pub fn segment_sin2_doc(a: f64, b: f64, t0: f64, t1: f64) -> f64 {
     (a * (2.0 * t0).cos() - a * (2.0 * t1).cos()
         + 2.0 * (t1 - t0) * (2.0 * b + a * (t0 + t1))
@@ -193,7 +193,7 @@ fn doc_constants(m: &PiecewiseLinear) -> (f64, f64, f64) {
     (dx0, dy0, 0.5 * (dx0 + dy0))
 }
 
-/// I₂¹ (seed 000 eq 19, first integral: θ_m ∈ [0, E], E = π/2 − θ_o, the back half of the
+/// I₂¹ (document 000 eq 19, first integral: θ_m ∈ [0, E], E = π/2 − θ_o, the back half of the
 /// azimuths) by the last lines of eq 20 as printed: the D_x line with cos θ_o where sin θ_o
 /// belongs, the D_y line with cos θ_o D_y(0) where sin θ_o D_x(0) belongs (eq 20 prints each
 /// of these lines twice, once with sin θ_o for the D_x one; the first occurrences are taken);
@@ -230,7 +230,7 @@ fn i21(m: &PiecewiseLinear, theta_o: f64, phi_o: f64, printed: bool) -> f64 {
         + co * PI / (2.0 * c) * (dy0 * tx + dx0 * ty)
 }
 
-/// The cos θ_o part of I₂² (seed 000 eq 25, last line) as printed: −(cos θ_o/4)(∫_{θ_{k+1}}^{π/2}
+/// The cos θ_o part of I₂² (document 000 eq 25, last line) as printed: −(cos θ_o/4)(∫_{θ_{k+1}}^{π/2}
 /// 2π D_x(θ) D_x(0) cos θ sin θ/c dθ + 2 ∫_E^{θ_{k+1}} 2π D_y D_x(0) cos θ sin θ/c dθ): D_x(θ)
 /// where D_y(θ) belongs and the partial term written twice. (The remaining C-dependent part,
 /// D_x(0)/c ∫ D_y cos sin (C − ½ sin 2C cos 2φ_o), is eq 27's and not included.)
@@ -262,7 +262,7 @@ fn i22_y_term(m: &PiecewiseLinear, theta_o: f64, printed: bool) -> f64 {
     -co / 4.0 * TAU * dx0 / c * (outer + times * upper(&dy, e, k1))
 }
 
-/// C = arccos(−1/(tan θ_o tan θ_m)) of seed 000 eq 18 and 27–28 as printed: at θ_m = E =
+/// C = arccos(−1/(tan θ_o tan θ_m)) of document 000 eq 18 and 27–28 as printed: at θ_m = E =
 /// π/2 − θ_o, where eq 28 evaluates it, the argument is −1 only in exact arithmetic; rounded,
 /// it falls below −1 for most θ_o and C is NaN.
 pub fn c_printed(theta_o: f64, theta_m: f64) -> f64 {
@@ -277,7 +277,7 @@ pub fn c_corrected(theta_o: f64, theta_m: f64) -> f64 {
         .acos()
 }
 
-/// Seed 000 Algorithm 2 (θ_m given φ_m) line by line, with errata 000-E1–E3 corrected (the
+/// Document 000 Algorithm 2 (θ_m given φ_m) line by line, with errata 000-E1–E3 corrected (the
 /// normalization c for the printed b, b^y in B^aniso, the conditional cdf of eq 9) and the
 /// printed exit `|value| < 1e-5` kept (`tolerance`; `value` is in the units of the
 /// unnormalized segment integral ∫(A^aniso θ + B^aniso) cos θ sin θ dθ, not a probability),

@@ -1,15 +1,15 @@
-//! Errata demonstrations of Seed 001 (STD, Ribardière et al.): each printed form and its correction against a
-//! harness oracle (reference/ERRATA.md, section "Seed 001").
+//! Errata demonstrations of Document 001 (STD, Ribardière et al.): each printed form and its correction against a
+//! harness oracle (reference/ERRATA.md, section "Document 001").
 
 use super::*;
-use mfh_reference::errata::seed001;
+use mfh_reference::errata::document001;
 
-/// The STD P2 of seed 001 in the document's variables, unnormalized: ((γ−1)σ² + q²)^{½−γ}.
+/// The STD P2 of document 001 in the document's variables, unnormalized: ((γ−1)σ² + q²)^{½−γ}.
 fn std_p2_unnormalized(g: f64, sigma: f64, q: f64) -> f64 {
     ((g - 1.0) * sigma * sigma + q * q).powf(0.5 - g)
 }
 
-/// Λ by its definition (seed 001 eq 17): (1/μ)∫_μ^∞ (q − μ) P2 dq / ∫ P2 dq, by harness
+/// Λ by its definition (document 001 eq 17): (1/μ)∫_μ^∞ (q − μ) P2 dq / ∫ P2 dq, by harness
 /// quadrature.
 fn std_lambda_oracle(g: f64, sigma: f64, mu: f64) -> Estimate {
     let k = ((g - 1.0) * sigma * sigma).sqrt();
@@ -72,33 +72,33 @@ fn e001_3() -> Result<Shown, String> {
     ))
 }
 
-/// 001-4: seed 001 eq 28, the alternating sum Σ C(n,k)(−1)^k/(2k+1)(1 − s^{2k+1}) for
+/// 001-4: document 001 eq 28, the alternating sum Σ C(n,k)(−1)^k/(2k+1)(1 − s^{2k+1}) for
 /// ∫_{t0}^∞ (1+t²)^{½−γ} dt at integer γ, with s as printed and as corrected.
 fn e001_4() -> Result<Shown, String> {
     let (g, sigma, mu) = (3.0f64, 0.3f64, 0.4f64);
     let t0 = mu / ((g - 1.0).sqrt() * sigma);
     Ok(Shown::new(
-        seed001::eq28_tail_printed(3, sigma, mu),
-        seed001::eq28_tail_corrected(3, sigma, mu),
+        document001::eq28_tail_printed(3, sigma, mu),
+        document001::eq28_tail_corrected(3, sigma, mu),
         tail_oracle(g, t0),
         &ERRATUM,
     ))
 }
 
-/// 001-5: seed 001 eq 20, ∫_{t0}^∞ (1+t²)^{½−γ} dt = √πΓ(γ−1)/(2Γ(γ−½)) − (μ/2)₂F₁(…)/√((γ−1)σ²)
+/// 001-5: document 001 eq 20, ∫_{t0}^∞ (1+t²)^{½−γ} dt = √πΓ(γ−1)/(2Γ(γ−½)) − (μ/2)₂F₁(…)/√((γ−1)σ²)
 /// as printed; without the ½ (= t0 ₂F₁) corrected.
 fn e001_5() -> Result<Shown, String> {
     let (g, sigma, mu) = (2.5f64, 0.3f64, 0.4f64);
     let t0 = mu / ((g - 1.0) * sigma * sigma).sqrt();
     Ok(Shown::new(
-        seed001::eq20_tail_printed(g, sigma, mu),
-        seed001::eq20_tail_corrected(g, sigma, mu),
+        document001::eq20_tail_printed(g, sigma, mu),
+        document001::eq20_tail_corrected(g, sigma, mu),
         tail_oracle(g, t0),
         &ERRATUM,
     ))
 }
 
-/// 001-6: seed 001 eq 32–33 (half-integer γ), the printed prefactor (with a free q, bound to μ)
+/// 001-6: document 001 eq 32–33 (half-integer γ), the printed prefactor (with a free q, bound to μ)
 /// against 2(γ−1)^γσ^{2γ−2}/(πμ) Σ C(n,k)(−1)^k/(2k+1).
 fn e001_6() -> Result<Shown, String> {
     let (g, sigma, mu) = (2.5f64, 0.3f64, 0.4f64);
@@ -115,14 +115,14 @@ fn e001_6() -> Result<Shown, String> {
     ))
 }
 
-/// P2 of seed 001 §7.1 (σ = 1): (γ−1)^γ Γ(γ−½)/(√π Γ(γ) (γ − 1 + p²)^{γ−½}).
+/// P2 of document 001 §7.1 (σ = 1): (γ−1)^γ Γ(γ−½)/(√π Γ(γ) (γ − 1 + p²)^{γ−½}).
 fn p2_sec71(g: f64, p: f64) -> f64 {
     let ln = (g - 1.0) * (g - 1.0).ln() + gamma_half_ratio(g - 1.0).ln()
         - (g - 0.5) * (g - 1.0 + p * p).ln();
     ln.exp() / PI.sqrt()
 }
 
-/// 001-7: seed 001 §7.1 visible-slope cdf C²_ωi(p), printed (γ−1)^{γ−½} p ₂F₁ against
+/// 001-7: document 001 §7.1 visible-slope cdf C²_ωi(p), printed (γ−1)^{γ−½} p ₂F₁ against
 /// (γ−1)^{½−γ} p ₂F₁, oracle ∫_{−∞}^p G1 (1 − p′ tan θ) P2(p′) dp′.
 fn e001_7() -> Result<Shown, String> {
     let (g, theta, p) = (3.0f64, 0.8f64, 0.3f64);
@@ -135,8 +135,8 @@ fn e001_7() -> Result<Shown, String> {
         acc(),
     );
     Ok(Shown::new(
-        seed001::sec71_cdf_printed(g, theta, p),
-        seed001::sec71_cdf_corrected(g, theta, p),
+        document001::sec71_cdf_printed(g, theta, p),
+        document001::sec71_cdf_corrected(g, theta, p),
         Estimate {
             value: g1 * o.value,
             error_bound: g1 * o.error_bound,
@@ -146,7 +146,7 @@ fn e001_7() -> Result<Shown, String> {
     ))
 }
 
-/// 001-8: seed 001 §7.1 C^{2|2}(q|p): the conditional cdf of q′ with the printed kernel
+/// 001-8: document 001 §7.1 C^{2|2}(q|p): the conditional cdf of q′ with the printed kernel
 /// (1/(γ−1) + p² + q′²)^{−γ} and the corrected (γ − 1 + p² + q′²)^{−γ}, against the kernel of
 /// P22, (1 + p²/(γ−1) + q′²/(γ−1))^{−γ}; all by harness quadrature.
 fn e001_8() -> Result<Shown, String> {
@@ -162,14 +162,14 @@ fn e001_8() -> Result<Shown, String> {
         }
     };
     Ok(Shown::new(
-        cdf(&|s| seed001::sec71_kernel_printed(g, p, s)).value,
-        cdf(&|s| seed001::sec71_kernel_corrected(g, p, s)).value,
+        cdf(&|s| document001::sec71_kernel_printed(g, p, s)).value,
+        cdf(&|s| document001::sec71_kernel_corrected(g, p, s)).value,
         cdf(&|s| (1.0 + p * p / (g - 1.0) + s * s / (g - 1.0)).powf(-g)),
         &ERRATUM,
     ))
 }
 
-/// 001-9: seed 001 Table 1 anisotropic Beckmann D: ∫ D cos θ dω = 1 (normalization). The
+/// 001-9: document 001 Table 1 anisotropic Beckmann D: ∫ D cos θ dω = 1 (normalization). The
 /// printed D does not decay at the horizon: its integral over θ ≤ 1.3 alone is the value.
 fn e001_9() -> Result<Shown, String> {
     let (sx, sy) = (0.2f64, 0.5f64);
@@ -184,9 +184,9 @@ fn e001_9() -> Result<Shown, String> {
         }
         let (theta, phi) = (r2.sqrt().atan2(m[2]), m[1].atan2(m[0]));
         let d = if printed {
-            seed001::table1_aniso_beckmann_printed(sx, sy, theta, phi)
+            document001::table1_aniso_beckmann_printed(sx, sy, theta, phi)
         } else {
-            seed001::table1_aniso_beckmann_corrected(sx, sy, theta, phi)
+            document001::table1_aniso_beckmann_corrected(sx, sy, theta, phi)
         };
         d * m[2]
     };
@@ -227,7 +227,7 @@ fn e001_9() -> Result<Shown, String> {
     ))
 }
 
-/// 001-10: seed 001 §8 Algorithm 2 for ₂F₁(½, γ−½; 3/2; z), printed and corrected, against
+/// 001-10: document 001 §8 Algorithm 2 for ₂F₁(½, γ−½; 3/2; z), printed and corrected, against
 /// ₂F₁(½, γ−½; 3/2; −x²) = (1/x)∫₀ˣ (1 + q²)^{½−γ} dq by harness quadrature (γ = 5/2, z = −3:
 /// line 12).
 fn e001_10() -> Result<Shown, String> {

@@ -1,10 +1,10 @@
-//! Errata demonstrations of Seed 003 (spherical Gaussians, Khungurn): each printed form and its correction against a
-//! harness oracle (reference/ERRATA.md, section "Seed 003").
+//! Errata demonstrations of Document 003 (spherical Gaussians, Khungurn): each printed form and its correction against a
+//! harness oracle (reference/ERRATA.md, section "Document 003").
 
 use super::*;
-use mfh_reference::errata::seed003;
+use mfh_reference::errata::document003;
 
-/// 003-E1: seed 003 §2.1 Cook–Torrance Fresnel factor with g = √(η² − c² − 1) (printed) and
+/// 003-E1: document 003 §2.1 Cook–Torrance Fresnel factor with g = √(η² − c² − 1) (printed) and
 /// √(η² + c² − 1), against the mean of the s and p reflectances from Snell's law (η = 1.5,
 /// c = 0.6).
 fn e003_1() -> Result<Shown, String> {
@@ -14,8 +14,8 @@ fn e003_1() -> Result<Shown, String> {
     let rs = ((c - eta * cos_t) / (c + eta * cos_t)).powi(2);
     let rp = ((eta * c - cos_t) / (eta * c + cos_t)).powi(2);
     Ok(Shown::new(
-        seed003::fresnel_printed(eta, c),
-        seed003::fresnel_corrected(eta, c),
+        document003::fresnel_printed(eta, c),
+        document003::fresnel_corrected(eta, c),
         exact(0.5 * (rs + rp)),
         &ERRATUM,
     ))
@@ -28,7 +28,7 @@ fn sphere(f: &dyn Fn(Vec3) -> f64, axis: Vec3, width: f64) -> Estimate {
     integrate_cap(f, axis, PI, width, None, Accuracy::relative(1e-10))
 }
 
-/// 003-E2: seed 003 §2.2 cap product G ⊗ V′ ≈ G(·; p, λ, μ f_h(θ_d, λ)/f_h(π/2, λ)); its
+/// 003-E2: document 003 §2.2 cap product G ⊗ V′ ≈ G(·; p, λ, μ f_h(θ_d, λ)/f_h(π/2, λ)); its
 /// integral must equal ∫_cap G (λ = 3, θ_d = 1).
 fn e003_2() -> Result<Shown, String> {
     let (lambda, theta_d) = (3.0, 1.0);
@@ -63,7 +63,7 @@ fn asg(bandwidths: [f64; 2]) -> Result<Asg, String> {
     .map_err(|e| e.to_string())
 }
 
-/// 003-E4: seed 003 §3.2.3, ∫_{S²} e^{−A(v·x − a)² − B(v·y − b)²} dv ≈ π/√(AB) (printed) against
+/// 003-E4: document 003 §3.2.3, ∫_{S²} e^{−A(v·x − a)² − B(v·y − b)²} dv ≈ π/√(AB) (printed) against
 /// 2π/√(AB) (both hemispheres), A = B = 1e4, by harness quadrature. Centred (a = b = 0): off
 /// centre each peak also carries the Jacobian 1/|v·z| = 1/√(1 − a² − b²) of dv = dv_x dv_y/|v_z|
 /// (2.6 % at a = 0.2, b = 0.1), which neither form has.
@@ -88,7 +88,7 @@ fn e003_4() -> Result<Shown, String> {
     ))
 }
 
-/// 003-E5: seed 003 §3.2.3 "when λ, μ > 3, the L2-error is less than 0.2 %": the relative L2
+/// 003-E5: document 003 §3.2.3 "when λ, μ > 3, the L2-error is less than 0.2 %": the relative L2
 /// error over the SG axis p (a 2-D grid of axes on the upper hemisphere, quadrature-weighted) at
 /// λ = μ = 3.5, SG sharpness 2ν = 20, against the claim; corrected: the weaker 2.8 % bound at
 /// SG sharpness 200, where it holds.
@@ -144,7 +144,7 @@ fn e003_5() -> Result<Shown, String> {
     ))
 }
 
-/// 003-E6: seed 003 §3.3.3, ∫ e^{2ν(i·p − 1)} V(i) di ≈ f_h(θ_d, ν) (printed) for a cap
+/// 003-E6: document 003 §3.3.3, ∫ e^{2ν(i·p − 1)} V(i) di ≈ f_h(θ_d, ν) (printed) for a cap
 /// visibility, against f_h(θ_d, 2ν), oracle by quadrature (ν = 5, θ_d = 1).
 fn e003_6() -> Result<Shown, String> {
     let (nu, theta_d) = (5.0, 1.0);
@@ -157,7 +157,7 @@ fn e003_6() -> Result<Shown, String> {
     ))
 }
 
-/// 003-E8: seed 003 §4.1, the third line of the derivation of ω·ξ − 1 (printed without − 1),
+/// 003-E8: document 003 §4.1, the third line of the derivation of ω·ξ − 1 (printed without − 1),
 /// against ln(G(ω)/μ)/λ of the SG.
 fn e003_8() -> Result<Shown, String> {
     let (t, p, t1, p1) = (0.3f64, 0.8f64, -0.2f64, 0.4f64);
@@ -165,14 +165,14 @@ fn e003_8() -> Result<Shown, String> {
     let sg = Sg::new(xi, 4.0, 1.0).map_err(|e| e.to_string())?;
     let omega = fiber_direction(t, p);
     Ok(Shown::new(
-        seed003::eq_sec41_line3_printed(t, p, t1, p1),
-        seed003::eq_sec41_line3_corrected(t, p, t1, p1),
+        document003::eq_sec41_line3_printed(t, p, t1, p1),
+        document003::eq_sec41_line3_corrected(t, p, t1, p1),
         exact(sg.eval(omega).ln() / 4.0),
         &ERRATUM,
     ))
 }
 
-/// 003-E9: seed 003 §3.3.2, the ASG warp axis z_i = o (printed) against 2(o·z_h)z_h − o: the
+/// 003-E9: document 003 §3.3.2, the ASG warp axis z_i = o (printed) against 2(o·z_h)z_h − o: the
 /// BRDF lobe G_h(h(i)), h(i) = (i + o)/‖i + o‖, must peak (= c) at z_i.
 fn e003_9() -> Result<Shown, String> {
     let z_h = from_spherical(0.3, 0.5);

@@ -1,9 +1,9 @@
-//! Errata demonstrations of Seed 002 (Gaussian slopes, Heitz et al.): each printed form and its correction against a
-//! harness oracle (reference/ERRATA.md, section "Seed 002").
+//! Errata demonstrations of Document 002 (Gaussian slopes, Heitz et al.): each printed form and its correction against a
+//! harness oracle (reference/ERRATA.md, section "Document 002").
 
 use super::*;
 use crate::oracle::visible_moments::visible_moments_oracle;
-use mfh_reference::errata::seed002 as errata002;
+use mfh_reference::errata::document002 as errata002;
 
 const GS_MEAN: [f64; 2] = [1.0, 1.0];
 const GS_COV: [[f64; 2]; 2] = [[1.0, 0.75], [0.75, 1.0]];
@@ -39,8 +39,8 @@ fn e002_2() -> Result<Shown, String> {
     visible_route("pseudocode_printed", 1.56, -FRAC_PI_2)
 }
 
-/// 002-3: seed 002 eq 52, s_⊥ p_s = −σ_o² ∂p_s/∂s_⊥ + c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s (printed) against
-/// −σ_⊥² ∂p_s/∂s_⊥ − c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s (`errata::seed002`); oracle: the left side.
+/// 002-3: document 002 eq 52, s_⊥ p_s = −σ_o² ∂p_s/∂s_⊥ + c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s (printed) against
+/// −σ_⊥² ∂p_s/∂s_⊥ − c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s (`errata::document002`); oracle: the left side.
 fn e002_3() -> Result<Shown, String> {
     let gs =
         GaussianSlopes::new([0.3, -0.2], [[0.5, 0.2], [0.2, 0.3]]).map_err(|e| e.to_string())?;
@@ -53,7 +53,7 @@ fn e002_3() -> Result<Shown, String> {
     ))
 }
 
-/// 002-4: seed 002 eq 53 at a back-facing slope off the cut (H = 0 in a neighbourhood): the
+/// 002-4: document 002 eq 53 at a back-facing slope off the cut (H = 0 in a neighbourhood): the
 /// left side s_o p_s H and every derivative term vanish; the printed last term s̄_o p_s does not.
 fn e002_4() -> Result<Shown, String> {
     let gs =

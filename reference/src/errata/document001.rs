@@ -1,4 +1,4 @@
-//! Seed 001 (STD): derivation steps that no route evaluates, as printed and corrected (the
+//! Document 001 (STD): derivation steps that no route evaluates, as printed and corrected (the
 //! printed forms of evaluated routes are routes: `table1_printed`, `half_integer_printed`,
 //! `sample_wm_printed`, `2f1_algorithm2`). Variables are the document's: σ the roughness, μ =
 //! cot θ, t₀ = μ/√((γ−1)σ²).

@@ -1,4 +1,4 @@
-//! Criterion benchmarks of the closed forms of seeds 004 (GTR), 000 (piecewise-linear NDF and
+//! Criterion benchmarks of the closed forms of documents 004 (GTR), 000 (piecewise-linear NDF and
 //! blend), 002 (visible moments of Gaussian slopes) and 003 (spherical Gaussians, ASG, circular
 //! Gaussians) at the level of each route: what `closed_forms.rs` does not already cover.
 //!
@@ -8,14 +8,14 @@
 //! (`Gtr::g1_route`, the routes `implementation` and `spline` computing G1 directly), the spline
 //! at γ > 4 (the clamp); the piecewise-linear samplers split into Algorithm 1 (φ) and Algorithm
 //! 2 (θ | φ) and their cdfs (eq 7, 8–9), G1 by each Λ route; the blend's G1; every visible-moment
-//! route of seed 002 including near-singular covariance; and everything of seed 003.
+//! route of document 002 including near-singular covariance; and everything of document 003.
 //!
 //! Every benchmark sweeps a fixed set of inputs per iteration (64 unless the name says
 //! otherwise; quadrature routes fewer); criterion's `time` is per sweep and its `thrpt` in
 //! evaluations per second, so ns per evaluation = time / inputs. Names read
 //! `quantity/family/parameters[/route]`.
 //!
-//! Run: `cargo bench -p mfh-harness --bench other_seeds` (a few minutes), `-- --quick` for a
+//! Run: `cargo bench -p mfh-harness --bench other_documents` (a few minutes), `-- --quick` for a
 //! fast pass, or with a filter (`-- sg/`).
 
 mod common;
@@ -52,7 +52,7 @@ fn uniforms() -> [f64; N] {
     })
 }
 
-/// GTR (seed 004): Λ by every route at γ = 0 and 3 (closed_forms.rs has 1, 1.5, 2, 4), Λ at
+/// GTR (document 004): Λ by every route at γ = 0 and 3 (closed_forms.rs has 1, 1.5, 2, 4), Λ at
 /// the ends of the α range, G1 by every route, the spline at non-integer γ and past the γ > 4
 /// clamp.
 fn bench_gtr(c: &mut Criterion) {
@@ -127,7 +127,7 @@ fn bench_gtr(c: &mut Criterion) {
     g.finish();
 }
 
-/// Piecewise-linear (seed 000): Algorithm 1 (φ), Algorithm 2 (θ | φ), the cdfs of eq 7 and
+/// Piecewise-linear (document 000): Algorithm 1 (φ), Algorithm 2 (θ | φ), the cdfs of eq 7 and
 /// eq 8–9, and G1 by each Λ route.
 fn bench_piecewise(c: &mut Criterion) {
     let m = piecewise_model();
@@ -187,7 +187,7 @@ fn bench_piecewise(c: &mut Criterion) {
     g.finish();
 }
 
-/// Gaussian slopes (seed 002): the visible moments by every route, for a regular covariance,
+/// Gaussian slopes (document 002): the visible moments by every route, for a regular covariance,
 /// a correlation of 1 − 1e-9 and a variance ratio of 1e-8.
 fn bench_gaussian_slopes(c: &mut Criterion) {
     let dirs = directions();
@@ -226,7 +226,7 @@ fn axis(theta: f64, phi: f64) -> Vec3 {
     from_spherical(theta, phi)
 }
 
-/// Spherical Gaussians (seed 003 §1–2): evaluation, inner product (closed form, printed, and
+/// Spherical Gaussians (document 003 §1–2): evaluation, inner product (closed form, printed, and
 /// quadrature) for sharpness 1 … 1e4, vector product, integral, cap integral and cap products,
 /// clamped-cosine inner product, lobe warp.
 fn bench_sg(c: &mut Criterion) {
@@ -353,7 +353,7 @@ fn asg(bandwidths: [f64; 2], tilt: f64) -> Asg {
     Asg::new(x, y, z, bandwidths, 1.3).expect("valid ASG")
 }
 
-/// Anisotropic SGs (seed 003 §3): evaluation, the integral (approximation, large-bandwidth
+/// Anisotropic SGs (document 003 §3): evaluation, the integral (approximation, large-bandwidth
 /// form, exact), the product approximation, the ASG–SG convolution (approximation and exact).
 fn bench_asg(c: &mut Criterion) {
     let sph = sphere_directions();
@@ -435,7 +435,7 @@ fn bench_asg(c: &mut Criterion) {
     g.finish();
 }
 
-/// Circular Gaussians and von Mises (seed 003 §4): the scaled I₀, the von Mises integral, the
+/// Circular Gaussians and von Mises (document 003 §4): the scaled I₀, the von Mises integral, the
 /// product, the period and interval integrals (erf route and quadrature), the SG decomposition.
 fn bench_circular(c: &mut Criterion) {
     // κ log-spread over [1e-3, 1e4] (both branches of I₀: series below 20, asymptotic above).

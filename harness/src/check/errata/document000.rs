@@ -1,8 +1,8 @@
-//! Errata demonstrations of Seed 000 (piecewise-linear NDF, Ribardière et al.): each printed form and its correction against a
-//! harness oracle (reference/ERRATA.md, section "Seed 000").
+//! Errata demonstrations of Document 000 (piecewise-linear NDF, Ribardière et al.): each printed form and its correction against a
+//! harness oracle (reference/ERRATA.md, section "Document 000").
 
 use super::*;
-use mfh_reference::errata::seed000;
+use mfh_reference::errata::document000;
 use mfh_reference::family::FamilySpec;
 
 const PL_X: [f64; 6] = [3.0, 2.2, 1.4, 0.9, 0.3, 0.05];
@@ -54,14 +54,14 @@ fn ratio(a: Estimate, b: Estimate) -> Estimate {
     }
 }
 
-/// 000-E1: seed 000 eq 8 as printed integrates over φ ∈ [0, 2π]: the marginal cdf of θ. As
+/// 000-E1: document 000 eq 8 as printed integrates over φ ∈ [0, 2π]: the marginal cdf of θ. As
 /// the conditional cdf of θ given φ_m (normalized to 1 at π/2) it is wrong; eq 9's form (no φ
 /// integral, factor 2π) is right. Oracle: the conditional cdf from D by quadrature.
 fn e000_1() -> Result<Shown, String> {
     let m = pl()?;
     let (phi, theta) = (0.3f64, 0.5f64);
     Ok(Shown::new(
-        seed000::eq8_theta_cdf_printed(&m, theta),
+        document000::eq8_theta_cdf_printed(&m, theta),
         m.cdf_theta(theta, phi),
         ratio(
             theta_mass(&m, phi, 0.0, theta),
@@ -71,7 +71,7 @@ fn e000_1() -> Result<Shown, String> {
     ))
 }
 
-/// 000-E2: seed 000 text after eq 9: the segment integral ∫ (A θ + B) cos θ sin θ dθ with
+/// 000-E2: document 000 text after eq 9: the segment integral ∫ (A θ + B) cos θ sin θ dθ with
 /// B^aniso = cos²φ D_y(0) b^x + sin²φ D_x(0) b^x (printed) or … b^y (Algorithm 2, line 2),
 /// against the mass of D on the segment by quadrature.
 fn e000_2() -> Result<Shown, String> {
@@ -79,14 +79,14 @@ fn e000_2() -> Result<Shown, String> {
     let (phi, k) = (0.9f64, 1);
     let (t0, t1) = (m.breakpoints()[k], m.breakpoints()[k + 1]);
     Ok(Shown::new(
-        seed000::b_aniso_segment_printed(&m, phi, k),
-        seed000::b_aniso_segment_corrected(&m, phi, k),
+        document000::b_aniso_segment_printed(&m, phi, k),
+        document000::b_aniso_segment_corrected(&m, phi, k),
         theta_mass(&m, phi, t0, t1),
         &ERRATUM,
     ))
 }
 
-/// 000-E4: seed 000 eq 9 summed Σ_{i=1}^k ∫_{θᵢ}^{θᵢ₊₁} read with eq 4's θ₀ = 0 omits the first
+/// 000-E4: document 000 eq 9 summed Σ_{i=1}^k ∫_{θᵢ}^{θᵢ₊₁} read with eq 4's θ₀ = 0 omits the first
 /// segment: the conditional mass at π/2 then misses [θ₀, θ₁]. Value: the mass over the segments
 /// the mixed reading sums; corrected: all segments; oracle: ∫₀^{π/2} by quadrature.
 fn e000_4() -> Result<Shown, String> {
@@ -107,14 +107,14 @@ fn e000_4() -> Result<Shown, String> {
     ))
 }
 
-/// 000-E5: seed 000 eq 23, partial segment ∫_{θ_k}^{E} (aθ + b) sin²θ dθ with cos 2φ_o (the
+/// 000-E5: document 000 eq 23, partial segment ∫_{θ_k}^{E} (aθ + b) sin²θ dθ with cos 2φ_o (the
 /// extracted y line) and cos 2θ_o (right), against quadrature.
 fn e000_5() -> Result<Shown, String> {
     let (a, b, tk, theta_o, phi_o) = (0.7f64, 0.4f64, 0.2f64, 0.9f64, 0.3f64);
     let e = FRAC_PI_2 - theta_o;
     Ok(Shown::new(
-        seed000::eq23_partial_segment_printed(a, b, tk, theta_o, phi_o),
-        seed000::eq23_partial_segment_corrected(a, b, tk, theta_o),
+        document000::eq23_partial_segment_printed(a, b, tk, theta_o, phi_o),
+        document000::eq23_partial_segment_corrected(a, b, tk, theta_o),
         integrate(&|t: f64| (a * t + b) * t.sin().powi(2), tk, e, acc()),
         &ERRATUM,
     ))
@@ -128,7 +128,7 @@ fn pl_lambda_oracle(w: Vec3) -> Result<(Box<dyn Model>, Estimate), String> {
     Ok((m, o))
 }
 
-/// 000-E7: seed 000 eq 32 with the lower limit −∞: (1/μ)∫(q − μ)P₂ dq = (E[q] − μ)/μ, and
+/// 000-E7: document 000 eq 32 with the lower limit −∞: (1/μ)∫(q − μ)P₂ dq = (E[q] − μ)/μ, and
 /// E[q] = 0 because D(θ, φ + π) = D(θ, φ) (eq 1) and ∫P₂ = 1, so the printed Λ is −1 for every
 /// direction; with the lower limit μ it is Smith's Λ (route `domain_split_adaptive`, eq 34),
 /// against the back-facing oracle.
@@ -143,7 +143,7 @@ fn e000_7() -> Result<Shown, String> {
     ))
 }
 
-/// 000-E8: seed 000 eq 31 with p, q the slopes of the fixed frame: the printed P₂ is the one
+/// 000-E8: document 000 eq 31 with p, q the slopes of the fixed frame: the printed P₂ is the one
 /// along φ_v = π/2, so for v at φ_v = 0 it yields Λ(θ, π/2); along the azimuth of v it is
 /// Λ(θ, 0) (both by eq 34 with eq 27 integrated adaptively), against the oracle at φ_v = 0.
 fn e000_8() -> Result<Shown, String> {
@@ -157,7 +157,7 @@ fn e000_8() -> Result<Shown, String> {
     ))
 }
 
-/// 000-E9: seed 000 eq 33, G = 1/(1 + Λ(i) + Λ(o)) without χ⁺: for a back-facing microfacet G₂
+/// 000-E9: document 000 eq 33, G = 1/(1 + Λ(i) + Λ(o)) without χ⁺: for a back-facing microfacet G₂
 /// must vanish.
 fn e000_9() -> Result<Shown, String> {
     let m = pl()?;
@@ -175,12 +175,12 @@ fn e000_9() -> Result<Shown, String> {
     ))
 }
 
-/// The domain-split Λ of seed 000 (eq 34) with the remaining integral by `remaining`.
+/// The domain-split Λ of document 000 (eq 34) with the remaining integral by `remaining`.
 fn split(theta: f64, phi: f64, remaining: Remaining) -> Result<f64, String> {
     Ok(domain_split(&pl()?, theta, (2.0 * phi).cos(), remaining).lambda)
 }
 
-/// 000-E10: seed 000 eq 28, the trapezoid rule, against Λ by quadrature (θ_o = 0.3, where
+/// 000-E10: document 000 eq 28, the trapezoid rule, against Λ by quadrature (θ_o = 0.3, where
 /// [E, π/2] lies in one segment); corrected: eq 27 integrated adaptively.
 fn e000_10() -> Result<Shown, String> {
     let (theta, phi) = (0.3, 0.7);
@@ -193,20 +193,20 @@ fn e000_10() -> Result<Shown, String> {
     ))
 }
 
-/// 000-E11: seed 000 eq 34 with eq 16's I₁ (= I₁₁ + cos θ_o/2) for the display: Λ is ½ too large.
+/// 000-E11: document 000 eq 34 with eq 16's I₁ (= I₁₁ + cos θ_o/2) for the display: Λ is ½ too large.
 fn e000_11() -> Result<Shown, String> {
     let (theta, phi) = (0.3f64, 0.7f64);
     let (_, o) = pl_lambda_oracle(from_spherical(theta, phi))?;
     let ds = domain_split(&pl()?, theta, (2.0 * phi).cos(), Remaining::Adaptive);
     Ok(Shown::new(
-        seed000::eq34_lambda_printed(theta, ds.i11, ds.i2_1, ds.i2_2),
-        seed000::eq34_lambda_corrected(theta, ds.i11, ds.i2_1, ds.i2_2),
+        document000::eq34_lambda_printed(theta, ds.i11, ds.i2_1, ds.i2_2),
+        document000::eq34_lambda_corrected(theta, ds.i11, ds.i2_1, ds.i2_2),
         o,
         &ERRATUM,
     ))
 }
 
-/// 000-E12: seed 000 eq 27 calls the remaining integral "Λ": taken as Smith's Λ it is wrong.
+/// 000-E12: document 000 eq 27 calls the remaining integral "Λ": taken as Smith's Λ it is wrong.
 /// Printed: Λ_doc = I₂² + (cos θ_o/4)·T_rest read as Λ (recovered as I₂² … is not available, so
 /// the partial integral I₂² itself); corrected: eq 34's Λ.
 fn e000_12() -> Result<Shown, String> {
@@ -239,7 +239,7 @@ fn e000_13() -> Result<Shown, String> {
     ))
 }
 
-/// 000-E14: seed 000 eq 2 defines c as ∫∫ D cos θ sin θ dθ dφ with the normalized D of eq 1,
+/// 000-E14: document 000 eq 2 defines c as ∫∫ D cos θ sin θ dθ dφ with the normalized D of eq 1,
 /// which is 1, not eq 3's c; the third line's integrand gives c. Oracle: that integral by
 /// hemisphere quadrature of the unnormalized blend.
 fn e000_14() -> Result<Shown, String> {
@@ -278,7 +278,7 @@ fn e000_14() -> Result<Shown, String> {
     ))
 }
 
-/// 000-E15: seed 000 eq 18, the front-facing condition with cos φ_m (φ_o = 0 assumed) for
+/// 000-E15: document 000 eq 18, the front-facing condition with cos φ_m (φ_o = 0 assumed) for
 /// cos(φ_m − φ_o): ∫ χ (o·m) D dm with the printed χ, against cos θ_o (1 + Λ(o)) (Λ by the
 /// back-facing oracle).
 fn e000_15() -> Result<Shown, String> {
@@ -335,7 +335,7 @@ fn e000_15() -> Result<Shown, String> {
     ))
 }
 
-/// 000-E16: seed 000 eq 20, the sin²θ_m lines of I₂¹ with cos θ_o for sin θ_o and D_y(0) for
+/// 000-E16: document 000 eq 20, the sin²θ_m lines of I₂¹ with cos θ_o for sin θ_o and D_y(0) for
 /// D_x(0), against I₂¹ = ∫₀^E ∫_{φ_o+π/2}^{φ_o+3π/2} (o·m) D sin θ_m dφ_m dθ_m (eq 19) by nested
 /// harness quadrature with the breakpoints as cuts.
 fn e000_16() -> Result<Shown, String> {
@@ -370,8 +370,8 @@ fn e000_16() -> Result<Shown, String> {
         acc(),
     );
     Ok(Shown::new(
-        seed000::i21_eq20_printed(&m, theta_o, phi_o),
-        seed000::i21_eq20_corrected(&m, theta_o, phi_o),
+        document000::i21_eq20_printed(&m, theta_o, phi_o),
+        document000::i21_eq20_corrected(&m, theta_o, phi_o),
         Estimate {
             evaluations: outer.evaluations + evaluations.get(),
             ..outer
@@ -380,7 +380,7 @@ fn e000_16() -> Result<Shown, String> {
     ))
 }
 
-/// 000-E17: seed 000 eq 25, last line: −(cos θ_o/4)(∫_{θ_{k+1}}^{π/2} 2π D_x(θ) D_x(0) cos sin/c
+/// 000-E17: document 000 eq 25, last line: −(cos θ_o/4)(∫_{θ_{k+1}}^{π/2} 2π D_x(θ) D_x(0) cos sin/c
 /// plus twice ∫_E^{θ_{k+1}} 2π D_y D_x(0) cos sin/c) as printed, against −(cos θ_o/4) ∫_E^{π/2}
 /// 2π D_y D_x(0) cos θ sin θ/c dθ by harness quadrature (θ_o = 0.9).
 fn e000_17() -> Result<Shown, String> {
@@ -394,8 +394,8 @@ fn e000_17() -> Result<Shown, String> {
     let q = integrate_pieces(&|t: f64| m.d_y(t) * t.cos() * t.sin(), &cuts, acc());
     let k = -theta_o.cos() / 4.0 * TAU * dx0 / c;
     Ok(Shown::new(
-        seed000::i22_y_term_eq25_printed(&m, theta_o),
-        seed000::i22_y_term_eq25_corrected(&m, theta_o),
+        document000::i22_y_term_eq25_printed(&m, theta_o),
+        document000::i22_y_term_eq25_corrected(&m, theta_o),
         Estimate {
             value: k * q.value,
             error_bound: k.abs() * q.error_bound,
@@ -405,14 +405,14 @@ fn e000_17() -> Result<Shown, String> {
     ))
 }
 
-/// 000-U1: seed 000 Algorithm 1 as printed in the zero case D_x(0) = D_y(0) = 0 (ξ₁ = 0.3,
+/// 000-U1: document 000 Algorithm 1 as printed in the zero case D_x(0) = D_y(0) = 0 (ξ₁ = 0.3,
 /// 10⁴ iterations): line 18's (D_y(0) − D_x(0))/(D_y(0) + D_x(0)) is 0/0, `value` is NaN, the
 /// exit |value| < 1e-5 never holds (printed: the NaN left after the bound). Guarded as the
 /// reference does (k_x = k_y = 1: φ uniform): 2πξ₁, the inverse of the cdf φ/2π.
 fn e000_u1() -> Result<Shown, String> {
     let xi = 0.3;
-    let printed = seed000::algorithm1_printed(0.0, 0.0, xi, 10_000);
-    let guarded = seed000::algorithm1_corrected(0.0, 0.0, xi, 10_000);
+    let printed = document000::algorithm1_printed(0.0, 0.0, xi, 10_000);
+    let guarded = document000::algorithm1_corrected(0.0, 0.0, xi, 10_000);
     if printed.converged || !guarded.converged {
         return Err(format!("unexpected runs: {printed:?}, {guarded:?}"));
     }
@@ -424,7 +424,7 @@ fn e000_u1() -> Result<Shown, String> {
     ))
 }
 
-/// 000-U2: seed 000 eq 27/28's C = arccos(−1/(tan θ_o tan θ_m)) at θ_m = E = π/2 − θ_o, where the
+/// 000-U2: document 000 eq 27/28's C = arccos(−1/(tan θ_o tan θ_m)) at θ_m = E = π/2 − θ_o, where the
 /// trapezoid rule of eq 28 evaluates it: the argument is −1 − 4e-16 in double precision at
 /// θ_o = 0.3 and C is NaN (so is Λ); clamped to [−1, 1] as the reference does, C = π, its
 /// exact value.
@@ -432,8 +432,8 @@ fn e000_u2() -> Result<Shown, String> {
     let theta_o = 0.3f64;
     let e = FRAC_PI_2 - theta_o;
     Ok(Shown::new(
-        seed000::c_printed(theta_o, e),
-        seed000::c_corrected(theta_o, e),
+        document000::c_printed(theta_o, e),
+        document000::c_corrected(theta_o, e),
         exact(PI),
         &ERRATUM,
     ))

@@ -19,7 +19,7 @@ use mfh_reference::geometry::{sin_cos_turns, Vec3};
 use std::f64::consts::{PI, TAU};
 use std::sync::Arc;
 
-/// How far from unit length a sample may be before it is outside the domain.
+/// How far from unit length a sample may be before it is outside the upper hemisphere.
 pub const UNIT_TOLERANCE: f64 = 1e-6;
 
 /// A grid of `2R` φ-columns over [0, 2π) by `R` z-rows over [0, 1] (z = cos θ): equal-area
@@ -57,7 +57,7 @@ pub enum GridError {
 
 /// Why a direction lies outside the upper hemisphere.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-pub enum DomainError {
+pub enum DirectionError {
     /// A component is NaN or infinite.
     #[error("non-finite direction {0:?}")]
     NotFinite(Vec3),
@@ -178,9 +178,9 @@ impl HemisphereGrid {
     }
 
     /// The cell index (row-major: `row * columns + column`, row 0 at the horizon) of a unit
-    /// direction in the upper hemisphere, or why it is not in the domain.
+    /// direction in the upper hemisphere, or why it is not in the upper hemisphere.
     #[inline]
-    pub fn cell_of(&self, m: Vec3) -> Result<usize, DomainError> {
+    pub fn cell_of(&self, m: Vec3) -> Result<usize, DirectionError> {
         let row = self.row_of(m)?;
         let mut phi = m[1].atan2(m[0]);
         if phi < 0.0 {
@@ -194,9 +194,9 @@ impl HemisphereGrid {
         Ok(row * columns + column)
     }
 
-    /// The z-row of a unit direction in the upper hemisphere, or why it is not in the domain.
+    /// The z-row of a unit direction in the upper hemisphere, or why it is not in the upper hemisphere.
     #[inline]
-    fn row_of(&self, m: Vec3) -> Result<usize, DomainError> {
+    fn row_of(&self, m: Vec3) -> Result<usize, DirectionError> {
         let len = validate(m)?;
         let z = m[2] / len;
         let rows = self.rows();
@@ -228,16 +228,16 @@ impl HemisphereGrid {
 /// The length of `m` if it is a unit direction (within [`UNIT_TOLERANCE`]) in the closed upper
 /// hemisphere, else why it is not.
 #[inline]
-pub fn validate(m: Vec3) -> Result<f64, DomainError> {
+pub fn validate(m: Vec3) -> Result<f64, DirectionError> {
     if !(m[0].is_finite() && m[1].is_finite() && m[2].is_finite()) {
-        return Err(DomainError::NotFinite(m));
+        return Err(DirectionError::NotFinite(m));
     }
     let len = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
     if !((len - 1.0).abs() <= UNIT_TOLERANCE) {
-        return Err(DomainError::NotUnit(m, len));
+        return Err(DirectionError::NotUnit(m, len));
     }
     if m[2] < 0.0 {
-        return Err(DomainError::BelowHorizon(m));
+        return Err(DirectionError::BelowHorizon(m));
     }
     Ok(len)
 }
@@ -318,10 +318,10 @@ impl CellFinder {
         &self.grid
     }
 
-    /// The cell index of a direction, or why it is not in the domain: the same answer as
+    /// The cell index of a direction, or why it is not in the upper hemisphere: the same answer as
     /// [`HemisphereGrid::cell_of`] (up to directions within ~1e-16 rad of a column boundary).
     #[inline(always)]
-    pub fn cell_of(&self, m: Vec3) -> Result<usize, DomainError> {
+    pub fn cell_of(&self, m: Vec3) -> Result<usize, DirectionError> {
         // The same decisions as `validate` (`squared_length` is its accepted interval of |m|²;
         // a non-finite component makes |m|² NaN or ∞, outside it), without its square root;
         // a rejected direction goes through `validate` for the same error.
@@ -346,13 +346,13 @@ impl CellFinder {
     }
 
     /// The cells of a block of directions: `cells[i]` is the cell of `m[i]` as
-    /// [`CellFinder::cell_of`] finds it; returns whether every direction was in the domain
+    /// [`CellFinder::cell_of`] finds it; returns whether every direction was in the upper hemisphere
     /// (if not, the cells of those outside are unspecified: callers redo the block one by
     /// one for the errors).
     ///
     /// One straight-line pass per sub-block of [`FIND_BLOCK`] directions, no branch and no
     /// table, so it vectorizes (8 lanes under AVX-512, 4 under AVX2: it runs through `pulp`'s
-    /// safe runtime dispatch, compiled for x86-64-v4 or v3 where the CPU has it): the domain test on |m|², the
+    /// safe runtime dispatch, compiled for x86-64-v4 or v3 where the CPU has it): the hemisphere test on |m|², the
     /// row ⌊z·R⌋ and the column ⌊φ̃·2R/2π⌋ of the azimuth estimate φ̃ of
     /// [`approximate_azimuth`], and whether each is *clear*: z·R farther than `row_margin`
     /// from an integer, φ̃·2R/2π farther than [`COLUMN_MARGIN`]·2R/2π (a margin of 2.5e-6 rad,
@@ -362,7 +362,7 @@ impl CellFinder {
     /// boundaries b_j, b_{j+1} are decided before they are made — the direction is at least
     /// 2.5e-6 − 2.5e-7 rad inside the column, where |b × (x, y)| ≥ |(x, y)| sin(2.2e-6) dwarfs
     /// the rounding of b_j (≤ 1 ulp, 1.1e-16) — so the answer is `cell_of`'s without making them. The
-    /// rest (outside the domain, near a row or column edge or the pole: at R = 64 a fraction
+    /// rest (outside the upper hemisphere, near a row or column edge or the pole: at R = 64 a fraction
     /// ≈ 2·2.5e-6·128/2π ≈ 1e-4 of directions for the columns) goes through
     /// [`CellFinder::cell_of`]. Either way the cell is a function of the direction alone,
     /// whatever the block, the thread or the dispatch path (the test
@@ -566,10 +566,10 @@ impl CellFinder {
         (cross > 0.0) | ((cross == 0.0) & (c * x + s * y > 0.0))
     }
 
-    /// Why `m`, rejected by the squared-length test, is outside the domain.
+    /// Why `m`, rejected by the squared-length test, is outside the upper hemisphere.
     #[cold]
     #[inline(never)]
-    fn rejection(&self, m: Vec3) -> DomainError {
+    fn rejection(&self, m: Vec3) -> DirectionError {
         match validate(m) {
             Err(error) => error,
             Ok(len) => unreachable!(
@@ -613,7 +613,7 @@ impl CellFinder {
 
 /// The cells of a block from a finder's fast pass: `found[k]` is the cell as an exact f64 (an
 /// integer in [0, 2³¹)), or −1 where the direction was not clear and `exact(k)` decides it
-/// (`None`: outside the domain). Returns whether every direction was in the domain (if not,
+/// (`None`: outside the upper hemisphere). Returns whether every direction was in the upper hemisphere (if not,
 /// the cells of those outside are unspecified).
 #[inline(always)]
 pub(crate) fn finish_cells(
@@ -823,7 +823,7 @@ mod tests {
             }
             assert!(matches!(
                 finder.cell_of([0.0, 0.6, -0.8]),
-                Err(DomainError::BelowHorizon(_))
+                Err(DirectionError::BelowHorizon(_))
             ));
         }
     }
@@ -831,7 +831,7 @@ mod tests {
     /// The cell of `m` as `CellFinder::cell_of` found it before the square-root-free
     /// validation, the row from z·R and the branch-free first step (validate, row from
     /// z / |m|, then the two searches from the estimate).
-    fn previous_cell_of(finder: &CellFinder, m: Vec3) -> Result<usize, DomainError> {
+    fn previous_cell_of(finder: &CellFinder, m: Vec3) -> Result<usize, DirectionError> {
         let row = finder.grid.row_of(m)?;
         let (x, y) = (m[0], m[1]);
         let columns = finder.grid.columns();
@@ -890,7 +890,7 @@ mod tests {
         let mut rng = crate::random::Stream::new(11, 0);
         let mut uniform = || rng.uniform();
         // Debug text: errors carrying NaN compare unequal with ==.
-        let same = |a: &Result<usize, DomainError>, b: &Result<usize, DomainError>| {
+        let same = |a: &Result<usize, DirectionError>, b: &Result<usize, DirectionError>| {
             format!("{a:?}") == format!("{b:?}")
         };
         let mut rejected = 0usize;
@@ -976,7 +976,7 @@ mod tests {
                     directions.push([z, 0.0, 0.0]);
                 }
             }
-            // Outside the domain.
+            // Outside the upper hemisphere.
             for m in [
                 [f64::NAN, 0.0, 1.0],
                 [0.0, f64::INFINITY, 0.0],
@@ -990,7 +990,7 @@ mod tests {
                 directions.push(m);
             }
             // The block finder agrees with the one-by-one finder on every direction inside
-            // the domain, and reports the block as not inside when one is outside.
+            // the upper hemisphere, and reports the block as not inside when one is outside.
             let mut cells = vec![usize::MAX; directions.len()];
             let all_inside = finder.cells_of(&directions, &mut cells);
             let mut any_outside = false;
@@ -1264,15 +1264,15 @@ mod tests {
         assert_eq!(grid.cell_of([1.0, -1e-300, 0.0]), Ok(7));
         assert!(matches!(
             grid.cell_of([0.0, 0.6, -0.8]),
-            Err(DomainError::BelowHorizon(_))
+            Err(DirectionError::BelowHorizon(_))
         ));
         assert!(matches!(
             grid.cell_of([f64::NAN, 0.0, 1.0]),
-            Err(DomainError::NotFinite(_))
+            Err(DirectionError::NotFinite(_))
         ));
         assert!(matches!(
             grid.cell_of([0.0, 0.0, 1.1]),
-            Err(DomainError::NotUnit(..))
+            Err(DirectionError::NotUnit(..))
         ));
         assert!(HemisphereGrid::new(0).is_none());
     }

@@ -1,27 +1,27 @@
-//! Seed 003 (spherical Gaussians, Khungurn): derivation steps and building blocks that no
+//! Document 003 (spherical Gaussians, Khungurn): derivation steps and building blocks that no
 //! route evaluates, as printed and corrected.
 
 /// Cook–Torrance's Fresnel factor ½ ((g − c)/(g + c))² (1 + ((c(g + c) − 1)/(c(g − c) + 1))²)
-/// for a given g (c = cos θ_d), the form of seed 003 §2.1.
+/// for a given g (c = cos θ_d), the form of document 003 §2.1.
 fn fresnel_with_g(c: f64, g: f64) -> f64 {
     let a = (g - c) / (g + c);
     let b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
     0.5 * a * a * (1.0 + b * b)
 }
 
-/// Seed 003 §2.1's Fresnel factor as printed, with g = √(η² − c² − 1) (ERRATA 003-E1: the sign
+/// Document 003 §2.1's Fresnel factor as printed, with g = √(η² − c² − 1) (ERRATA 003-E1: the sign
 /// of c²; NaN where η² < c² + 1, e.g. at normal incidence for η < √2).
 pub fn fresnel_printed(eta: f64, c: f64) -> f64 {
     fresnel_with_g(c, (eta * eta - c * c - 1.0).sqrt())
 }
 
-/// Seed 003 §2.1's Fresnel factor corrected: g = √(η² + c² − 1) (Cook and Torrance 1982), the
+/// Document 003 §2.1's Fresnel factor corrected: g = √(η² + c² − 1) (Cook and Torrance 1982), the
 /// mean of the s and p reflectances of a dielectric of relative index η.
 pub fn fresnel_corrected(eta: f64, c: f64) -> f64 {
     fresnel_with_g(c, (eta * eta + c * c - 1.0).sqrt())
 }
 
-/// Seed 003 §4.1, the third line of the derivation of ω·ξ − 1 for ω = (θ, φ), ξ = (θ', φ') on
+/// Document 003 §4.1, the third line of the derivation of ω·ξ − 1 for ω = (θ, φ), ξ = (θ', φ') on
 /// the fibre parametrization, as printed: sin θ sin θ' + cos θ cos θ' (cos φ cos φ' + sin φ sin
 /// φ'), which is ω·ξ (ERRATA 003-E8: the − 1 dropped).
 pub fn eq_sec41_line3_printed(theta: f64, phi: f64, theta1: f64, phi1: f64) -> f64 {
@@ -29,7 +29,7 @@ pub fn eq_sec41_line3_printed(theta: f64, phi: f64, theta1: f64, phi1: f64) -> f
         + theta.cos() * theta1.cos() * (phi.cos() * phi1.cos() + phi.sin() * phi1.sin())
 }
 
-/// Seed 003 §4.1, the third line corrected: the printed line − 1 = ω·ξ − 1.
+/// Document 003 §4.1, the third line corrected: the printed line − 1 = ω·ξ − 1.
 pub fn eq_sec41_line3_corrected(theta: f64, phi: f64, theta1: f64, phi1: f64) -> f64 {
     eq_sec41_line3_printed(theta, phi, theta1, phi1) - 1.0
 }

@@ -1,11 +1,11 @@
-//! Seed 002 (Heitz et al., Gaussian slopes): the identities eq 52 and eq 53 as printed beside
-//! their corrections (ERRATA.md seed 002 #3, #4), at a point of the view frame of eq 47–50.
+//! Document 002 (Heitz et al., Gaussian slopes): the identities eq 52 and eq 53 as printed beside
+//! their corrections (ERRATA.md document 002 #3, #4), at a point of the view frame of eq 47–50.
 //! Errata #1 and #2 (eq 59, pseudocode lines 36–39) are routes of the model
 //! (`equations_printed`, `pseudocode_printed`).
 
 use crate::slopes::gaussian::GaussianSlopes;
 
-/// The view-frame quantities of seed 002 eq 47–50 at the slope (s_o, s_⊥) of the frame of
+/// The view-frame quantities of document 002 eq 47–50 at the slope (s_o, s_⊥) of the frame of
 /// azimuth φ: p_s and its derivatives, the slope, and the moments of p_s in that frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViewFramePoint {
@@ -56,29 +56,29 @@ impl ViewFramePoint {
     }
 }
 
-/// Seed 002 eq 51, right as printed: s_o p_s = −c_o⊥ ∂p_s/∂s_⊥ − σ_o² ∂p_s/∂s_o + s̄_o p_s.
+/// Document 002 eq 51, right as printed: s_o p_s = −c_o⊥ ∂p_s/∂s_⊥ − σ_o² ∂p_s/∂s_o + s̄_o p_s.
 pub fn eq51(f: &ViewFramePoint) -> f64 {
     -f.cov * f.dp_perp - f.var_o * f.dp_o + f.mean_o * f.p
 }
 
-/// Seed 002 eq 52 as printed: s_⊥ p_s = −σ_o² ∂p_s/∂s_⊥ + c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s (wrong
-/// coefficients, ERRATA.md seed 002 #3; eq 54 inherits them).
+/// Document 002 eq 52 as printed: s_⊥ p_s = −σ_o² ∂p_s/∂s_⊥ + c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s (wrong
+/// coefficients, ERRATA.md document 002 #3; eq 54 inherits them).
 pub fn eq52_printed(f: &ViewFramePoint) -> f64 {
     -f.var_o * f.dp_perp + f.cov * f.dp_o + f.mean_perp * f.p
 }
 
-/// Seed 002 eq 52 corrected: s_⊥ p_s = −σ_⊥² ∂p_s/∂s_⊥ − c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s.
+/// Document 002 eq 52 corrected: s_⊥ p_s = −σ_⊥² ∂p_s/∂s_⊥ − c_o⊥ ∂p_s/∂s_o + s̄_⊥ p_s.
 pub fn eq52_corrected(f: &ViewFramePoint) -> f64 {
     -f.var_perp * f.dp_perp - f.cov * f.dp_o + f.mean_perp * f.p
 }
 
-/// The last term of seed 002 eq 53 as printed, s̄_o p_s(s): it lacks the H(s) that multiplying
-/// eq 51 by H gives (ERRATA.md seed 002 #4; eq 54's s̄_⊥ p_s likewise).
+/// The last term of document 002 eq 53 as printed, s̄_o p_s(s): it lacks the H(s) that multiplying
+/// eq 51 by H gives (ERRATA.md document 002 #4; eq 54's s̄_⊥ p_s likewise).
 pub fn eq53_last_term_printed(f: &ViewFramePoint) -> f64 {
     f.mean_o * f.p
 }
 
-/// The last term of seed 002 eq 53 corrected, s̄_o p_s(s) H(s) with the visibility
+/// The last term of document 002 eq 53 corrected, s̄_o p_s(s) H(s) with the visibility
 /// H(s) = Heaviside(cos θ − s_o sin θ) at incidence θ.
 pub fn eq53_last_term_corrected(f: &ViewFramePoint, theta: f64) -> f64 {
     let h = if theta.cos() - f.s_o * theta.sin() > 0.0 {
