@@ -15,10 +15,10 @@
 //! --quick` for a fast pass).
 
 use criterion::{black_box, Criterion, Throughput};
+use mfh_harness::oracle::chi2::sphere::{chi2_masses, observe_sphere, SphereMasses};
+use mfh_harness::oracle::chi2::sphere_finder::SphereFinder;
 use mfh_harness::oracle::chi2::{cells, observe_batch};
 use mfh_harness::oracle::hemisphere_grid::CellFinder;
-use mfh_harness::oracle::sphere_chi2::{chi2_masses, observe_sphere, SphereMasses};
-use mfh_harness::oracle::sphere_finder::SphereFinder;
 use mfh_harness::random::stream;
 use mfh_reference::bsdf::microfacet::{Microfacet, Sampling};
 use mfh_reference::bsdf::spec::BsdfSpec;

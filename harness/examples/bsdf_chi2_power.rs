@@ -11,8 +11,8 @@
 //! cargo run --release -p mfh-harness --example bsdf_chi2_power [-- SAMPLES]
 //! ```
 
+use mfh_harness::oracle::chi2::sphere::sphere_chi2;
 use mfh_harness::oracle::chi2::Chi2Config;
-use mfh_harness::oracle::sphere_chi2::sphere_chi2;
 use mfh_harness::tolerance::STATISTICAL_ALPHA;
 use mfh_reference::bsdf::{Bsdf, BsdfSpec, Directions};
 use mfh_reference::geometry::Vec3;

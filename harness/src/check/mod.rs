@@ -8,7 +8,7 @@
 //! `batch_agrees.rs`); `bsdf/` (a whole BSDF, planned from the `Bsdf` capability at normal,
 //! oblique and grazing incidences and, when it transmits, from inside and beyond the critical
 //! angle; the integrals an incidence's checks share computed once in `bsdf/mod.rs`, their
-//! samples drawn by the chi-square oracle's one loop, `oracle::sphere_chi2::draw_chunks`;
+//! samples drawn by the chi-square oracle's one loop, `oracle::chi2::sphere::draw_chunks`;
 //! `bsdf.ndf_consistency` in `ndf.rs` where the subject offers the NDF the BSDF is built on —
 //! `subject::bsdf::OwnNdf`, from `Audit::of_bsdf(…).ndf(…)` or a reference BSDF's spec);
 //! `sg/` (the shared helpers in `sg.rs`, then `isotropic.rs`, `circular.rs`, `asg.rs`

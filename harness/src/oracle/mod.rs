@@ -18,8 +18,8 @@
 //! (`mod.rs` the procedure; `cells.rs` the cells at the density's marginal quantiles,
 //! `binning.rs`, `expected.rs` the cell masses by cubature, `judge.rs` sanity, pooling and the
 //! p-value, `components.rs` the statistic's smooth and remaining parts). A BSDF's chi-square
-//! over the whole sphere: `sphere_chi2.rs`, its masses by the globally adaptive cubature of
-//! `cubature/global.rs` (for densities with steps), its cells found by `sphere_finder.rs`. The
+//! over the whole sphere: `chi2/sphere.rs`, its masses by the globally adaptive cubature of
+//! `cubature/global.rs` (for densities with steps), its cells found by `chi2/sphere_finder.rs`. The
 //! cell grids: `hemisphere_grid.rs` (its cell finder runs under the batch samplers' SIMD dispatch), with
 //! the branch-free edge search of `edge_table.rs`. The KS test: `ks/`. Where a density's lobe
 //! is, from the density alone: `lobe.rs`; the chi-square and KS oracles also cut their
@@ -41,8 +41,6 @@ pub mod monte_carlo;
 pub mod precise;
 pub mod quadrature;
 pub mod smith_lambda;
-pub mod sphere_chi2;
-pub mod sphere_finder;
 pub mod student_t;
 pub mod visible_moments;
 

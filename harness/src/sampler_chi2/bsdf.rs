@@ -1,13 +1,13 @@
 //! Running one whole-sphere chi-square test of a reference BSDF's sampler, as `mfh chi2 --bsdf`
 //! asks for it: the request (validated against the limits of the NDF path, with
-//! typed errors naming the option and the limit), the run ([`crate::oracle::sphere_chi2`]), the
+//! typed errors naming the option and the limit), the run ([`crate::oracle::chi2::sphere`]), the
 //! record (a JSON object) and its observed/expected tables ([`RecordData::SphereChi2Table`],
 //! which the report sinks draw). No exit codes and no file writing here.
 
 use super::{finite_or_null, MIN_RESOLUTION};
 use super::{min_samples, out_of_range, Chi2InputError, MAX_RESOLUTION, MAX_SAMPLES};
+use crate::oracle::chi2::sphere::{sphere_chi2_about, SphereChi2Result};
 use crate::oracle::chi2::Chi2Config;
-use crate::oracle::sphere_chi2::{sphere_chi2_about, SphereChi2Result};
 use crate::record::RecordData;
 use crate::tolerance::MIN_EXPECTED;
 use mfh_reference::bsdf::{Bsdf, BsdfSpec, Directions};

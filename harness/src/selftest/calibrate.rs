@@ -275,8 +275,8 @@ pub fn calibrate_bsdf(
     progress: Option<super::Progress<'_>>,
 ) -> Result<Vec<TestCalibration>, String> {
     use crate::check::bsdf::{incidences, pdf_at};
+    use crate::oracle::chi2::sphere::{chi2_masses_about, sphere_chi2_against};
     use crate::oracle::lobe_centres::lobe_centres;
-    use crate::oracle::sphere_chi2::{chi2_masses_about, sphere_chi2_against};
     let spec: mfh_reference::bsdf::BsdfSpec =
         serde_json::from_str(BSDF_MODEL).map_err(|e| format!("calibration BSDF: {e}"))?;
     let bsdf = spec.build().map_err(|e| format!("calibration BSDF: {e}"))?;

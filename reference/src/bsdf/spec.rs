@@ -93,7 +93,7 @@ pub struct DielectricSpec {
 /// whole-sphere integrals cannot certify: a Beckmann conductor of α_x 0.68, α_y 1e-7 at
 /// normal incidence integrated to a pdf mass of 1.2e-3 against 0.961 by Monte Carlo, and
 /// ratios of 10⁶–10¹¹ left the masses' bounds unresolved within the budget. At 100 the
-/// property test of `harness/src/oracle/sphere_mass_tests.rs` holds over the rest of the
+/// property test of `harness/src/oracle/chi2/sphere_mass_tests.rs` holds over the rest of the
 /// domain (α from 1e-7 to 1e4, η from 0.1 to 10).
 pub const ANISOTROPY_MAX: f64 = 100.0;
 

@@ -13,12 +13,12 @@ use super::{
     ALBEDO_CERTIFIED_BOUND, SOURCE,
 };
 use crate::check::{applied, covers, Check, PlannedCheck, Profile};
+use crate::oracle::chi2::sphere::{
+    cross_check_sphere, cross_checked_allowance, CROSS_CHECK_RESOLUTION,
+};
 use crate::oracle::chi2::Expected;
 use crate::oracle::lobe_centres::lobe_centres;
 use crate::oracle::monte_carlo::two_sided_p;
-use crate::oracle::sphere_chi2::{
-    cross_check_sphere, cross_checked_allowance, CROSS_CHECK_RESOLUTION,
-};
 use crate::oracle::Estimate;
 use crate::record::{Measured, OracleValue, Verdict};
 use crate::tolerance::{BSDF_ENERGY, STATISTICAL_ALPHA};
@@ -177,7 +177,7 @@ pub fn plan<'a>(
                 // 3.5e-9; GGX 0.3 at η 1.00005, cos θi 0.05, both 0.5830581 ± 1.1e-6 against
                 // a mean weight of 0.5830906 ± 5.4e-6, 3.2e-5 apart, untraced). That floor is
                 // the check's stated resolution, validated against Monte Carlo over the
-                // accepted domain (`oracle/sphere_mass_tests.rs`) and at its corners, not a
+                // accepted domain (`oracle/chi2/sphere_mass_tests.rs`) and at its corners, not a
                 // proven bound.
                 let (second_upper, second_lower) = cross.get(bsdf, wi, n);
                 let second_total = sum(&second_upper, &second_lower);

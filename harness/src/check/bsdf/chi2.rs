@@ -1,12 +1,12 @@
 //! `bsdf.chi2`: the directions `sample` returns against `pdf` over the whole sphere, at one
-//! incidence ([`crate::oracle::sphere_chi2`]).
+//! incidence ([`crate::oracle::chi2::sphere`]).
 
 use super::{BsdfSubject, Incidence, Integrals, SOURCE};
 use crate::check::{applied, covers, Check, PlannedCheck, Profile};
-use crate::oracle::chi2::{Chi2Config, TestOutcome};
-use crate::oracle::sphere_chi2::{
+use crate::oracle::chi2::sphere::{
     sphere_chi2_against, SphereChi2Result, MASS_BUDGET, MASS_NONCENTRALITY,
 };
+use crate::oracle::chi2::{Chi2Config, TestOutcome};
 use crate::record::{Measured, OracleValue, RecordData, Verdict};
 use crate::tolerance::STATISTICAL_ALPHA;
 use mfh_reference::bsdf::Directions;

@@ -23,9 +23,9 @@
 use super::SOURCE as BSDF_SOURCE;
 use crate::check::regime::{self, AtIncidence, SweepPoint};
 use crate::check::{applied, Check, PlannedCheck, Profile};
+use crate::oracle::chi2::sphere::{chi2_masses_about, sphere_chi2_against};
 use crate::oracle::chi2::Chi2Config;
 use crate::oracle::lobe_centres::lobe_centres;
-use crate::oracle::sphere_chi2::{chi2_masses_about, sphere_chi2_against};
 use crate::record::{Measured, RecordData, Verdict};
 use crate::subject::bsdf::BsdfSubject;
 use crate::tolerance::{PDF_JACOBIAN, STATISTICAL_ALPHA};

@@ -3,7 +3,7 @@
 //!
 //! | check | file | oracle |
 //! |---|---|---|
-//! | `bsdf.chi2` | `chi2.rs` | sampled wo against `pdf` over the whole sphere ([`crate::oracle::sphere_chi2`]) |
+//! | `bsdf.chi2` | `chi2.rs` | sampled wo against `pdf` over the whole sphere ([`crate::oracle::chi2::sphere`]) |
 //! | `bsdf.sample_consistency` | `consistency.rs` | the sample's pdf and weight against `pdf` and `eval/pdf` at its wo |
 //! | `bsdf.failure_rate` | `consistency.rs` | the rate of failed samples against 1 − ∫ pdf (cubature) |
 //! | `bsdf.albedo` | `albedo.rs` | ∫ eval by cubature against the mean sampled weight (Monte Carlo) |
@@ -34,12 +34,12 @@ pub use against::plan_against;
 pub use chi2::{table as chi2_table, RESOLUTION as CHI2_RESOLUTION};
 
 use super::{PlannedCheck, Profile};
+use crate::oracle::chi2::sphere::{
+    chi2_masses_about, draw_chunks, expected_sphere_about, SphereMasses,
+};
 use crate::oracle::chi2::Expected;
 use crate::oracle::hemisphere_grid::HemisphereGrid;
 use crate::oracle::lobe_centres::lobe_centres;
-use crate::oracle::sphere_chi2::{
-    chi2_masses_about, draw_chunks, expected_sphere_about, SphereMasses,
-};
 use crate::oracle::Estimate;
 use crate::subject::bsdf::BsdfSubject;
 use mfh_reference::bsdf::{Bsdf, BsdfSample};
@@ -239,7 +239,7 @@ impl Integrals {
 /// The summed error bound ∫ eval aims at in each hemisphere for `samples` sampled weights:
 /// 10/N (1e-5 at the ci profile's 10⁶), with a floor of 1e-9.
 ///
-/// Why not the chi-square's 1/N ([`crate::oracle::sphere_chi2::mass_target`]): `bsdf.albedo` compares the integral with
+/// Why not the chi-square's 1/N ([`crate::oracle::chi2::sphere::mass_target`]): `bsdf.albedo` compares the integral with
 /// the mean sampled weight, whose standard error is σ_w/√N (σ_w, the weights' spread, is
 /// 0.05–1 for the microfacet BSDFs we audit), and takes the bound off the deviation; a bound
 /// of 2 × 10/N is then 20/(σ_w √N) ≤ 0.4 standard errors at 10⁶ samples for σ_w ≥ 0.05, a

@@ -1,7 +1,7 @@
 //! The verdict of the chi-square test from its observed and expected counts: the sanity
 //! failures first, then the verdict step [`pearson_test`] — the pooled statistic, its two
 //! parts and their p-value against α — which the whole sphere's test
-//! (`crate::oracle::sphere_chi2`) takes too.
+//! (`crate::oracle::chi2::sphere`) takes too.
 
 use super::components::{components, Components};
 use super::{Chi2Config, Chi2Result, Expected, Failure, Observed, OutsideHemisphere, TestOutcome};

@@ -43,6 +43,8 @@ pub mod cells;
 pub mod components;
 mod expected;
 mod judge;
+pub mod sphere;
+pub mod sphere_finder;
 
 pub use binning::{observe, observe_batch, observe_blocks, Observed, CHUNK};
 pub use expected::{

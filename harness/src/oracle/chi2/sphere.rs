@@ -55,12 +55,12 @@
 
 use crate::oracle::chi2::cells::{self, Layout};
 use crate::oracle::chi2::components::Components;
+use crate::oracle::chi2::sphere_finder::SphereFinder;
 use crate::oracle::chi2::{
     expected_mass_global_until, pearson_test, Chi2Config, Expected, TestOutcome,
 };
 use crate::oracle::hemisphere_grid::HemisphereGrid;
 use crate::oracle::lobe;
-use crate::oracle::sphere_finder::SphereFinder;
 use crate::random::stream;
 use crate::tolerance::{MASS_TOLERANCE, MIN_EXPECTED};
 use mfh_reference::bsdf::Directions;

@@ -1,5 +1,5 @@
 //! The cells of sampled directions over the whole sphere, for the BSDF chi-square
-//! (`oracle::sphere_chi2`): the upper hemisphere's grid for z ≥ 0, the lower hemisphere's,
+//! (`oracle::chi2::sphere`): the upper hemisphere's grid for z ≥ 0, the lower hemisphere's,
 //! mirrored through the surface, for z < 0, numbered as one list — the upper grid's cells,
 //! then the lower grid's, then one cell for the failed samples (`None`).
 //!
