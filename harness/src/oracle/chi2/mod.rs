@@ -44,6 +44,7 @@ pub mod components;
 mod expected;
 mod judge;
 pub mod sphere;
+pub mod sphere_accuracy;
 pub mod sphere_finder;
 
 pub use binning::{observe, observe_batch, observe_blocks, Observed, CHUNK};
