@@ -43,6 +43,7 @@ pub mod sampling;
 pub mod sg;
 pub mod smith;
 pub mod stability;
+pub mod step_ladder;
 
 use crate::oracle::Estimate;
 use crate::record::{

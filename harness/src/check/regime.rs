@@ -169,6 +169,9 @@ pub struct Density {
     pub finest: f64,
     /// A bound on the extrapolated density's relative rounding error ([`rounding_bound`]).
     pub rounding: f64,
+    /// The relative difference of the extrapolated density from the next finer step's (h/2,
+    /// h/4, h/8), where it was measured (`check/step_ladder.rs`), else 0.
+    pub finer: f64,
 }
 
 /// The ulps of each component of a sampled direction that the rounding bound allows at the
@@ -192,14 +195,18 @@ pub const NOISE_DIVISOR: f64 = 2.0;
 
 /// The relative rounding error of a central-difference density from directions each of whose
 /// components is within `e` of its exact value: each component of a column a = (p − q)/(2h) is
-/// off by ≤ 2e/(2h), so |a| by ≤ √3·e/h; the density 1/|a × b| by ≤ r = √3·e/h·(1/|a| + 1/|b|)
-/// to first order at step h. The steps h/2 and h/4 double and quadruple r, and the
-/// extrapolation (4 D(h/4) − D(h/2))/3 weighs the two errors 4/3 and 1/3: ≤ (16r + 2r)/3 = 6r.
-/// Negligible for an f64 map of ε-accurate
-/// directions (~1e-8 at |a| = 1e-3), it is what limits a float32 map at tiny roughness, whose
-/// derivatives are of the order of α: at α = 0.001 and step 4e-3, r reaches ~0.1.
-pub fn rounding_bound(e: f64, h: f64, a: f64, b: f64) -> f64 {
-    6.0 * 3f64.sqrt() * e / h * (1.0 / a + 1.0 / b)
+/// off by ≤ 2e/(2h), so a by a vector δa of length ≤ √3·e/h, and |a × b| by ≤ |δa||b| + |a||δb|;
+/// the density 1/|a × b| by ≤ r = √3·e/h·(|a| + |b|)/|a × b| to first order at step h (for
+/// orthogonal columns √3·e/h·(1/|a| + 1/|b|); columns nearly parallel, a map that shears u,
+/// amplify it by |a||b|/|a × b|: 3 150 for GGX α 1e4 refracting into η 0.1 at cos θi 0.03,
+/// whose densities at step 1.25e-5 are off by 3e-6 where the orthogonal bound says 6.5e-7).
+/// The steps h/2 and h/4 double and quadruple r, and the extrapolation (4 D(h/4) − D(h/2))/3
+/// weighs the two errors 4/3 and 1/3: ≤ (16r + 2r)/3 = 6r. Negligible for an f64 map of
+/// ε-accurate directions (~1e-8 at |a| = 1e-3), it is what limits a float32 map at tiny
+/// roughness, whose derivatives are of the order of α: at α = 0.001 and step 4e-3, r reaches
+/// ~0.1. `a`, `b` and `cross` are |a|, |b| and |a × b| at step h.
+pub fn rounding_bound(e: f64, h: f64, (a, b, cross): (f64, f64, f64)) -> f64 {
+    6.0 * 3f64.sqrt() * e / h * (a + b) / cross
 }
 
 impl Density {
@@ -221,7 +228,8 @@ impl Density {
     /// within [2, 8] of the asymptotic 4), or differ by no more than twice their rounding
     /// bound. A point whose densities wander instead (its map not yet smooth at the step's
     /// scale, or its rounding beyond the bound: GGX α 1e4 refracting into η 0.1 at step 6e-6,
-    /// whose differences are in a ratio of 50) says nothing and is left out.
+    /// whose differences are in a ratio of 50) says nothing at this step; the step ladder
+    /// (`check/step_ladder.rs`) measures it at others.
     ///
     /// [`spread`]: Density::spread
     pub fn resolved(&self, unresolved: f64) -> bool {
@@ -238,12 +246,13 @@ impl Density {
         ((coarser - self.value()) / self.value()).abs()
     }
 
-    /// What a point's error is allowed beyond the tolerance: the [`extrapolation`]'s error and
+    /// What a point's error is allowed beyond the tolerance: the [`extrapolation`]'s error (or
+    /// the difference from the finer step's extrapolation, [`Density::finer`], if larger) and
     /// the rounding bound.
     ///
     /// [`extrapolation`]: Density::extrapolation
     pub fn allowance(&self) -> f64 {
-        self.extrapolation() + self.rounding
+        self.extrapolation().max(self.finer) + self.rounding
     }
 }
 
@@ -268,43 +277,13 @@ pub type BatchMap<'m> = dyn FnMut(&[[f64; 3]], &mut [Option<Vec3>]) + 'm;
 
 /// The directions at `centres` (u₀ fixed, u₁ and u₂ the coordinates of the map) and, where the
 /// map is defined on the whole stencil and stays on the centre's side of the surface there,
-/// its density by central differences with step `h`, for a map computed in precision `eps`
-/// (its ε), with the bound of its rounding from the noise the stencil shows ([`NOISE_DIVISOR`])
-/// or [`DIRECTION_ULPS`], whichever is larger. A point whose stencil leaves the map's domain or
-/// its side of the surface, or that is not [`Density::resolved`] at `unresolved`, is measured again
-/// with the step h/[`REFINE`] (one more call of `map`, for those points only): where the map
-/// is defined on a sliver of u (a lobe that almost always fails: GGX α 1e4 refracting into
-/// η 0.1), the finer stencil fits in it. `map` is one batch call: `out[k]` the direction of
-/// `u[k]`, None where the map fails.
+/// its density by central differences with steps `h`, h/2 and h/4, for a map computed in
+/// precision `eps` (its ε), with the bound of its rounding from the noise the stencil shows
+/// ([`NOISE_DIVISOR`]) or [`DIRECTION_ULPS`], whichever is larger. `map` is one batch call:
+/// `out[k]` the direction of `u[k]`, None where the map fails. A point this stencil cannot
+/// judge, or judges failing, is measured again on a ladder of steps
+/// (`check/step_ladder.rs`).
 pub fn densities(
-    centres: &[[f64; 3]],
-    h: f64,
-    eps: f64,
-    unresolved: f64,
-    map: &mut BatchMap<'_>,
-) -> Vec<(Option<Vec3>, Option<Density>)> {
-    let mut out = densities_at(centres, h, eps, map);
-    let again: Vec<usize> = (0..out.len())
-        .filter(|&k| out[k].0.is_some() && !out[k].1.is_some_and(|d| d.resolved(unresolved)))
-        .collect();
-    if !again.is_empty() {
-        let retry: Vec<[f64; 3]> = again.iter().map(|&k| centres[k]).collect();
-        let finer = densities_at(&retry, h / REFINE, eps, map);
-        for (&k, (_, d)) in again.iter().zip(finer) {
-            if d.is_some_and(|d| d.resolved(unresolved)) {
-                out[k].1 = d;
-            }
-        }
-    }
-    out
-}
-
-/// The factor by which [`densities`] shrinks the step of an unresolved point: 16 (f64: 6.25e-6,
-/// whose rounding, 16 × that of 1e-4, stays ≤ 1e-7 where the map's derivatives are ≥ 1e-3).
-pub const REFINE: f64 = 16.0;
-
-/// [`densities`] at one step.
-fn densities_at(
     centres: &[[f64; 3]],
     h: f64,
     eps: f64,
@@ -351,30 +330,32 @@ fn densities_at(
                 };
                 (d(s[k], s[k + 1]), d(s[k + 2], s[k + 3]))
             };
-            let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            let density = |k: usize, step: f64| {
-                let (a, b) = columns(k, step);
-                let x = [
-                    a[1] * b[2] - a[2] * b[1],
-                    a[2] * b[0] - a[0] * b[2],
-                    a[0] * b[1] - a[1] * b[0],
-                ];
-                1.0 / (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
-            };
+            // |a|, |b| and |a × b| of the columns at one step.
+            let lengths = |k: usize, step: f64| column_lengths(columns(k, step));
+            let density = |k: usize, step: f64| 1.0 / lengths(k, step).2;
             (
                 centre,
                 Some(Density {
                     coarse: density(0, h),
                     fine: density(4, h / 2.0),
                     finest: density(8, h / 4.0),
-                    rounding: {
-                        let (a, b) = columns(0, h);
-                        rounding_bound(e, h, norm(a), norm(b))
-                    },
+                    rounding: rounding_bound(e, h, lengths(0, h)),
+                    finer: 0.0,
                 }),
             )
         })
         .collect()
+}
+
+/// |a|, |b| and |a × b| of two columns.
+pub fn column_lengths((a, b): ([f64; 3], [f64; 3])) -> (f64, f64, f64) {
+    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let x = [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ];
+    (norm(a), norm(b), norm(x))
 }
 
 /// What one incidence of a sweep measured: the worst relative error of the stated pdf against
@@ -555,7 +536,7 @@ mod tests {
     fn the_densities_of_a_linear_map_are_exact() {
         // u ↦ (u₁, 2u₂, 1) (not unit, but a map): density 1/2 everywhere.
         let c = [[0.5, 0.3, 0.6]];
-        let d = densities(&c, 1e-3, f64::EPSILON, 1e-3, &mut |u, out| {
+        let d = densities(&c, 1e-3, f64::EPSILON, &mut |u, out| {
             for (o, u) in out.iter_mut().zip(u) {
                 *o = Some([u[1], 2.0 * u[2], 1.0]);
             }

@@ -21,7 +21,8 @@
 //! narrowed in θi by bisection to the record's region.
 
 use super::SOURCE as BSDF_SOURCE;
-use crate::check::regime::{self, AtIncidence, SweepPoint};
+use crate::check::regime::{self, AtIncidence, Density, SweepPoint};
+use crate::check::step_ladder;
 use crate::check::{applied, Check, PlannedCheck, Profile};
 use crate::oracle::chi2::sphere::{chi2_masses_about, sphere_chi2_against};
 use crate::oracle::chi2::Chi2Config;
@@ -195,14 +196,53 @@ pub fn measure(
 ) -> AtIncidence {
     let lobes = lobes(bsdf, wi, points, spent);
     let centres: Vec<[f64; 3]> = lobes.iter().map(|l| l.u).collect();
-    let d = regime::densities(&centres, step, eps, unresolved, &mut |u, out| {
-        let w = directions(bsdf, wi, u, spent);
-        out.copy_from_slice(&w);
-    });
+    let mut samples = 0;
+    let mut map = |u: &[[f64; 3]], out: &mut [Option<Vec3>]| {
+        let mut d = Directions::new(u.len());
+        bsdf.sample_wo_batch(wi, u, &mut d);
+        samples += u.len() as u64;
+        for (o, w) in out.iter_mut().zip(d.iter()) {
+            *o = w;
+        }
+    };
+    let mut d = regime::densities(&centres, step, eps, &mut map);
     let wo: Vec<Vec3> = d.iter().map(|(c, _)| c.unwrap_or(wi)).collect();
     let mut pdf = vec![0.0; wo.len()];
     bsdf.pdf_batch(&vec![wi; wo.len()], &wo, &mut pdf);
     spent.pdfs += wo.len() as u64;
+    // A point's error against pdf and its excess over its allowance, where it can be judged:
+    // its centre falls in the lobe its interval was found for (a third lobe inside the
+    // interval, or a boundary within rounding of the midpoint, leaves it unresolved) and its
+    // density is resolved.
+    let judged = |k: usize, (c, density): &(Option<Vec3>, Option<Density>)| {
+        let l = &lobes[k];
+        if lobe(wi, *c) != l.lobe {
+            return None;
+        }
+        let density = (*density)?;
+        let value = density.value() * l.measure;
+        if !(value.is_finite() && value > 0.0 && density.resolved(unresolved)) {
+            return None;
+        }
+        let p = pdf[k];
+        let error = if p.is_finite() && p >= 0.0 {
+            ((p - value) / value).abs()
+        } else {
+            f64::INFINITY
+        };
+        let allowance = density.allowance() + l.uncertainty / l.measure;
+        Some((error, (error - allowance).max(0.0), allowance))
+    };
+    // What the single stencil cannot judge to the tolerance (unresolved, or allowed more than
+    // the tolerance), or judges failing, is measured on the ladder.
+    let again: Vec<usize> = (0..d.len())
+        .filter(|&k| {
+            lobe(wi, d[k].0) == lobes[k].lobe
+                && !judged(k, &d[k]).is_some_and(|(_, x, a)| x <= tolerance && a <= tolerance)
+        })
+        .collect();
+    step_ladder::measure_again(&mut d, &centres, &again, (step, eps, unresolved), &mut map);
+    spent.samples += samples;
     let mut out = AtIncidence {
         theta,
         worst: 0.0,
@@ -211,25 +251,12 @@ pub fn measure(
         resolved: 0,
         measured: lobes.len(),
     };
-    for ((l, (c, density)), &p) in lobes.iter().zip(&d).zip(&pdf) {
-        // The centre must fall in the lobe its interval was found for (a third lobe inside
-        // the interval, or a boundary within rounding of the midpoint, leaves it unresolved).
-        if lobe(wi, *c) != l.lobe {
+    for (k, point) in d.iter().enumerate() {
+        let Some((error, excess, _)) = judged(k, point) else {
             continue;
-        }
-        let Some(density) = density else { continue };
-        let value = density.value() * l.measure;
-        if !(value.is_finite() && value > 0.0 && density.resolved(unresolved)) {
-            continue;
-        }
-        out.resolved += 1;
-        let error = if p.is_finite() && p >= 0.0 {
-            ((p - value) / value).abs()
-        } else {
-            f64::INFINITY
         };
+        out.resolved += 1;
         out.worst = out.worst.max(error);
-        let excess = (error - density.allowance() - l.uncertainty / l.measure).max(0.0);
         if !(excess <= out.excess) {
             out.excess = excess;
         }

@@ -10,7 +10,8 @@
 //! within 1e-5 of the normal, not orthogonal to it: ≈ 1 % density error for θi < 0.089 rad at
 //! α 0.05), a clamp of the stretched normal's height, a branch near grazing.
 
-use crate::check::regime::{self, AtIncidence, SweepPoint};
+use crate::check::regime::{self, AtIncidence, Density, SweepPoint};
+use crate::check::step_ladder;
 use crate::check::{applied, covers, need, Check, PlannedCheck};
 use crate::record::{Measured, RecordData};
 use crate::subject::Subject;
@@ -38,7 +39,7 @@ pub fn measure(
     let centres: Vec<[f64; 3]> = points.iter().map(|p| [0.0, p[0], p[1]]).collect();
     let mut u2 = Vec::new();
     let mut ms = Vec::new();
-    let d = regime::densities(&centres, step, eps, unresolved, &mut |u, out| {
+    let mut map = |u: &[[f64; 3]], out: &mut [Option<Vec3>]| {
         u2.clear();
         u2.extend(u.iter().map(|u| [u[1], u[2]]));
         ms.clear();
@@ -47,13 +48,34 @@ pub fn measure(
         for (o, m) in out.iter_mut().zip(&ms) {
             *o = m.iter().all(|c| c.is_finite()).then_some(*m);
         }
-    });
-    let centres: Vec<Vec3> = d
+    };
+    let mut d = regime::densities(&centres, step, eps, &mut map);
+    let normals: Vec<Vec3> = d
         .iter()
         .map(|(c, _)| c.unwrap_or([0.0, 0.0, 1.0]))
         .collect();
-    let mut pdf = vec![0.0; centres.len()];
-    v.pdf_wm_visible_batch(wi, &centres, &mut pdf);
+    let mut pdf = vec![0.0; normals.len()];
+    v.pdf_wm_visible_batch(wi, &normals, &mut pdf);
+    // A point's error and its excess over its allowance, where its density is resolved.
+    let judged = |k: usize, density: Option<Density>| {
+        let density = density?;
+        let value = density.value();
+        if !(value.is_finite() && value > 0.0 && density.resolved(unresolved)) {
+            return None;
+        }
+        let error = ((pdf[k] - value) / value).abs();
+        let allowance = density.allowance();
+        Some((error, (error - allowance).max(0.0), allowance))
+    };
+    // What the single stencil cannot judge to the tolerance (unresolved, or allowed more than
+    // the tolerance), or judges failing, is measured on the ladder.
+    let again: Vec<usize> = (0..d.len())
+        .filter(|&k| {
+            d[k].0.is_some()
+                && !judged(k, d[k].1).is_some_and(|(_, x, a)| x <= tolerance && a <= tolerance)
+        })
+        .collect();
+    step_ladder::measure_again(&mut d, &centres, &again, (step, eps, unresolved), &mut map);
     let mut out = AtIncidence {
         theta,
         worst: 0.0,
@@ -62,7 +84,8 @@ pub fn measure(
         resolved: 0,
         measured: points.len(),
     };
-    for ((c, density), &p) in d.iter().zip(&pdf) {
+    for (k, (c, density)) in d.iter().enumerate() {
+        let p = pdf[k];
         if c.is_none() || !p.is_finite() || p < 0.0 {
             // A sampled normal that is not one, or a pdf that is not a density, is wrong
             // wherever it happens.
@@ -72,15 +95,11 @@ pub fn measure(
             out.resolved += 1;
             continue;
         }
-        let Some(density) = density else { continue };
-        let value = density.value();
-        if !(value.is_finite() && value > 0.0 && density.resolved(unresolved)) {
+        let Some((error, excess, _)) = judged(k, *density) else {
             continue;
-        }
+        };
         out.resolved += 1;
-        let error = ((p - value) / value).abs();
         out.worst = out.worst.max(error);
-        let excess = (error - density.allowance()).max(0.0);
         if !(excess <= out.excess) {
             out.excess = excess;
         }
