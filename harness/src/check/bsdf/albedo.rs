@@ -363,3 +363,7 @@ fn importance_factor(bsdf: &dyn Bsdf, wi: Vec3) -> f64 {
 #[cfg(test)]
 #[path = "energy_tests.rs"]
 mod energy_tests;
+
+#[cfg(test)]
+#[path = "albedo_golden_tests.rs"]
+mod albedo_golden_tests;
