@@ -174,11 +174,13 @@ pub fn plan<'a>(
                 // does not judge: an error common to both layouts stays there (measured
                 // 2026-12-06: Beckmann α 1e-7 at η 0.999, θi 0.9, both 1.0020034303 ± 1.3e-7
                 // where Fresnel's law gives 1.0020030022 and the mean weight 1.002002998 ±
-                // 3.5e-9; GGX 0.3 at η 1.00005, cos θi 0.05, both 0.5830581 ± 1.1e-6 against
-                // a mean weight of 0.5830906 ± 5.4e-6, 3.2e-5 apart, untraced). That floor is
-                // the check's stated resolution, validated against Monte Carlo over the
-                // accepted domain (`oracle/chi2/sphere_mass_tests.rs`) and at its corners, not a
-                // proven bound.
+                // 3.5e-9, a near-delta lobe ~1e-10 wide whose nodes' directions are rounded by
+                // ~1e-6 of its width). That floor is the check's stated resolution, validated
+                // against Monte Carlo over the accepted domain
+                // (`oracle/chi2/sphere_mass_tests.rs`) and at its corners, not a proven bound.
+                // (The other common error measured, GGX α 0.3 at η 1.00005 and cos θi 0.05
+                // 3.2e-5 short on both layouts, was the transmission edge inside the pieces,
+                // cut exactly since: `albedo_golden_tests.rs`.)
                 let (second_upper, second_lower) = cross.get(bsdf, wi, n);
                 let second_total = sum(&second_upper, &second_lower);
                 let cross_checked = allowance(&quad, &second_total);
