@@ -377,6 +377,29 @@ pub struct AtIncidence {
     pub measured: usize,
 }
 
+impl AtIncidence {
+    /// Nothing measured yet at θi `theta`, of `measured` points.
+    pub fn new(theta: f64, measured: usize) -> Self {
+        AtIncidence {
+            theta,
+            worst: 0.0,
+            excess: 0.0,
+            fails: false,
+            resolved: 0,
+            measured,
+        }
+    }
+
+    /// Counts one resolved point: its relative error and its excess over its allowance.
+    pub fn add(&mut self, error: f64, excess: f64) {
+        self.resolved += 1;
+        self.worst = self.worst.max(error);
+        if !(excess <= self.excess) {
+            self.excess = excess;
+        }
+    }
+}
+
 /// The verdict of a Jacobian sweep: an error (it cannot judge) when fewer than the fraction
 /// `need` of the `measured` points had a smooth map within the stencil, else fail or pass.
 pub fn verdict(resolved: usize, measured: usize, need: f64, fails: bool) -> crate::record::Verdict {

@@ -106,6 +106,13 @@ pub fn ladder(
         .collect()
 }
 
+/// Whether a point judged by the single stencil — (error, excess over its allowance,
+/// allowance), None where it could not be judged — is settled at `tolerance`: judged, passing,
+/// and allowed no more than the tolerance. The others are measured on the ladder.
+pub fn settled(judged: Option<(f64, f64, f64)>, tolerance: f64) -> bool {
+    judged.is_some_and(|(_, excess, allowance)| excess <= tolerance && allowance <= tolerance)
+}
+
 /// Measures the points `which` of `d` (densities at `centres` by the single stencil) again on
 /// the ladder, each replaced by its best rung, or by None (unresolved) where no rung is
 /// resolved.

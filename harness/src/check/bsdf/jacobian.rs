@@ -237,28 +237,15 @@ pub fn measure(
     // the tolerance), or judges failing, is measured on the ladder.
     let again: Vec<usize> = (0..d.len())
         .filter(|&k| {
-            lobe(wi, d[k].0) == lobes[k].lobe
-                && !judged(k, &d[k]).is_some_and(|(_, x, a)| x <= tolerance && a <= tolerance)
+            lobe(wi, d[k].0) == lobes[k].lobe && !step_ladder::settled(judged(k, &d[k]), tolerance)
         })
         .collect();
     step_ladder::measure_again(&mut d, &centres, &again, (step, eps, unresolved), &mut map);
     spent.samples += samples;
-    let mut out = AtIncidence {
-        theta,
-        worst: 0.0,
-        excess: 0.0,
-        fails: false,
-        resolved: 0,
-        measured: lobes.len(),
-    };
+    let mut out = AtIncidence::new(theta, lobes.len());
     for (k, point) in d.iter().enumerate() {
-        let Some((error, excess, _)) = judged(k, point) else {
-            continue;
-        };
-        out.resolved += 1;
-        out.worst = out.worst.max(error);
-        if !(excess <= out.excess) {
-            out.excess = excess;
+        if let Some((error, excess, _)) = judged(k, point) {
+            out.add(error, excess);
         }
     }
     out.fails = !(out.excess <= tolerance);

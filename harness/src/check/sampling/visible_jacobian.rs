@@ -70,20 +70,10 @@ pub fn measure(
     // What the single stencil cannot judge to the tolerance (unresolved, or allowed more than
     // the tolerance), or judges failing, is measured on the ladder.
     let again: Vec<usize> = (0..d.len())
-        .filter(|&k| {
-            d[k].0.is_some()
-                && !judged(k, d[k].1).is_some_and(|(_, x, a)| x <= tolerance && a <= tolerance)
-        })
+        .filter(|&k| d[k].0.is_some() && !step_ladder::settled(judged(k, d[k].1), tolerance))
         .collect();
     step_ladder::measure_again(&mut d, &centres, &again, (step, eps, unresolved), &mut map);
-    let mut out = AtIncidence {
-        theta,
-        worst: 0.0,
-        excess: 0.0,
-        fails: false,
-        resolved: 0,
-        measured: points.len(),
-    };
+    let mut out = AtIncidence::new(theta, points.len());
     for (k, (c, density)) in d.iter().enumerate() {
         let p = pdf[k];
         if c.is_none() || !p.is_finite() || p < 0.0 {
@@ -95,13 +85,8 @@ pub fn measure(
             out.resolved += 1;
             continue;
         }
-        let Some((error, excess, _)) = judged(k, *density) else {
-            continue;
-        };
-        out.resolved += 1;
-        out.worst = out.worst.max(error);
-        if !(excess <= out.excess) {
-            out.excess = excess;
+        if let Some((error, excess, _)) = judged(k, *density) {
+            out.add(error, excess);
         }
     }
     out.fails |= !(out.excess <= tolerance);
