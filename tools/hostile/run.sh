@@ -142,6 +142,15 @@ child 8-control-child-eta1.5 "" --
 child 8-child-eval-1e308 "--huge-eval" --
 child 11-child-against-ndf-spec "" --against '{"family":"ggx","alpha":0.3}' --
 
+# 8. the same 1e308 eval in the pure-Python examples/external/dielectric.py (its speed is the
+# tracker's measurement's)
+if want 8-pychild-eval-1e308; then
+    run 8-pychild-eval-1e308 "$MFH" audit-external \
+        --cmd "python3 $HERE/py_dielectric_child.py --huge-eval" --profile ci --quiet \
+        --out 8-pychild-eval-1e308.d
+    row 8-pychild-eval-1e308 "$($KEYS report 8-pychild-eval-1e308.d); $($KEYS slowest 8-pychild-eval-1e308.d)"
+fi
+
 # 8. NDF children whose D is slow to integrate (ndf_child.py): time per record
 for kind in tabulated oscillating; do
     name="8-ndf-child-$kind"
