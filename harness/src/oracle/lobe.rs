@@ -30,6 +30,7 @@
 //! mass far from 1 and the tests fail (never a silent pass). Pass `start_points` (e.g. a few sampled
 //! normals) to [`measure_with`] to start the mode search there.
 
+use super::lobe_climb::{climb_many, Prefetch};
 use mfh_reference::Vec3;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -129,7 +130,7 @@ pub struct Options<'a> {
 
 /// The direction at (θ, φ) about +z (φ from +x).
 #[inline]
-fn direction(theta: f64, phi: f64) -> Vec3 {
+pub(super) fn direction(theta: f64, phi: f64) -> Vec3 {
     let (st, ct) = theta.sin_cos();
     let (sp, cp) = phi.sin_cos();
     [st * cp, st * sp, ct.max(0.0)]
@@ -154,10 +155,19 @@ pub fn measure_density(p: &(dyn Fn(Vec3) -> f64 + Sync)) -> Lobe {
 
 /// [`measure_density`] with a hint and start points.
 pub fn measure_with(p: &(dyn Fn(Vec3) -> f64 + Sync), options: &Options<'_>) -> Lobe {
+    measure_prefetched(p, None, options)
+}
+
+/// [`measure_with`] whose mode searches hand each round's points to `prefetch` first.
+fn measure_prefetched(
+    p: &(dyn Fn(Vec3) -> f64 + Sync),
+    prefetch: Prefetch<'_>,
+    options: &Options<'_>,
+) -> Lobe {
     if let Some(h) = options.hint.filter(|h| h.is_finite() && *h > 0.0) {
         let lo = (h * 1e-3).max(THETA_MIN);
         let hi = (h * 1e3).min(FRAC_PI_2);
-        let lobe = survey(p, lo, hi, 48, options.start_points);
+        let lobe = survey(p, prefetch, (lo, hi, 48), options.start_points);
         // A scale on the window's edge (or none at all) may be a lobe outside it.
         let ratio = (hi / lo).powf(1.0 / 47.0);
         let inside = lobe.theta_scale.iter().all(|&s| {
@@ -166,17 +176,28 @@ pub fn measure_with(p: &(dyn Fn(Vec3) -> f64 + Sync), options: &Options<'_>) -> 
         if inside && lobe.theta_scale.iter().any(|s| s.is_finite()) {
             return lobe;
         }
-        let mut full = survey(p, THETA_MIN, FRAC_PI_2, THETA_STEPS, options.start_points);
+        let mut full = survey(
+            p,
+            prefetch,
+            (THETA_MIN, FRAC_PI_2, THETA_STEPS),
+            options.start_points,
+        );
         full.evaluations += lobe.evaluations;
         return full;
     }
-    survey(p, THETA_MIN, FRAC_PI_2, THETA_STEPS, options.start_points)
+    survey(
+        p,
+        prefetch,
+        (THETA_MIN, FRAC_PI_2, THETA_STEPS),
+        options.start_points,
+    )
 }
 
 /// [`measure_with`] for a batch density (`p(m, out)` writes p(m\[i\]) into out\[i\]): the survey
-/// grids are evaluated first in one call each, then the measurement runs on those values (the
-/// mode search, a few hundred points, one point per call) — the same lobe bit for bit, while
-/// an external model pays a few hundred round trips rather than a few thousand.
+/// grids are evaluated first in one call each, then the measurement runs on those values, its
+/// mode searches a round at a time in one call (`oracle/lobe_climb.rs`), its widths one point
+/// per call — the same lobe bit for bit, while an external model pays a few hundred round
+/// trips rather than tens of thousands.
 pub fn measure_with_batch(p: &(dyn Fn(&[Vec3], &mut [f64]) + Sync), options: &Options<'_>) -> Lobe {
     let mut grids = vec![(THETA_MIN, FRAC_PI_2, THETA_STEPS)];
     if let Some(h) = options.hint.filter(|h| h.is_finite() && *h > 0.0) {
@@ -196,14 +217,27 @@ pub fn measure_with_batch(p: &(dyn Fn(&[Vec3], &mut [f64]) + Sync), options: &Op
         p(&dirs, &mut values);
         known.extend(dirs.iter().map(|m| m.map(f64::to_bits)).zip(values));
     }
+    let known = std::sync::Mutex::new(known);
     let scalar = |m: Vec3| {
-        known.get(&m.map(f64::to_bits)).copied().unwrap_or_else(|| {
+        let cached = known
+            .lock()
+            .expect("not poisoned")
+            .get(&m.map(f64::to_bits))
+            .copied();
+        cached.unwrap_or_else(|| {
             let mut v = [0.0];
             p(&[m], &mut v);
             v[0]
         })
     };
-    measure_with(&scalar, options)
+    // The mode searches' points, a round at a time, in one call each.
+    let prefetch = |dirs: &[Vec3]| {
+        let mut values = vec![0.0; dirs.len()];
+        p(dirs, &mut values);
+        let mut known = known.lock().expect("not poisoned");
+        known.extend(dirs.iter().map(|m| m.map(f64::to_bits)).zip(values));
+    };
+    measure_prefetched(&scalar, Some(&prefetch), options)
 }
 
 /// The survey's polar angles: `steps` log-spaced in [lo, hi].
@@ -229,7 +263,7 @@ fn survey_azimuths() -> Vec<f64> {
 }
 
 /// The density, 0 where it is not a finite non-negative number.
-fn clean(p: &(dyn Fn(Vec3) -> f64 + Sync), theta: f64, phi: f64) -> f64 {
+pub(super) fn clean(p: &(dyn Fn(Vec3) -> f64 + Sync), theta: f64, phi: f64) -> f64 {
     let v = p(direction(theta, phi));
     if v.is_finite() && v > 0.0 {
         v
@@ -241,9 +275,8 @@ fn clean(p: &(dyn Fn(Vec3) -> f64 + Sync), theta: f64, phi: f64) -> f64 {
 /// The survey over `steps` log-spaced θ in [lo, hi] at [`AZIMUTHS`] azimuths, then the mode.
 fn survey(
     p: &(dyn Fn(Vec3) -> f64 + Sync),
-    lo: f64,
-    hi: f64,
-    steps: usize,
+    prefetch: Prefetch<'_>,
+    (lo, hi, steps): (f64, f64, usize),
     start_points: &[Vec3],
 ) -> Lobe {
     let mut evaluations = 0u64;
@@ -308,21 +341,27 @@ fn survey(
         narrowest = (FALLBACK_WIDTH, 0.0);
         widest = (FALLBACK_WIDTH, 0.0);
     }
-    for &m in start_points {
-        if m.iter().all(|c| c.is_finite()) && m[2] >= 0.0 {
-            let (t, phi) = angles(m);
-            let v = clean(p, t, phi);
-            evaluations += 1;
-            if v > best.0 {
-                best = (v, t, phi);
-            }
+    let starts: Vec<(f64, f64)> = start_points
+        .iter()
+        .filter(|m| m.iter().all(|c| c.is_finite()) && m[2] >= 0.0)
+        .map(|&m| angles(m))
+        .collect();
+    if let Some(fetch) = prefetch {
+        let dirs: Vec<Vec3> = starts.iter().map(|&(t, f)| direction(t, f)).collect();
+        fetch(&dirs);
+    }
+    for &(t, phi) in &starts {
+        let v = clean(p, t, phi);
+        evaluations += 1;
+        if v > best.0 {
+            best = (v, t, phi);
         }
     }
     let mut mode = None;
     if best.0 > 0.0 {
-        let (found, spent) = climb(p, best, narrowest.0);
+        let (found, spent) = climb_many(p, prefetch, &[best], narrowest.0)[0];
         evaluations += spent;
-        let (m, spent) = widths(p, found);
+        let (m, spent) = widths(p, prefetch, found);
         evaluations += spent;
         if off_pole(&m, narrowest.0) {
             mode = Some(m);
@@ -330,24 +369,21 @@ fn survey(
     }
     // The start points that climb elsewhere: further modes.
     let mut extra_modes: Vec<Mode> = Vec::new();
-    let mut starts: Vec<(f64, f64, f64)> = Vec::new();
-    for &m in start_points {
-        if m.iter().all(|c| c.is_finite()) && m[2] >= 0.0 {
-            let (t, phi) = angles(m);
-            let v = clean(p, t, phi);
-            evaluations += 1;
-            if v > 0.0 {
-                starts.push((v, t, phi));
-            }
-        }
-    }
+    let mut starts: Vec<(f64, f64, f64)> = starts
+        .iter()
+        .map(|&(t, phi)| (clean(p, t, phi), t, phi))
+        .filter(|s| s.0 > 0.0)
+        .collect();
+    evaluations += start_points.len() as u64;
     starts.sort_by(|a, b| b.0.total_cmp(&a.0));
-    for start in starts {
+    // All climbed at once (one call a round for an external model), then taken in order as
+    // one at a time would: the first MAX_EXTRA_MODES that lead to a new mode.
+    let climbs = climb_many(p, prefetch, &starts, narrowest.0);
+    evaluations += climbs.iter().map(|c| c.1).sum::<u64>();
+    for (found, _) in climbs {
         if extra_modes.len() >= MAX_EXTRA_MODES {
             break;
         }
-        let (found, spent) = climb(p, start, narrowest.0);
-        evaluations += spent;
         let known = mode
             .iter()
             .chain(&extra_modes)
@@ -355,7 +391,7 @@ fn survey(
         if known {
             continue;
         }
-        let (m, spent) = widths(p, found);
+        let (m, spent) = widths(p, prefetch, found);
         evaluations += spent;
         if off_pole(&m, narrowest.0) {
             extra_modes.push(m);
@@ -390,97 +426,87 @@ fn same_mode(k: &Mode, theta: f64, phi: f64) -> bool {
     (theta - k.theta).abs() <= 2.0 * k.width_theta && d_phi * k.theta.sin() <= 2.0 * k.width_arc
 }
 
-/// Compass search for the mode of p from `start` = (p, θ, φ): moves to the best of the four
-/// neighbours at (±Δθ, ±Δφ) while one is higher, else halves the steps, until the neighbours
-/// differ from the centre by less than 1e-6 relative (the steps are then ~1e-3 of the lobe's
-/// width) or 400 evaluations are spent. Returns ((p, θ, φ), evaluations).
-fn climb(
-    p: &(dyn Fn(Vec3) -> f64 + Sync),
-    start: (f64, f64, f64),
-    scale: f64,
-) -> ((f64, f64, f64), u64) {
-    let (mut v, mut theta, mut phi) = start;
-    let mut dt = (0.3 * theta).max(0.1 * scale).min(0.5);
-    let mut dp = TAU / AZIMUTHS as f64;
-    let mut spent = 0u64;
-    while spent < 400 {
-        let candidates = [
-            (theta + dt, phi),
-            ((theta - dt).max(0.0), phi),
-            (theta, (phi + dp).rem_euclid(TAU)),
-            (theta, (phi - dp).rem_euclid(TAU)),
-        ];
-        let mut moved = false;
-        let mut flat = true;
-        for (t, f) in candidates {
-            let t = t.min(FRAC_PI_2);
-            let w = clean(p, t, f);
-            spent += 1;
-            if (w - v).abs() > 1e-6 * v {
-                flat = false;
-            }
-            if w > v {
-                (v, theta, phi) = (w, t, f);
-                moved = true;
-            }
-        }
-        if !moved {
-            if flat {
-                break;
-            }
-            dt *= 0.5;
-            dp *= 0.5;
-        }
-    }
-    ((v, theta, phi), spent)
-}
-
 /// The half-widths of the mode `at` = (p, θ, φ): along ±θ and ±arc, where p falls below
 /// e^{−1/2}·p(mode), probed geometrically from [`WIDTH_PROBE_MIN`] then bisected in ln width 8
-/// times.
-fn widths(p: &(dyn Fn(Vec3) -> f64 + Sync), at: (f64, f64, f64)) -> (Mode, u64) {
+/// times. With `prefetch`, the four ladders of probes (83 points each) go in one call and the
+/// bisections a step of all four at a time: 9 calls, not ~360.
+fn widths(
+    p: &(dyn Fn(Vec3) -> f64 + Sync),
+    prefetch: Prefetch<'_>,
+    at: (f64, f64, f64),
+) -> (Mode, u64) {
     let (v, theta, phi) = at;
     let level = v * (-0.5f64).exp();
-    let mut spent = 0u64;
     let sin = theta.sin().max(1e-300);
-    let mut half = |along: &dyn Fn(f64) -> f64| {
+    // The four directions from the mode, as the point at distance w along each (None: beyond
+    // the hemisphere in θ, where the density counts 0).
+    let along = |k: usize, w: f64| -> Option<(f64, f64)> {
+        match k {
+            0 | 1 => {
+                let t = if k == 0 { theta + w } else { theta - w };
+                (0.0..=FRAC_PI_2).contains(&t).then_some((t, phi))
+            }
+            2 => Some((theta, phi + w / sin)),
+            _ => Some((theta, phi - w / sin)),
+        }
+    };
+    let value = |k: usize, w: f64| along(k, w).map_or(0.0, |(t, f)| clean(p, t, f));
+    let fetch = |points: &[(usize, f64)]| {
+        if let Some(fetch) = prefetch {
+            let dirs: Vec<Vec3> = points
+                .iter()
+                .filter_map(|&(k, w)| along(k, w))
+                .map(|(t, f)| direction(t, f))
+                .collect();
+            fetch(&dirs);
+        }
+    };
+    // The geometric probes, all four ladders in one call, then each walked out until p falls
+    // below the level (or past π).
+    let mut ladder = vec![WIDTH_PROBE_MIN * PROBE_FACTOR];
+    while ladder[ladder.len() - 1] <= PI {
+        ladder.push(ladder[ladder.len() - 1] * PROBE_FACTOR);
+    }
+    let probes: Vec<(usize, f64)> = (0..4)
+        .flat_map(|k| ladder.iter().map(move |&w| (k, w)))
+        .collect();
+    fetch(&probes);
+    let mut spent = probes.len() as u64;
+    let mut bracket = [(WIDTH_PROBE_MIN, WIDTH_PROBE_MIN); 4];
+    for (k, b) in bracket.iter_mut().enumerate() {
         let mut below = WIDTH_PROBE_MIN;
         let mut above;
         loop {
             above = below * PROBE_FACTOR;
-            spent += 1;
-            if along(above) < level || above > PI {
+            if value(k, above) < level || above > PI {
                 break;
             }
             below = above;
         }
-        for _ in 0..8 {
-            let mid = (below * above).sqrt();
-            spent += 1;
-            if along(mid) < level {
-                above = mid;
+        *b = (below, above);
+    }
+    // Bisection in ln width, the four in lockstep: a call a step.
+    for _ in 0..8 {
+        let mids: Vec<(usize, f64)> = (0..4)
+            .map(|k| (k, (bracket[k].0 * bracket[k].1).sqrt()))
+            .collect();
+        fetch(&mids);
+        spent += 4;
+        for (k, mid) in mids {
+            if value(k, mid) < level {
+                bracket[k].1 = mid;
             } else {
-                below = mid;
+                bracket[k].0 = mid;
             }
         }
-        (below * above).sqrt()
-    };
-    let theta_at = |t: f64| {
-        if (0.0..=FRAC_PI_2).contains(&t) {
-            clean(p, t, phi)
-        } else {
-            0.0
-        }
-    };
-    let width_theta = half(&|w| theta_at(theta + w)).min(half(&|w| theta_at(theta - w)));
-    let width_arc =
-        half(&|w| clean(p, theta, phi + w / sin)).min(half(&|w| clean(p, theta, phi - w / sin)));
+    }
+    let half = |k: usize| (bracket[k].0 * bracket[k].1).sqrt();
     (
         Mode {
             theta,
             phi,
-            width_theta: width_theta.min(FRAC_PI_2),
-            width_arc: width_arc.min(PI),
+            width_theta: half(0).min(half(1)).min(FRAC_PI_2),
+            width_arc: half(2).min(half(3)).min(PI),
         },
         spent,
     )

@@ -37,6 +37,7 @@ pub mod hemisphere_grid;
 pub mod ks;
 pub mod lobe;
 pub mod lobe_centres;
+pub mod lobe_climb;
 pub mod monte_carlo;
 pub mod precise;
 pub mod quadrature;
