@@ -1,9 +1,9 @@
 //! Where samplers change regime, and how a failure is narrowed to a region: the incidences the
 //! Jacobian checks sweep (near normal, log-spaced in the stretched tilt α tan θi; around the
-//! critical angle on both sides; towards grazing; drawn per seed), the densities of a sampling
-//! map u ↦ direction by Richardson-extrapolated central differences at many points in one
-//! batch, and the bisection that narrows a failure found at some incidences to the interval of
-//! θi where it holds (the record's [`Region`]).
+//! critical angle on both sides; towards grazing; drawn per seed), the [`Density`] of a
+//! sampling map u ↦ direction by Richardson-extrapolated central differences and its bounds
+//! (measured in `check/step_ladder.rs`), and the bisection that narrows a failure found at some
+//! incidences to the interval of θi where it holds (the record's [`Region`]).
 //!
 //! A Jacobian check is deterministic, cheap (tens of sampler calls a point) and local: it sees
 //! a 1 % density error in a corner of the incidences that a chi-square over the whole sphere
@@ -256,96 +256,8 @@ impl Density {
     }
 }
 
-/// The offsets of a point's stencil in (u₁, u₂), in steps: ±1, ±½ and ±¼ along each.
-const STENCIL: [(f64, f64); 12] = [
-    (1.0, 0.0),
-    (-1.0, 0.0),
-    (0.0, 1.0),
-    (0.0, -1.0),
-    (0.5, 0.0),
-    (-0.5, 0.0),
-    (0.0, 0.5),
-    (0.0, -0.5),
-    (0.25, 0.0),
-    (-0.25, 0.0),
-    (0.0, 0.25),
-    (0.0, -0.25),
-];
-
 /// A sampling map in batch: `out[k]` the direction of `u[k]` (u₀, u₁, u₂), None where it fails.
 pub type BatchMap<'m> = dyn FnMut(&[[f64; 3]], &mut [Option<Vec3>]) + 'm;
-
-/// The directions at `centres` (u₀ fixed, u₁ and u₂ the coordinates of the map) and, where the
-/// map is defined on the whole stencil and stays on the centre's side of the surface there,
-/// its density by central differences with steps `h`, h/2 and h/4, for a map computed in
-/// precision `eps` (its ε), with the bound of its rounding from the noise the stencil shows
-/// ([`NOISE_DIVISOR`]) or [`DIRECTION_ULPS`], whichever is larger. `map` is one batch call:
-/// `out[k]` the direction of `u[k]`, None where the map fails. A point this stencil cannot
-/// judge, or judges failing, is measured again on a ladder of steps
-/// (`check/step_ladder.rs`).
-pub fn densities(
-    centres: &[[f64; 3]],
-    h: f64,
-    eps: f64,
-    map: &mut BatchMap<'_>,
-) -> Vec<(Option<Vec3>, Option<Density>)> {
-    const PER: usize = 1 + STENCIL.len();
-    let mut u = Vec::with_capacity(centres.len() * PER);
-    for c in centres {
-        u.push(*c);
-        for (a, b) in STENCIL {
-            u.push([c[0], c[1] + a * h, c[2] + b * h]);
-        }
-    }
-    let mut w = vec![None; u.len()];
-    map(&u, &mut w);
-    w.chunks(PER)
-        .map(|w| {
-            let centre = w[0];
-            let Some(c) = centre else {
-                return (None, None);
-            };
-            let all: Option<Vec<Vec3>> = w[1..].iter().copied().collect();
-            let Some(s) = all.filter(|s| s.iter().all(|d| (d[2] > 0.0) == (c[2] > 0.0))) else {
-                return (centre, None);
-            };
-            // The fourth differences along u₁ (s[1], s[5], c, s[4], s[0]) and u₂ (s[3], s[7],
-            // c, s[6], s[2]): the map's rounding noise.
-            let noise = (0..3)
-                .flat_map(|k| {
-                    let fourth = |a: usize, b: usize, d: usize, e: usize| {
-                        (s[a][k] - 4.0 * s[b][k] + 6.0 * c[k] - 4.0 * s[d][k] + s[e][k]).abs()
-                    };
-                    [fourth(1, 5, 4, 0), fourth(3, 7, 6, 2)]
-                })
-                .fold(0.0, f64::max);
-            let e = (DIRECTION_ULPS * eps).max(noise / NOISE_DIVISOR);
-            let columns = |k: usize, step: f64| {
-                let d = |p: Vec3, q: Vec3| {
-                    [
-                        (p[0] - q[0]) / (2.0 * step),
-                        (p[1] - q[1]) / (2.0 * step),
-                        (p[2] - q[2]) / (2.0 * step),
-                    ]
-                };
-                (d(s[k], s[k + 1]), d(s[k + 2], s[k + 3]))
-            };
-            // |a|, |b| and |a × b| of the columns at one step.
-            let lengths = |k: usize, step: f64| column_lengths(columns(k, step));
-            let density = |k: usize, step: f64| 1.0 / lengths(k, step).2;
-            (
-                centre,
-                Some(Density {
-                    coarse: density(0, h),
-                    fine: density(4, h / 2.0),
-                    finest: density(8, h / 4.0),
-                    rounding: rounding_bound(e, h, lengths(0, h)),
-                    finer: 0.0,
-                }),
-            )
-        })
-        .collect()
-}
 
 /// |a|, |b| and |a × b| of two columns.
 pub fn column_lengths((a, b): ([f64; 3], [f64; 3])) -> (f64, f64, f64) {
@@ -553,19 +465,6 @@ mod tests {
         assert!(r.text.contains("1.10 %"), "{}", r.text);
         assert_eq!(r.failing_incidences, 3);
         assert!(narrow(&at[3..], &mut |t| f(t), "density", "").is_none());
-    }
-
-    #[test]
-    fn the_densities_of_a_linear_map_are_exact() {
-        // u ↦ (u₁, 2u₂, 1) (not unit, but a map): density 1/2 everywhere.
-        let c = [[0.5, 0.3, 0.6]];
-        let d = densities(&c, 1e-3, f64::EPSILON, &mut |u, out| {
-            for (o, u) in out.iter_mut().zip(u) {
-                *o = Some([u[1], 2.0 * u[2], 1.0]);
-            }
-        });
-        let density = d[0].1.unwrap();
-        assert!((density.value() - 0.5).abs() < 1e-9, "{density:?}");
     }
 }
 

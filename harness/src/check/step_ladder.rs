@@ -1,6 +1,6 @@
-//! The step ladder of a finite-difference density: where the Jacobian checks' one stencil
-//! (`regime::densities`, steps h, h/2, h/4) cannot judge a point, or judges it failing, the
-//! point is measured again on a ladder of steps h·2ʲ, j from [`FINEST`] up to [`TOP`] in u, and
+//! The finite-difference densities of a sampling map at many points in one batch: first by one
+//! stencil ([`densities`], steps h, h/2, h/4); where that cannot judge a point, or judges it
+//! failing, the point is measured again on a ladder of steps h·2ʲ, j from [`FINEST`] up to [`TOP`] in u, and
 //! judged at the rung whose error bound is smallest.
 //!
 //! Why: the error of a central-difference density is truncation, which grows with the step,
@@ -68,16 +68,37 @@ pub fn ladder(
     map: &mut BatchMap<'_>,
 ) -> Vec<Option<Density>> {
     let levels = levels(h);
-    // Per point: the index of its centre in the batch and, per level, of its first offset
-    // (None where the stencil leaves [0, 1)).
+    let steps: Vec<f64> = levels.iter().map(|l| l.1).collect();
+    stencils(centres, &steps, map)
+        .into_iter()
+        .map(|(c, at)| {
+            // The noise of the finest rungs (FINEST + NOISE_RUNGS at the most).
+            let fine = levels
+                .iter()
+                .filter(|l| l.0 <= FINEST + NOISE_RUNGS)
+                .count();
+            let rungs = Rungs::new(&steps, &at, c?, eps, fine);
+            best(&rungs, unresolved)
+        })
+        .collect()
+}
+
+/// The directions of one point: its centre (None where the map fails there) and, at each
+/// step, the four offsets (+u₁, −u₁, +u₂, −u₂), None where the stencil leaves [0, 1), the map
+/// fails, or a direction is not on the centre's side of the surface.
+type PointStencils = (Option<Vec3>, Vec<Option<[Vec3; 4]>>);
+
+/// The stencils of every point of `centres` at `steps`, in one call of `map`.
+fn stencils(centres: &[[f64; 3]], steps: &[f64], map: &mut BatchMap<'_>) -> Vec<PointStencils> {
+    // Per point: the index of its centre in the batch and, per step, of its first offset.
     let mut u = Vec::new();
     let mut at: Vec<(usize, Vec<Option<usize>>)> = Vec::with_capacity(centres.len());
     for c in centres {
         let centre = u.len();
         u.push(*c);
         let inside = |d: f64| [c[1], c[2]].iter().all(|x| *x - d >= 0.0 && *x + d < 1.0);
-        let mut first = Vec::with_capacity(levels.len());
-        for &(_, d) in &levels {
+        let mut first = Vec::with_capacity(steps.len());
+        for &d in steps {
             if inside(d) {
                 first.push(Some(u.len()));
                 u.extend(AXES.map(|(a, b)| [c[0], c[1] + a * d, c[2] + b * d]));
@@ -91,9 +112,11 @@ pub fn ladder(
     map(&u, &mut w);
     at.iter()
         .map(|(centre, first)| {
-            let c = w[*centre]?;
+            let Some(c) = w[*centre] else {
+                return (None, vec![None; first.len()]);
+            };
             let same_side = |d: &Vec3| (d[2] > 0.0) == (c[2] > 0.0);
-            let stencils: Vec<Option<[Vec3; 4]>> = first
+            let stencils = first
                 .iter()
                 .map(|f| {
                     let s: Option<Vec<Vec3>> = w[(*f)?..(*f)? + 4].iter().copied().collect();
@@ -101,7 +124,93 @@ pub fn ladder(
                     Some([s[0], s[1], s[2], s[3]])
                 })
                 .collect();
-            best(&levels, &stencils, c, eps, unresolved)
+            (Some(c), stencils)
+        })
+        .collect()
+}
+
+/// The densities of one point's stencils at ascending `steps`, with the rounding of its
+/// directions: the largest fourth difference (offsets −2d, −d, 0, d, 2d along each axis and
+/// component) of the pairs of consecutive steps among the first `noisy`, over
+/// [`NOISE_DIVISOR`], at least [`DIRECTION_ULPS`] ε.
+struct Rungs<'a> {
+    steps: &'a [f64],
+    /// |a|, |b| and |a × b| of the columns at each step (the density is 1/|a × b|).
+    lengths: Vec<Option<(f64, f64, f64)>>,
+    /// The rounding of each direction component.
+    e: f64,
+}
+
+impl<'a> Rungs<'a> {
+    fn new(
+        steps: &'a [f64],
+        stencils: &[Option<[Vec3; 4]>],
+        c: Vec3,
+        eps: f64,
+        noisy: usize,
+    ) -> Self {
+        let mut noise: f64 = 0.0;
+        for k in 1..noisy.min(stencils.len()) {
+            let (Some(big), Some(small)) = (stencils[k], stencils[k - 1]) else {
+                continue;
+            };
+            for axis in [0, 2] {
+                for i in 0..3 {
+                    let f = big[axis][i] - 4.0 * small[axis][i] + 6.0 * c[i]
+                        - 4.0 * small[axis + 1][i]
+                        + big[axis + 1][i];
+                    noise = noise.max(f.abs());
+                }
+            }
+        }
+        let columns = |s: &[Vec3; 4], d: f64| {
+            let col = |p: Vec3, q: Vec3| [0, 1, 2].map(|i| (p[i] - q[i]) / (2.0 * d));
+            (col(s[0], s[1]), col(s[2], s[3]))
+        };
+        Rungs {
+            steps,
+            lengths: stencils
+                .iter()
+                .zip(steps)
+                .map(|(s, &d)| Some(column_lengths(columns(s.as_ref()?, d))))
+                .collect(),
+            e: (DIRECTION_ULPS * eps).max(noise / NOISE_DIVISOR),
+        }
+    }
+
+    /// The Richardson triple whose coarsest step is `steps[k]` (with k − 1 and k − 2).
+    fn triple(&self, k: usize) -> Option<Density> {
+        let at = self.lengths[k]?;
+        Some(Density {
+            coarse: 1.0 / at.2,
+            fine: 1.0 / self.lengths[k.checked_sub(1)?]?.2,
+            finest: 1.0 / self.lengths[k.checked_sub(2)?]?.2,
+            rounding: rounding_bound(self.e, self.steps[k], at),
+            finer: 0.0,
+        })
+    }
+}
+
+/// The directions at `centres` (u₀ fixed, u₁ and u₂ the coordinates of the map) and, where the
+/// map is defined on the whole stencil and stays on the centre's side of the surface there,
+/// its density by central differences with steps `h`, h/2 and h/4 (the single stencil), for a
+/// map computed in precision `eps` (its ε), with the bound of its rounding from the noise the
+/// stencil shows ([`NOISE_DIVISOR`]) or [`DIRECTION_ULPS`], whichever is larger. `map` is one
+/// batch call: `out[k]` the direction of `u[k]`, None where the map fails. A point this
+/// stencil cannot judge, or judges failing, is measured again on the ladder
+/// ([`measure_again`]).
+pub fn densities(
+    centres: &[[f64; 3]],
+    h: f64,
+    eps: f64,
+    map: &mut BatchMap<'_>,
+) -> Vec<(Option<Vec3>, Option<Density>)> {
+    let steps = [h / 4.0, h / 2.0, h];
+    stencils(centres, &steps, map)
+        .into_iter()
+        .map(|(c, at)| {
+            let density = c.and_then(|c| Rungs::new(&steps, &at, c, eps, 3).triple(2));
+            (c, density)
         })
         .collect()
 }
@@ -132,62 +241,16 @@ pub fn measure_again(
     }
 }
 
-/// The best rung of one point from its stencils (`stencils[k]` at step `levels[k]`).
-fn best(
-    levels: &[(i32, f64)],
-    stencils: &[Option<[Vec3; 4]>],
-    c: Vec3,
-    eps: f64,
-    unresolved: f64,
-) -> Option<Density> {
-    // The noise: the largest fourth difference of consecutive steps up to FINEST + NOISE_RUNGS,
-    // along each axis and component (offsets −2d, −d, 0, d, 2d).
-    let mut noise: f64 = 0.0;
-    for k in 1..levels.len() {
-        let (Some(big), Some(small), true) = (
-            stencils[k],
-            stencils[k - 1],
-            levels[k].0 <= FINEST + NOISE_RUNGS,
-        ) else {
-            continue;
-        };
-        for axis in [0, 2] {
-            for i in 0..3 {
-                let f = big[axis][i] - 4.0 * small[axis][i] + 6.0 * c[i] - 4.0 * small[axis + 1][i]
-                    + big[axis + 1][i];
-                noise = noise.max(f.abs());
-            }
-        }
-    }
-    let e = (DIRECTION_ULPS * eps).max(noise / NOISE_DIVISOR);
-    let columns = |s: &[Vec3; 4], d: f64| {
-        let col = |p: Vec3, q: Vec3| [0, 1, 2].map(|i| (p[i] - q[i]) / (2.0 * d));
-        (col(s[0], s[1]), col(s[2], s[3]))
-    };
-    // |a|, |b| and |a × b| at each step: the density is 1/|a × b|.
-    let lengths: Vec<Option<(f64, f64, f64)>> = stencils
-        .iter()
-        .zip(levels)
-        .map(|(s, &(_, d))| Some(column_lengths(columns(s.as_ref()?, d))))
-        .collect();
-    let triple = |k: usize| -> Option<Density> {
-        let at = lengths[k]?;
-        Some(Density {
-            coarse: 1.0 / at.2,
-            fine: 1.0 / lengths[k.checked_sub(1)?]?.2,
-            finest: 1.0 / lengths[k.checked_sub(2)?]?.2,
-            rounding: rounding_bound(e, levels[k].1, at),
-            finer: 0.0,
-        })
-    };
-    (3..levels.len())
+/// The best rung of one point: among the triples with both neighbours, resolved and converging
+/// as d⁴ (their differences in a ratio within [8, 32] of the asymptotic 16) or within their
+/// rounding, the one of smallest allowance.
+fn best(rungs: &Rungs<'_>, unresolved: f64) -> Option<Density> {
+    (3..rungs.steps.len())
         .filter_map(|k| {
-            let mut t = triple(k)?;
-            let below = triple(k - 1)?;
+            let mut t = rungs.triple(k)?;
+            let below = rungs.triple(k - 1)?;
             let v = t.value();
             t.finer = ((v - below.value()) / v).abs();
-            // The rungs converge as d⁴ (their differences in a ratio within [8, 32] of the
-            // asymptotic 16), or differ by no more than their rounding.
             let coarser = t.extrapolation();
             let ratio = coarser / t.finer;
             let converging =
@@ -200,7 +263,6 @@ fn best(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::check::regime;
 
     /// A map of density 50 whose first component carries a white rounding-like error of up
     /// to 1e-12 (a pseudo-random function of u, thousands of ulps, as a map that cancels
@@ -219,9 +281,7 @@ mod tests {
         };
         let c = [[0.5, 0.31, 0.62]];
         let exact = 1.0 / 0.02;
-        let base = regime::densities(&c, 1e-4, f64::EPSILON, &mut map)[0]
-            .1
-            .unwrap();
+        let base = densities(&c, 1e-4, f64::EPSILON, &mut map)[0].1.unwrap();
         let d = ladder(&c, 1e-4, f64::EPSILON, 1e-3, &mut map)[0].unwrap();
         let error = ((d.value() - exact) / exact).abs();
         eprintln!(
@@ -234,6 +294,19 @@ mod tests {
             error <= d.allowance() && d.allowance() < 1e-6,
             "{d:?} {error}"
         );
+    }
+
+    #[test]
+    fn the_densities_of_a_linear_map_are_exact() {
+        // u ↦ (u₁, 2u₂, 1) (not unit, but a map): density 1/2 everywhere.
+        let c = [[0.5, 0.3, 0.6]];
+        let d = densities(&c, 1e-3, f64::EPSILON, &mut |u, out| {
+            for (o, u) in out.iter_mut().zip(u) {
+                *o = Some([u[1], 2.0 * u[2], 1.0]);
+            }
+        });
+        let density = d[0].1.unwrap();
+        assert!((density.value() - 0.5).abs() < 1e-9, "{density:?}");
     }
 
     /// A map with a kink 3e-5 from the point along u₁: the rungs whose stencil reaches across

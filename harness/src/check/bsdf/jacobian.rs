@@ -205,7 +205,7 @@ pub fn measure(
             *o = w;
         }
     };
-    let mut d = regime::densities(&centres, step, eps, &mut map);
+    let mut d = step_ladder::densities(&centres, step, eps, &mut map);
     let wo: Vec<Vec3> = d.iter().map(|(c, _)| c.unwrap_or(wi)).collect();
     let mut pdf = vec![0.0; wo.len()];
     bsdf.pdf_batch(&vec![wi; wo.len()], &wo, &mut pdf);

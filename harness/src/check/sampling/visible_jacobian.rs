@@ -49,7 +49,7 @@ pub fn measure(
             *o = m.iter().all(|c| c.is_finite()).then_some(*m);
         }
     };
-    let mut d = regime::densities(&centres, step, eps, &mut map);
+    let mut d = step_ladder::densities(&centres, step, eps, &mut map);
     let normals: Vec<Vec3> = d
         .iter()
         .map(|(c, _)| c.unwrap_or([0.0, 0.0, 1.0]))
